@@ -1,0 +1,75 @@
+// The smooth reference line: a closed curve fitted through a track's waypoints with Ceres
+// (stay close to the waypoints, penalise change of curvature; periodic, so smooth across the
+// seam), re-parametrised by its own arc length and sampled densely. All Frenet conversion of
+// the planner happens on it. s is periodic with period length(); d is positive to the right of
+// the driving direction (the simulator's convention).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "frenetic/map/track.h"
+#include "frenetic/status.h"
+
+namespace frenetic::map {
+
+struct FrenetPoint {
+  double s = 0, d = 0;  // m
+};
+
+struct CartesianPose {
+  double x = 0, y = 0;   // m
+  double heading = 0;    // rad, counter-clockwise from +x, the road direction at s
+  double kappa = 0;      // 1/m, curvature of the offset curve at (s, d); positive turning left
+};
+
+// One sample of the centre line (d = 0).
+struct RefSample {
+  double s = 0, x = 0, y = 0, heading = 0, kappa = 0, dkappa = 0;
+};
+
+class ReferenceLine {
+ public:
+  struct Options {
+    double sample_step = 0.5;         // m between stored samples (≤ 1)
+    double control_spacing = 10.0;    // m between the fitted curve's control points
+    double smoothness_weight = 1.0;   // weight of the change-of-curvature penalty
+    int max_iterations = 200;         // Ceres iterations
+    Status Validate() const;          // a message naming the bad option
+  };
+
+  // Fits the line. Fails (with a message) only on an unusable track or options.
+  static StatusOr<std::shared_ptr<const ReferenceLine>> Fit(const Track& track,
+                                                            const Options& options);
+  static StatusOr<std::shared_ptr<const ReferenceLine>> Fit(const Track& track) {
+    return Fit(track, Options());
+  }
+
+  double length() const;  // loop length in the line's own arc length (≈ track max_s)
+  double WrapS(double s) const;                  // s modulo length(), in [0, length())
+  double DiffS(double s_to, double s_from) const;  // signed s_to − s_from in [−L/2, L/2)
+
+  // Pose of the point at (s, d): x, y, heading of the road there and curvature of the offset
+  // curve. Any finite s is wrapped. Never fails.
+  CartesianPose ToCartesian(double s, double d) const;
+  // Projection of (x, y) onto the line (Newton steps), robust at the seam and far from the road.
+  // With a hint the search starts near s_hint (faster; falls back to a global search if needed).
+  FrenetPoint ToFrenet(double x, double y) const;
+  FrenetPoint ToFrenet(double x, double y, double s_hint) const;
+
+  RefSample At(double s) const;  // interpolated centre-line sample at s (wrapped)
+  const std::vector<RefSample>& samples() const;
+
+  // Diagnostics of the fit.
+  double max_waypoint_distance() const;  // largest distance from a waypoint to the line, m
+  double max_map_s_difference() const;   // largest |s_line − s_map| at the waypoints, m
+
+  ~ReferenceLine();
+  struct Impl;
+  explicit ReferenceLine(std::unique_ptr<Impl> impl);
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace frenetic::map

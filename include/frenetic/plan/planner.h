@@ -1,0 +1,88 @@
+// The planner interface every planner implements (`search`, `baseline`), and what one planning
+// cycle returns. Plan() never throws, never returns NaN and never returns fewer than
+// kMinPathPoints points; after warm-up it does not allocate.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "frenetic/map/reference_line.h"
+#include "frenetic/plan/telemetry.h"
+#include "frenetic/status.h"
+
+namespace frenetic::plan {
+
+inline constexpr int kMinPathPoints = 50;
+inline constexpr double kTickSeconds = 0.02;  // the simulator's physics step
+
+enum class PlanStatus : std::uint8_t {
+  kOk,             // the search found a feasible, collision-free trajectory
+  kFallbackUsed,   // nothing passed; the keep-lane braking backup was sent
+  kInvalidInput,   // telemetry was unusable (NaN, empty...); a safe path was still returned
+  kOverBudget,     // the deadline cut the search short; the best result so far was sent
+};
+const char* ToString(PlanStatus status);
+
+// Why a candidate was rejected (hard filters, counted per reason).
+enum class Reject : std::uint8_t {
+  kSpeed, kAcceleration, kJerk, kOffRoad, kCollision, kCount
+};
+const char* ToString(Reject reason);
+
+// One weighted cost term of a candidate: name, weight, unweighted value.
+struct CostTermValue {
+  std::string name;
+  double weight = 0;
+  double value = 0;  // unweighted; contribution = weight * value
+};
+
+struct PlanSummary {
+  int candidates_generated = 0;
+  int candidates_scored = 0;
+  int candidates_checked = 0;   // went through the lazy feasibility / collision check
+  int candidates_feasible = 0;  // passed it (the first one wins)
+  std::array<int, static_cast<int>(Reject::kCount)> rejections{};
+  std::vector<CostTermValue> winner_costs;  // per term, in config order (capacity kept)
+  double winner_total_cost = 0;
+  int winner_lane = -1;           // target lane of the winner (0 = left)
+  double winner_end_speed = 0;    // m/s
+  double winner_duration = 0;     // s
+  int refine_iterations = 0;
+  double refine_cost_before = 0;
+  double refine_cost_after = 0;
+  int points_kept = 0;            // from the previous path
+  // Time per stage, milliseconds.
+  double ms_prepare = 0, ms_generate = 0, ms_score = 0, ms_check = 0, ms_refine = 0,
+         ms_output = 0, ms_total = 0;
+};
+
+struct PlanResult {
+  PlanStatus status = PlanStatus::kOk;
+  std::vector<double> x, y;  // map frame, m, one point per 0.02 s tick
+  PlanSummary summary;
+};
+
+class Planner {
+ public:
+  virtual ~Planner() = default;
+  // One planning cycle. The returned reference stays valid until the next call.
+  virtual const PlanResult& Plan(const Telemetry& telemetry) = 0;
+  // Forget all state (a new episode).
+  virtual void Reset() = 0;
+  virtual std::string_view name() const = 0;
+};
+
+class PlannerConfig;  // plan/planner_config.h
+
+// Names accepted by MakePlanner: "search", "baseline".
+std::vector<std::string> PlannerNames();
+
+// Builds the named planner on a reference line with a validated configuration.
+StatusOr<std::unique_ptr<Planner>> MakePlanner(std::string_view name, const PlannerConfig& config,
+                                               std::shared_ptr<const map::ReferenceLine> line);
+
+}  // namespace frenetic::plan

@@ -1,0 +1,29 @@
+// The simulator's telemetry, in SI units (the wire's mph and degrees are converted at the edges,
+// in net/ and sim/). Map frame: x east, y north, heading counter-clockwise from +x.
+#pragma once
+
+#include <vector>
+
+namespace frenetic::plan {
+
+// One sensor_fusion row. vx, vy in m/s in the map frame; s, d as the simulator reported them
+// (its chord-based Frenet, NaN replaced by 0). Parked cars have d far below 0.
+struct SensorCar {
+  int id = 0;
+  double x = 0, y = 0;
+  double vx = 0, vy = 0;
+  double s = 0, d = 0;
+};
+
+struct Telemetry {
+  double x = 0, y = 0;  // ego position, m
+  double yaw = 0;       // ego heading, rad, counter-clockwise from +x
+  double speed = 0;     // m/s (the simulator's displacement per tick / 0.02 s)
+  double s = 0, d = 0;  // the simulator's chord-based Frenet of the ego, m
+  std::vector<double> previous_path_x;  // unvisited points of the path sent last, m
+  std::vector<double> previous_path_y;
+  double end_path_s = 0, end_path_d = 0;  // simulator's Frenet of the last unvisited point (quirky)
+  std::vector<SensorCar> sensor_fusion;
+};
+
+}  // namespace frenetic::plan

@@ -1,0 +1,46 @@
+# Shared set-up for run.sh and test.sh: install missing Debian packages, configure, build.
+# Sourced, not run. Idempotent: does nothing slow when everything is in place.
+set -euo pipefail
+
+FRENETIC_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${FRENETIC_BUILD_DIR:-$FRENETIC_ROOT/build}"
+JOBS="${FRENETIC_JOBS:-$(nproc)}"
+
+# Debian 12 packages the build needs.
+BUILD_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev libnlopt-cxx-dev libceres-dev libboost-dev
+  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libopenmpi-dev openmpi-bin
+)
+
+log() { printf '[frenetic] %s\n' "$*" >&2; }
+
+# ensure_packages PKG...: apt-get installs the ones that are missing (as root, or with sudo).
+ensure_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  log "installing missing packages: ${missing[*]}"
+  local sudo=()
+  [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# configure_and_build [extra cmake args...]
+configure_and_build() {
+  local generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+    log "configuring a Release build in $BUILD_DIR"
+    cmake -S "$FRENETIC_ROOT" -B "$BUILD_DIR" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+  elif [ $# -gt 0 ]; then
+    cmake -S "$FRENETIC_ROOT" -B "$BUILD_DIR" "$@" >/dev/null
+  fi
+  log "building with $JOBS jobs"
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+}
