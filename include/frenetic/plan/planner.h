@@ -66,6 +66,24 @@ struct PlanResult {
   PlanSummary summary;
 };
 
+// Optional per-cycle explanation for reports (`frenetic drive --record`): the best candidates
+// of the cycle with their costs and what became of them. Filling it may allocate; it is off
+// unless a trace is attached.
+struct CandidateTrace {
+  int lane = -1;              // target lane
+  double end_speed = 0;       // m/s
+  double duration = 0;        // s
+  double total_cost = 0;      // weighted sum
+  bool checked = false;       // went through the feasibility / collision check
+  bool winner = false;
+  int reject = -1;            // static_cast<int>(Reject) when checked and rejected, else -1
+  std::vector<double> x, y;   // the candidate's path in the map frame, coarsely sampled (~0.25 s)
+  std::vector<CostTermValue> costs;  // per term, config order
+};
+struct CycleTrace {
+  std::vector<CandidateTrace> candidates;  // best first
+};
+
 class Planner {
  public:
   virtual ~Planner() = default;
@@ -74,6 +92,12 @@ class Planner {
   // Forget all state (a new episode).
   virtual void Reset() = 0;
   virtual std::string_view name() const = 0;
+  // Attach (or detach with nullptr) a trace the next Plan() calls fill with up to
+  // `max_candidates` candidates. Planners without candidates leave it empty.
+  virtual void set_trace(CycleTrace* trace, int max_candidates) {
+    (void)trace;
+    (void)max_candidates;
+  }
 };
 
 class PlannerConfig;  // plan/planner_config.h
