@@ -1,6 +1,8 @@
 // The simulator's own Frenet conversion (udacity-sim.md §5.3): chord polyline through the
 // waypoints, nearest waypoint of the *owner* position, float32 arithmetic. The headless
-// simulator reports every s and d with it, exactly as the Unity simulator does.
+// simulator reports every s and d with it, exactly as the Unity simulator does. The §10 validation
+// vectors reproduce to 1e-3 m (the spawned car's to 4e-3 m: its logged position is rounded).
+// Sign of d: negative when p is at least as close to (1000, 2000) as its foot on the chord.
 #pragma once
 
 #include <vector>

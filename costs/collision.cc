@@ -1,0 +1,52 @@
+// collision: predicted overlap of the oriented ego footprint (heading from the Frenet velocity)
+// with predicted cars' footprints, each inflated by a safety margin. Earlier overlaps weigh more
+// (1 / (1 + t / time_scale)); the value is in [0, 1].
+#include <algorithm>
+#include <cmath>
+
+#include "frenetic/cost/cost_registry.h"
+#include "frenetic/traj/box.h"
+
+namespace frenetic::cost {
+namespace {
+
+class CollisionCost : public CostTerm {
+ public:
+  std::vector<CostParamSpec> ParamSpecs() const override {
+    return {{"margin", 0.5, 0.0, 3.0, false}, {"time_scale", 2.0, 0.2, 20.0, true}};
+  }
+  void Configure(std::span<const double> v) override {
+    margin_ = v[0];
+    time_scale_ = v[1];
+  }
+  double Evaluate(const CostContext& ctx, const CostInput& in) const override {
+    const int n = ctx.num_samples;
+    if (n == 0 || ctx.num_cars == 0) return 0.0;
+    const double hl = 0.5 * ctx.car_length + margin_, hw = 0.5 * ctx.car_width + margin_;
+    // Cheap reject first: no overlap is possible beyond the boxes' circumscribed reach.
+    const double reach = 2.0 * std::hypot(hl, hw);
+    double sum = 0;
+    for (int k = 0; k < n; ++k) {
+      bool hit = false;
+      for (int c = 0; c < ctx.num_cars && !hit; ++c) {
+        const double ds = ctx.car_s[c * n + k] - in.s[k];
+        const double dd = ctx.car_d[c] - in.d[k];
+        if (std::abs(ds) > reach || std::abs(dd) > reach) continue;
+        const traj::OrientedBox ego{in.s[k], in.d[k], std::atan2(in.d_d[k], std::max(in.s_d[k], 0.5)),
+                                    hl, hw};
+        const traj::OrientedBox car{ctx.car_s[c * n + k], ctx.car_d[c], 0.0, hl, hw};
+        hit = traj::Overlap(ego, car);
+      }
+      if (hit) sum += 1.0 / (1.0 + k * ctx.dt / time_scale_);
+    }
+    return sum / n;
+  }
+
+ private:
+  double margin_ = 0.5, time_scale_ = 2.0;
+};
+
+}  // namespace
+}  // namespace frenetic::cost
+
+FRENETIC_REGISTER_COST(collision, frenetic::cost::CollisionCost);

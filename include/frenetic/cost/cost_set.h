@@ -1,0 +1,45 @@
+// An immutable, weighted set of cost terms in config order: the snapshot the planner scores
+// with. Built once from validated configuration; shared read-only (weights can change between
+// cycles by building a new set).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "frenetic/cost/cost_term.h"
+#include "frenetic/status.h"
+
+namespace frenetic::cost {
+
+// One term as configured: its registered name, weight (>= 0) and parameter values by key
+// (absent keys take the term's defaults).
+struct CostTermConfig {
+  std::string name;
+  double weight = 0;
+  std::vector<std::pair<std::string, double>> params;
+};
+
+class CostSet {
+ public:
+  // Errors name the unknown term, the unknown parameter key or the bad value.
+  static StatusOr<std::shared_ptr<const CostSet>> Build(const std::vector<CostTermConfig>& terms);
+
+  int size() const { return static_cast<int>(terms_.size()); }
+  const std::string& name(int i) const { return names_[i]; }
+  double weight(int i) const { return weights_[i]; }
+  const CostTerm& term(int i) const { return *terms_[i]; }
+
+  // Weighted sum over the terms in config order. When per_term is not null it receives the
+  // unweighted value of each term (size() entries). Does not allocate.
+  double Evaluate(const CostContext& ctx, const CostInput& in, double* per_term = nullptr) const;
+
+ private:
+  CostSet() = default;
+  std::vector<std::string> names_;
+  std::vector<double> weights_;
+  std::vector<std::unique_ptr<CostTerm>> terms_;
+};
+
+}  // namespace frenetic::cost

@@ -1,0 +1,86 @@
+// The cost-term interface. A term measures one thing about one candidate trajectory and returns
+// an UNWEIGHTED, finite, non-negative number scaled by a physical bound (jerk / 2 m/s^3, offset /
+// lane width...), so that the weights in config/planner.yaml stay within about 1–10. A term never
+// knows its weight. Terms live in costs/*.cc, one per file, and register themselves by name with
+// FRENETIC_REGISTER_COST (cost_registry.h).
+#pragma once
+
+#include <span>
+#include <string>
+#include <vector>
+
+namespace frenetic::cost {
+
+inline constexpr int kMaxLanes = 8;
+
+// What every term may read about the planning cycle (shared by all candidates). Frenet frame of
+// the reference line, s unwrapped (continuous through the loop's seam), d positive to the right.
+// Sample k of every array is at time t_k = k * dt after the candidates' start state.
+struct CostContext {
+  int num_samples = 0;  // n
+  double dt = 0.25;     // s between samples
+  double lane_width = 4.0;
+  int num_lanes = 3;
+  // Largest s-speed per lane that keeps the XY speed under the cap (m/s; curves make outer lanes
+  // faster in XY than in s).
+  double lane_speed_limit[kMaxLanes] = {};
+  double lane_center[kMaxLanes] = {};  // d of each lane's centre, m
+  // The start state.
+  double start_s = 0, start_d = 0, start_speed = 0;
+  int current_lane = 0;  // lane whose centre is nearest start_d
+  // Decision memory for hysteresis: the lane targeted last cycle and how long ago the latest
+  // lane change was chosen (s; large when none).
+  int previous_target_lane = -1;
+  double time_since_lane_change = 1e9;
+  int lane_before_change = -1;  // lane the latest lane change left (-1: none)
+  // Last cycle's chosen trajectory at the same sample times (nullptr when there is none).
+  const double* previous_s = nullptr;
+  const double* previous_d = nullptr;
+  // Predicted traffic: car c at sample k is at (car_s[c * n + k], car_d[c]) moving at car_v[c]
+  // along the lane. Cars the planner deems irrelevant (far, or behind in the ego's own lane) are
+  // already left out.
+  int num_cars = 0;
+  const double* car_s = nullptr;
+  const double* car_d = nullptr;
+  const double* car_v = nullptr;
+  double car_length = 4.8, car_width = 2.4;  // footprint of every car, ego included, m
+};
+
+enum class LonKind : int { kVelocityKeeping = 0, kFollowing = 1, kStopping = 2 };
+
+// One candidate, as sampled for scoring (struct of arrays, ctx.num_samples long).
+struct CostInput {
+  const double* s = nullptr;  // m
+  const double* s_d = nullptr;
+  const double* s_dd = nullptr;
+  const double* d = nullptr;  // m
+  const double* d_d = nullptr;
+  const double* d_dd = nullptr;
+  double lon_duration = 0, lat_duration = 0;  // s
+  // Integrals of squared jerk over each polynomial's duration (m^2/s^5).
+  double lon_jerk_squared = 0, lat_jerk_squared = 0;
+  double end_speed = 0;  // s-speed at the end of the longitudinal polynomial, m/s
+  double end_d = 0;      // m
+  int target_lane = 0;
+  LonKind kind = LonKind::kVelocityKeeping;
+};
+
+// A tunable parameter a term declares, with its default and a sensible range.
+struct CostParamSpec {
+  std::string key;
+  double default_value = 0, lo = 0, hi = 0;
+  bool log_scale = false;
+};
+
+class CostTerm {
+ public:
+  virtual ~CostTerm() = default;
+  // The term's parameters (none by default). Keys are plain identifiers.
+  virtual std::vector<CostParamSpec> ParamSpecs() const { return {}; }
+  // Receives one value per ParamSpecs() entry, in that order, each within [lo, hi].
+  virtual void Configure(std::span<const double> values) { (void)values; }
+  // The unweighted cost: finite and >= 0 for any finite input. Must not allocate.
+  virtual double Evaluate(const CostContext& ctx, const CostInput& in) const = 0;
+};
+
+}  // namespace frenetic::cost

@@ -1,0 +1,41 @@
+// Hard feasibility of a path in the map frame, measured the way the simulator measures it
+// (udacity-sim.md §7.1–7.3): per-tick speed; total acceleration as differences of 0.2 s block
+// means of speed plus v^2 times the block's mean Menger curvature; jerk as differences of 1 s
+// means of that acceleration. The planner's check evaluates EVERY block alignment (sliding
+// windows), so it is conservative whatever phase the simulator's blocks have.
+#pragma once
+
+#include <span>
+#include <vector>
+
+namespace frenetic::plan {
+
+struct XyLimits {
+  double max_speed = 22.128;  // m/s per 0.02 s step
+  double max_accel = 9.0;     // m/s^2
+  double max_jerk = 9.0;      // m/s^3
+};
+
+// Worst values found (m/s, m/s^2, m/s^3).
+struct XyMeasure {
+  double max_speed = 0, max_accel = 0, max_jerk = 0;
+};
+
+class XyChecker {
+ public:
+  explicit XyChecker(int capacity = 1024);
+  // Worst speed, acceleration and jerk of the path (points 0.02 s apart) over all windows that
+  // end at or after index `first`. Windows reaching before index 0 are skipped. Does not
+  // allocate for n <= capacity (larger n is truncated to capacity). NaN points give NaN values.
+  XyMeasure Measure(const double* x, const double* y, int n, int first);
+
+ private:
+  std::vector<double> v_, kappa_, vsum_, ksum_, acc_, asum_;
+};
+
+// The simulator's own measure for tests: fixed blocks starting at tick `phase`, with
+// v̄_{-1} = 0 and Ā_{-1} = 0 as the simulator starts. Speeds are displacement / 0.02 s.
+XyMeasure MeasureLikeSimulator(std::span<const double> x, std::span<const double> y,
+                               int phase = 0);
+
+}  // namespace frenetic::plan

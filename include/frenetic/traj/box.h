@@ -1,0 +1,18 @@
+// Oriented rectangles (car footprints) and their overlap test (separating axis theorem). Works
+// in any planar frame; the planner uses it in Frenet coordinates (s, d), where the road's
+// curvature distorts boxes negligibly at car scale.
+#pragma once
+
+namespace frenetic::traj {
+
+struct OrientedBox {
+  double cx = 0, cy = 0;   // centre, m
+  double heading = 0;      // rad, direction of the long side
+  double half_length = 0;  // m, along heading
+  double half_width = 0;   // m
+};
+
+// True when the boxes overlap (touching counts). Never fails; NaN input gives false.
+bool Overlap(const OrientedBox& a, const OrientedBox& b);
+
+}  // namespace frenetic::traj

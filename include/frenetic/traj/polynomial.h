@@ -1,0 +1,52 @@
+// Jerk-optimal 1-D polynomials of the Frenet lattice (Werling, Ziegler, Kammel, Thrun, "Optimal
+// Trajectory Generation for Dynamic Street Scenarios in a Frenet Frame", ICRA 2010): quintics
+// that join a start state (position, velocity, acceleration) to an end state, and quartics that
+// join a start state to an end velocity and acceleration (velocity keeping).
+#pragma once
+
+#include <array>
+
+namespace frenetic::traj {
+
+// Position, velocity, acceleration and jerk of a 1-D motion at one instant (SI units).
+struct State1d {
+  double p = 0, v = 0, a = 0, j = 0;
+};
+
+// p(t) = c0 + c1 t + c2 t^2 + c3 t^3 + c4 t^4 + c5 t^5, t in seconds from the start.
+struct Polynomial5 {
+  std::array<double, 6> c{};
+
+  double P(double t) const { return c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * (c[4] + t * c[5])))); }
+  double V(double t) const { return c[1] + t * (2 * c[2] + t * (3 * c[3] + t * (4 * c[4] + t * 5 * c[5]))); }
+  double A(double t) const { return 2 * c[2] + t * (6 * c[3] + t * (12 * c[4] + t * 20 * c[5])); }
+  double J(double t) const { return 6 * c[3] + t * (24 * c[4] + t * 60 * c[5]); }
+  State1d At(double t) const { return {P(t), V(t), A(t), J(t)}; }
+  // Closed form of the integral of J(t)^2 over [0, t_end], the comfort term of Werling et al.
+  double JerkSquaredIntegral(double t_end) const;
+  bool IsFinite() const;
+};
+
+// The quintic with p(0)=x0, v(0)=v0, a(0)=a0, p(T)=x1, v(T)=v1, a(T)=a1. T must be > 0
+// (callers validate; T <= 0 returns the constant-velocity polynomial through the start state).
+Polynomial5 SolveQuintic(double x0, double v0, double a0, double x1, double v1, double a1, double T);
+
+// The quartic (c5 = 0) with p(0)=x0, v(0)=v0, a(0)=a0, v(T)=v1, a(T)=a1; the end position is free.
+// T <= 0 returns the constant-velocity polynomial through the start state.
+Polynomial5 SolveQuartic(double x0, double v0, double a0, double v1, double a1, double T);
+
+// A polynomial valid on [0, duration], continued at constant velocity (zero acceleration) after
+// its end: the lattice's trajectories all end with zero acceleration, so the continuation is C1
+// and, for those, C2.
+struct Trajectory1d {
+  Polynomial5 poly;
+  double duration = 0;  // s
+
+  State1d At(double t) const {
+    if (t <= duration) return poly.At(t);
+    const State1d e = poly.At(duration);
+    return {e.p + e.v * (t - duration), e.v, 0.0, 0.0};
+  }
+};
+
+}  // namespace frenetic::traj

@@ -1,0 +1,61 @@
+#include "frenetic/cost/cost_set.h"
+
+#include <cmath>
+
+#include "frenetic/cost/cost_registry.h"
+
+namespace frenetic::cost {
+
+StatusOr<std::shared_ptr<const CostSet>> CostSet::Build(
+    const std::vector<CostTermConfig>& terms) {
+  std::shared_ptr<CostSet> set(new CostSet());
+  for (const CostTermConfig& tc : terms) {
+    for (const std::string& n : set->names_) {
+      if (n == tc.name) return Status::Error("cost term '" + tc.name + "' listed twice");
+    }
+    auto made = CostRegistry::Global().Make(tc.name);
+    if (!made.ok()) return made.status();
+    if (!std::isfinite(tc.weight) || tc.weight < 0) {
+      return Status::Error("weight of cost term '" + tc.name + "' must be finite and >= 0");
+    }
+    std::unique_ptr<CostTerm> term = std::move(made.value());
+    const std::vector<CostParamSpec> specs = term->ParamSpecs();
+    std::vector<double> values;
+    for (const CostParamSpec& spec : specs) values.push_back(spec.default_value);
+    for (const auto& [key, value] : tc.params) {
+      bool found = false;
+      for (size_t i = 0; i < specs.size(); ++i) {
+        if (specs[i].key != key) continue;
+        found = true;
+        if (!std::isfinite(value) || value < specs[i].lo || value > specs[i].hi) {
+          return Status::Error("parameter '" + tc.name + "." + key + "' = " +
+                               std::to_string(value) + " outside [" +
+                               std::to_string(specs[i].lo) + ", " + std::to_string(specs[i].hi) +
+                               "]");
+        }
+        values[i] = value;
+      }
+      if (!found) {
+        return Status::Error("unknown parameter '" + key + "' of cost term '" + tc.name + "'");
+      }
+    }
+    term->Configure(values);
+    set->names_.push_back(tc.name);
+    set->weights_.push_back(tc.weight);
+    set->terms_.push_back(std::move(term));
+  }
+  return std::shared_ptr<const CostSet>(std::move(set));
+}
+
+double CostSet::Evaluate(const CostContext& ctx, const CostInput& in, double* per_term) const {
+  double total = 0;
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    const double v = terms_[i]->Evaluate(ctx, in);
+    if (per_term != nullptr) per_term[i] = v;
+    total += weights_[i] * v;
+  }
+  return total;
+}
+
+}  // namespace frenetic::cost

@@ -1,0 +1,112 @@
+#include "frenetic/plan/feasibility.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace frenetic::plan {
+namespace {
+
+constexpr double kDt = 0.02;
+constexpr int kBlock = 10;  // ticks per acceleration sample (0.2 s)
+constexpr int kJerkBlocks = 5;  // acceleration samples per jerk sample (1 s)
+
+// Menger curvature of three points as the simulator computes it: 2 sin(theta) / |p3 - p1|.
+double Menger(double x1, double y1, double x2, double y2, double x3, double y3) {
+  const double ax = x2 - x1, ay = y2 - y1, bx = x3 - x2, by = y3 - y2;
+  const double la = std::hypot(ax, ay), lb = std::hypot(bx, by);
+  if (la == 0 || lb == 0) return 0.0;
+  const double cross = ax * by - ay * bx, dot = ax * bx + ay * by;
+  if (std::abs(cross) < 1e-12 * la * lb && dot < 0) return 1e6;  // reversal
+  const double chord = std::hypot(x3 - x1, y3 - y1);
+  if (chord == 0) return 1e6;
+  return 2.0 * std::abs(cross) / (la * lb) / chord;
+}
+
+}  // namespace
+
+XyChecker::XyChecker(int capacity) {
+  for (auto* v : {&v_, &kappa_, &vsum_, &ksum_, &acc_, &asum_}) v->assign(capacity + 1, 0.0);
+}
+
+XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first) {
+  XyMeasure m;
+  n = std::min(n, static_cast<int>(v_.size()) - 1);
+  if (n < 2) return m;
+  first = std::clamp(first, 1, n - 1);
+  // v_[i]: speed at tick i (from i-1); kappa_[i]: Menger curvature of (i-1, i, i+1).
+  v_[0] = 0;
+  for (int i = 1; i < n; ++i) v_[i] = std::hypot(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
+  kappa_[0] = 0;
+  kappa_[n - 1] = 0;
+  for (int i = 1; i + 1 < n; ++i) {
+    kappa_[i] = Menger(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
+  }
+  for (int i = first; i < n; ++i) m.max_speed = std::max(m.max_speed, v_[i]);
+  if (std::isnan(v_[n - 1])) m.max_speed = NAN;
+  // Prefix sums make every sliding block mean O(1).
+  vsum_[0] = 0;
+  ksum_[0] = 0;
+  for (int i = 0; i < n; ++i) {
+    vsum_[i + 1] = vsum_[i] + v_[i];
+    ksum_[i + 1] = ksum_[i] + kappa_[i];
+  }
+  auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock; };
+  // Block ending at tick j holds ticks j-9..j; its triples are centred at j-8..j-1.
+  auto kmean = [&](int j) { return (ksum_[j] - ksum_[j - 8]) / 8.0; };
+  // acc_[j] valid for j >= 2 * kBlock (needs the previous block, which starts at tick >= 1).
+  const int a0 = 2 * kBlock;
+  for (int j = a0; j < n; ++j) {
+    const double vm = vmean(j), vp = vmean(j - kBlock);
+    const double at = (vm - vp) / (kBlock * kDt), an = vm * vm * kmean(j);
+    acc_[j] = std::hypot(at, an);
+    if (j >= first) m.max_accel = std::max(m.max_accel, acc_[j]);
+  }
+  // Jerk from 1 s means of the acceleration samples, block-aligned with j.
+  const int span = kBlock * kJerkBlocks;
+  for (int j = a0 + (kJerkBlocks - 1) * kBlock + span; j < n; ++j) {
+    if (j < first) continue;
+    double now = 0, before = 0;
+    for (int b = 0; b < kJerkBlocks; ++b) {
+      now += acc_[j - b * kBlock];
+      before += acc_[j - span - b * kBlock];
+    }
+    const double jerk = std::abs(now - before) / kJerkBlocks / (span * kDt);
+    m.max_jerk = std::max(m.max_jerk, jerk);
+  }
+  return m;
+}
+
+XyMeasure MeasureLikeSimulator(std::span<const double> x, std::span<const double> y, int phase) {
+  XyMeasure m;
+  const int n = static_cast<int>(std::min(x.size(), y.size()));
+  double v_prev_mean = 0, a_prev_mean = 0;
+  double a_acc = 0;
+  int a_count = 0;
+  // Records start at tick `phase`+1 (the first tick with a displacement).
+  for (int start = phase + 1; start + kBlock <= n; start += kBlock) {
+    double vs = 0, ks = 0;
+    for (int i = start; i < start + kBlock; ++i) {
+      const double v = std::hypot(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
+      m.max_speed = std::max(m.max_speed, v);
+      vs += v;
+    }
+    for (int i = start + 1; i + 1 < start + kBlock; ++i) {
+      ks += Menger(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
+    }
+    const double vm = vs / kBlock, km = ks / 8.0;
+    const double a = std::hypot((vm - v_prev_mean) / (kBlock * kDt), vm * vm * km);
+    v_prev_mean = vm;
+    m.max_accel = std::max(m.max_accel, a);
+    a_acc += a;
+    if (++a_count == kJerkBlocks) {
+      const double mean = a_acc / kJerkBlocks;
+      m.max_jerk = std::max(m.max_jerk, std::abs(mean - a_prev_mean) / (kJerkBlocks * kBlock * kDt));
+      a_prev_mean = mean;
+      a_acc = 0;
+      a_count = 0;
+    }
+  }
+  return m;
+}
+
+}  // namespace frenetic::plan

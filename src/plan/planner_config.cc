@@ -1,0 +1,320 @@
+#include "frenetic/plan/planner_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "frenetic/check.h"
+#include "frenetic/cost/cost_registry.h"
+
+namespace frenetic::plan {
+namespace {
+
+struct Default {
+  const char* key;
+  double value, lo, hi;
+  bool log_scale;
+};
+
+// Every numeric planner parameter with its default and its valid / tunable range.
+constexpr Default kDefaults[] = {
+    {"budget_ms", 15, 1, 200, true},
+    {"limits.max_speed_mph", 49.5, 20, 49.95, false},
+    {"limits.max_accel", 9, 1, 9.9, false},
+    {"limits.max_jerk", 9, 1, 9.9, false},
+    {"limits.d_min", 1.3, 0.8, 4, false},
+    {"limits.d_max", 10.7, 8, 11.2, false},
+    {"road.lane_width", 4, 2.5, 5, false},
+    {"road.num_lanes", 3, 1, 8, false},
+    {"road.outer_lane_inset", 0.2, 0, 1, false},
+    {"continuity.keep_points", 6, 1, 40, false},
+    {"continuity.output_points", 100, 50, 300, false},
+    {"continuity.resync_tolerance", 0.5, 0.01, 5, true},
+    {"grid.speeds", 16, 8, 64, false},
+    {"grid.durations", 6, 4, 16, false},
+    {"grid.min_duration", 1.5, 1, 6, false},
+    {"grid.max_duration", 6, 1.5, 8, false},
+    {"grid.follow_gaps", 3, 1, 8, false},
+    {"grid.follow_d0", 8, 2, 30, false},
+    {"grid.follow_tau", 1.0, 0.3, 3, false},
+    {"grid.follow_tau_step", 0.5, 0.1, 2, false},
+    {"grid.stop", 1, 0, 1, false},
+    {"grid.lat_durations", 3, 1, 8, false},
+    {"grid.lat_min_duration", 2.0, 1, 6, false},
+    {"grid.lat_max_duration", 4.0, 1, 8, false},
+    {"grid.lat_offsets", 1, 1, 7, false},
+    {"grid.lat_offset_step", 0.3, 0.05, 1, false},
+    {"score.dt", 0.25, 0.1, 0.5, false},
+    {"score.horizon", 6, 3, 8, false},
+    {"check.horizon", 5, 2, 8, false},
+    {"check.collision_dt", 0.1, 0.02, 0.25, false},
+    {"check.car_length", 4.8, 3, 7, false},
+    {"check.car_width", 2.4, 1.5, 3.5, false},
+    {"check.margin_s", 1.0, 0, 5, false},
+    {"check.margin_d", 0.3, 0, 2, false},
+    {"prediction.range", 200, 50, 400, false},
+    {"prediction.d_min", -1, -5, 0, false},
+    {"prediction.d_max", 13, 12, 20, false},
+    {"prediction.max_speed", 30, 20, 60, false},
+    {"prediction.spike_ratio", 1.8, 1.2, 3, false},
+    {"refine.enabled", 1, 0, 1, false},
+    {"refine.max_iterations", 40, 1, 500, true},
+    {"refine.budget_ms", 3, 0.1, 50, true},
+    {"fallback.decel", 3, 0.5, 8, false},
+    {"fallback.jerk", 4, 1, 9, false},
+    {"fallback.lat_duration", 3, 1, 6, false},
+    {"baseline.follow_distance", 30, 10, 80, false},
+    {"baseline.ahead_free", 50, 10, 150, false},
+    {"baseline.behind_free", 15, 5, 60, false},
+    {"baseline.speed_step_mph", 0.224, 0.05, 1, false},
+    {"baseline.max_speed_mph", 49.5, 20, 49.95, false},
+    {"baseline.path_points", 50, 50, 200, false},
+};
+
+std::string Fmt(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+PlannerConfig PlannerConfig::Defaults() {
+  PlannerConfig c;
+  for (const Default& d : kDefaults) c.params_.push_back({d.key, d.value, d.lo, d.hi, d.log_scale});
+  for (const std::string& name : cost::CostRegistry::Global().Names()) {
+    c.cost_order_.push_back(name);
+    c.params_.push_back({"weights." + name, 1.0, 0.0, 100.0, false});
+    auto term = cost::CostRegistry::Global().Make(name);
+    FRENETIC_CHECK(term.ok());
+    for (const auto& spec : term.value()->ParamSpecs()) {
+      c.params_.push_back({"costs." + name + "." + spec.key, spec.default_value, spec.lo, spec.hi,
+                           spec.log_scale});
+    }
+  }
+  return c;
+}
+
+PlannerConfig::Param* PlannerConfig::Find(std::string_view key) {
+  for (Param& p : params_) {
+    if (p.key == key) return &p;
+  }
+  return nullptr;
+}
+const PlannerConfig::Param* PlannerConfig::Find(std::string_view key) const {
+  for (const Param& p : params_) {
+    if (p.key == key) return &p;
+  }
+  return nullptr;
+}
+
+Status PlannerConfig::Set(std::string_view key, double value) {
+  Param* p = Find(key);
+  if (p == nullptr) return Status::Error(source_ + ": unknown key '" + std::string(key) + "'");
+  if (!std::isfinite(value) || value < p->lo || value > p->hi) {
+    return Status::Error(source_ + ": '" + std::string(key) + "' = " + Fmt(value) + " outside [" +
+                         Fmt(p->lo) + ", " + Fmt(p->hi) + "]");
+  }
+  const double old = p->value;
+  p->value = value;
+  Status s = Validate();
+  if (!s.ok()) p->value = old;
+  return s;
+}
+
+StatusOr<double> PlannerConfig::Get(std::string_view key) const {
+  const Param* p = Find(key);
+  if (p == nullptr) return Status::Error(source_ + ": unknown key '" + std::string(key) + "'");
+  return p->value;
+}
+
+double PlannerConfig::value(std::string_view key) const {
+  const Param* p = Find(key);
+  FRENETIC_CHECK(p != nullptr);
+  return p->value;
+}
+
+int PlannerConfig::int_value(std::string_view key) const {
+  return static_cast<int>(std::lround(value(key)));
+}
+
+double PlannerConfig::budget_ms() const { return value("budget_ms"); }
+
+std::vector<PlannerConfig::Param> PlannerConfig::Params() const { return params_; }
+
+std::vector<cost::CostTermConfig> PlannerConfig::cost_terms() const {
+  std::vector<cost::CostTermConfig> out;
+  for (const std::string& name : cost_order_) {
+    cost::CostTermConfig tc;
+    tc.name = name;
+    tc.weight = value("weights." + name);
+    const std::string prefix = "costs." + name + ".";
+    for (const Param& p : params_) {
+      if (p.key.rfind(prefix, 0) == 0) tc.params.emplace_back(p.key.substr(prefix.size()), p.value);
+    }
+    out.push_back(std::move(tc));
+  }
+  return out;
+}
+
+Status PlannerConfig::Validate() const {
+  auto err = [&](const std::string& m) { return Status::Error(source_ + ": " + m); };
+  if (value("grid.min_duration") >= value("grid.max_duration")) {
+    return err("grid.min_duration must be below grid.max_duration");
+  }
+  if (value("grid.lat_min_duration") > value("grid.lat_max_duration")) {
+    return err("grid.lat_min_duration must not exceed grid.lat_max_duration");
+  }
+  if (value("limits.d_min") >= value("limits.d_max")) {
+    return err("limits.d_min must be below limits.d_max");
+  }
+  if (int_value("continuity.keep_points") >= int_value("continuity.output_points") - 10) {
+    return err("continuity.keep_points must leave room in continuity.output_points");
+  }
+  if (int_value("grid.lat_offsets") % 2 == 0) return err("grid.lat_offsets must be odd");
+  auto set = cost::CostSet::Build(cost_terms());
+  if (!set.ok()) return err(set.message());
+  return Status::Ok();
+}
+
+StatusOr<PlannerConfig> PlannerConfig::Parse(std::string_view yaml, std::string_view source) {
+  PlannerConfig c = Defaults();
+  c.source_ = std::string(source);
+  const std::string src = c.source_;
+  auto err = [&](const std::string& m) { return Status::Error(src + ": " + m); };
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml));
+  } catch (const YAML::Exception& e) {
+    return err(std::string("YAML error: ") + e.what());
+  }
+  if (!root.IsMap()) return err("expected a mapping at the top level");
+  auto number = [&](const YAML::Node& node, const std::string& key) -> StatusOr<double> {
+    if (!node.IsScalar()) return err("'" + key + "' must be a number");
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      return err("'" + key + "' must be a number, got '" + node.Scalar() + "'");
+    }
+  };
+  std::vector<std::string> order;
+  bool saw_costs = false;
+  for (const auto& section : root) {
+    const std::string name = section.first.as<std::string>();
+    if (name == "costs") {
+      saw_costs = true;
+      if (!section.second.IsMap()) return err("'costs' must be a mapping of term names");
+      for (const auto& term : section.second) {
+        const std::string tname = term.first.as<std::string>();
+        if (!cost::CostRegistry::Global().Contains(tname)) {
+          return err("unknown cost term '" + tname + "'");
+        }
+        for (const std::string& o : order) {
+          if (o == tname) return err("cost term '" + tname + "' listed twice");
+        }
+        order.push_back(tname);
+        if (!term.second.IsMap() || !term.second["weight"]) {
+          return err("cost term '" + tname + "' has no weight (key 'costs." + tname + ".weight')");
+        }
+        for (const auto& kv : term.second) {
+          const std::string k = kv.first.as<std::string>();
+          const std::string key =
+              k == "weight" ? "weights." + tname : "costs." + tname + "." + k;
+          if (c.Find(key) == nullptr) return err("unknown key 'costs." + tname + "." + k + "'");
+          auto v = number(kv.second, key);
+          if (!v.ok()) return v.status();
+          Param* p = c.Find(key);
+          if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
+            return err("'" + key + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " +
+                       Fmt(p->hi) + "]");
+          }
+          p->value = *v;
+        }
+      }
+      continue;
+    }
+    if (section.second.IsScalar()) {
+      if (c.Find(name) == nullptr) return err("unknown key '" + name + "'");
+      auto v = number(section.second, name);
+      if (!v.ok()) return v.status();
+      Param* p = c.Find(name);
+      if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
+        return err("'" + name + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " + Fmt(p->hi) + "]");
+      }
+      p->value = *v;
+      continue;
+    }
+    if (!section.second.IsMap()) return err("unknown section '" + name + "'");
+    for (const auto& kv : section.second) {
+      const std::string key = name + "." + kv.first.as<std::string>();
+      if (key == "refine.algorithm") {
+        if (!kv.second.IsScalar()) return err("'refine.algorithm' must be a name");
+        c.refine_algorithm_ = kv.second.Scalar();
+        continue;
+      }
+      Param* p = c.Find(key);
+      if (p == nullptr || key.rfind("weights.", 0) == 0 || key.rfind("costs.", 0) == 0) {
+        return err("unknown key '" + key + "'");
+      }
+      auto v = number(kv.second, key);
+      if (!v.ok()) return v.status();
+      if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
+        return err("'" + key + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " + Fmt(p->hi) + "]");
+      }
+      p->value = *v;
+    }
+  }
+  if (!saw_costs) return err("missing section 'costs' (every cost term needs a weight)");
+  for (const std::string& name : cost::CostRegistry::Global().Names()) {
+    bool listed = false;
+    for (const std::string& o : order) listed = listed || o == name;
+    if (!listed) return err("missing weight of cost term '" + name + "' (key 'costs." + name + ".weight')");
+  }
+  c.cost_order_ = order;
+  Status s = c.Validate();
+  if (!s.ok()) return s;
+  return c;
+}
+
+StatusOr<PlannerConfig> PlannerConfig::Load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open planner configuration");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return Parse(ss.str(), path);
+}
+
+std::string PlannerConfig::DefaultPath() { return FRENETIC_SOURCE_DIR "/config/planner.yaml"; }
+
+StatusOr<PlannerConfig> PlannerConfig::LoadDefault() { return Load(DefaultPath()); }
+
+std::string PlannerConfig::ToYaml() const {
+  std::ostringstream os;
+  std::string section;
+  for (const Param& p : params_) {
+    if (p.key.rfind("weights.", 0) == 0 || p.key.rfind("costs.", 0) == 0) continue;
+    const size_t dot = p.key.find('.');
+    if (dot == std::string::npos) {
+      os << p.key << ": " << Fmt(p.value) << "\n";
+      continue;
+    }
+    const std::string sec = p.key.substr(0, dot);
+    if (sec != section) {
+      section = sec;
+      os << sec << ":\n";
+      if (sec == "refine") os << "  algorithm: " << refine_algorithm_ << "\n";
+    }
+    os << "  " << p.key.substr(dot + 1) << ": " << Fmt(p.value) << "\n";
+  }
+  os << "costs:\n";
+  for (const auto& tc : cost_terms()) {
+    os << "  " << tc.name << ":\n    weight: " << Fmt(tc.weight) << "\n";
+    for (const auto& [k, v] : tc.params) os << "    " << k << ": " << Fmt(v) << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace frenetic::plan

@@ -1,0 +1,1076 @@
+// The `search` planner. Werling, Ziegler, Kammel, Thrun, "Optimal Trajectory Generation for
+// Dynamic Street Scenarios in a Frenet Frame", ICRA 2010: 1-D longitudinal and lateral bundles,
+// every pair scored, lazy hard checks in cost order, a backup that always exists.
+#include <nlopt.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "frenetic/plan/feasibility.h"
+#include "frenetic/plan/predictor.h"
+#include "frenetic/traj/box.h"
+#include "frenetic/traj/frenet.h"
+#include "plan/search_planner.h"
+
+namespace frenetic::plan {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using traj::FrenetState;
+using traj::FrenetTrajectory;
+using traj::Polynomial5;
+using traj::Trajectory1d;
+
+constexpr double kMphToMps = 0.44704;
+constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s of blocks)
+
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+bool Finite(double v) { return std::isfinite(v); }
+
+// One longitudinal trajectory of the bundle.
+struct LonTraj {
+  Trajectory1d traj;
+  cost::LonKind kind = cost::LonKind::kVelocityKeeping;
+  int lane = -1;         // -1: usable in every lane; else only with this lane's lateral moves
+  double param = 0;      // end speed (velocity keeping), extra gap (following), distance (stop)
+  double lead_s = 0, lead_v = 0;  // following: the leader at the start instant
+  double jerk2 = 0;
+};
+
+struct LatTraj {
+  Trajectory1d traj;
+  int lane = 0;
+  double offset = 0;
+  double jerk2 = 0;
+};
+
+struct Settings {
+  double max_speed, max_accel, max_jerk, d_min, d_max;
+  double lane_width, outer_inset;
+  int num_lanes;
+  int keep_points, output_points;
+  double resync_tolerance;
+  int speeds, durations;
+  double min_duration, max_duration;
+  int follow_gaps;
+  double follow_d0, follow_tau, follow_tau_step;
+  bool stop;
+  int lat_durations;
+  double lat_min_duration, lat_max_duration;
+  int lat_offsets;
+  double lat_offset_step;
+  double score_dt, score_horizon;
+  double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d;
+  bool refine;
+  int refine_iterations;
+  double refine_budget_ms;
+  double fallback_decel, fallback_jerk, fallback_lat_duration;
+  double budget_ms;
+
+  explicit Settings(const PlannerConfig& c) {
+    max_speed = c.value("limits.max_speed_mph") * kMphToMps;
+    max_accel = c.value("limits.max_accel");
+    max_jerk = c.value("limits.max_jerk");
+    d_min = c.value("limits.d_min");
+    d_max = c.value("limits.d_max");
+    lane_width = c.value("road.lane_width");
+    outer_inset = c.value("road.outer_lane_inset");
+    num_lanes = std::clamp(c.int_value("road.num_lanes"), 1, cost::kMaxLanes);
+    keep_points = c.int_value("continuity.keep_points");
+    output_points = c.int_value("continuity.output_points");
+    resync_tolerance = c.value("continuity.resync_tolerance");
+    speeds = c.int_value("grid.speeds");
+    durations = c.int_value("grid.durations");
+    min_duration = c.value("grid.min_duration");
+    max_duration = c.value("grid.max_duration");
+    follow_gaps = c.int_value("grid.follow_gaps");
+    follow_d0 = c.value("grid.follow_d0");
+    follow_tau = c.value("grid.follow_tau");
+    follow_tau_step = c.value("grid.follow_tau_step");
+    stop = c.int_value("grid.stop") != 0;
+    lat_durations = c.int_value("grid.lat_durations");
+    lat_min_duration = c.value("grid.lat_min_duration");
+    lat_max_duration = c.value("grid.lat_max_duration");
+    lat_offsets = c.int_value("grid.lat_offsets");
+    lat_offset_step = c.value("grid.lat_offset_step");
+    score_dt = c.value("score.dt");
+    score_horizon = c.value("score.horizon");
+    check_horizon = c.value("check.horizon");
+    collision_dt = c.value("check.collision_dt");
+    car_length = c.value("check.car_length");
+    car_width = c.value("check.car_width");
+    margin_s = c.value("check.margin_s");
+    margin_d = c.value("check.margin_d");
+    refine = c.int_value("refine.enabled") != 0;
+    refine_iterations = c.int_value("refine.max_iterations");
+    refine_budget_ms = c.value("refine.budget_ms");
+    fallback_decel = c.value("fallback.decel");
+    fallback_jerk = c.value("fallback.jerk");
+    fallback_lat_duration = c.value("fallback.lat_duration");
+    budget_ms = c.budget_ms();
+  }
+};
+
+double Linspace(double lo, double hi, int count, int i) {
+  return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
+}
+
+class SearchPlanner : public Planner {
+ public:
+  SearchPlanner(const PlannerConfig& config, std::shared_ptr<const map::ReferenceLine> line,
+                std::shared_ptr<const cost::CostSet> costs)
+      : cfg_(config),
+        line_(std::move(line)),
+        costs_(std::move(costs)),
+        checker_(kHistory + 64 + static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds)) +
+                 cfg_.output_points) {
+    PredictorOptions po;
+    po.range = config.value("prediction.range");
+    po.d_min = config.value("prediction.d_min");
+    po.d_max = config.value("prediction.d_max");
+    po.max_speed = config.value("prediction.max_speed");
+    po.spike_ratio = config.value("prediction.spike_ratio");
+    predictor_ = MakeConstantVelocityPredictor(line_, po);
+    for (int l = 0; l < cfg_.num_lanes; ++l) {
+      lane_center_[l] = (l + 0.5) * cfg_.lane_width;
+    }
+    if (cfg_.num_lanes > 1) lane_center_[cfg_.num_lanes - 1] -= cfg_.outer_inset;
+
+    n_samples_ = static_cast<int>(std::floor(cfg_.score_horizon / cfg_.score_dt + 1e-9)) + 1;
+    n_ticks_ = static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds));
+    n_ticks_ = std::max(n_ticks_, cfg_.output_points);
+    const int max_lon = cfg_.speeds * cfg_.durations + cfg_.durations +
+                        cfg_.num_lanes * cfg_.follow_gaps * cfg_.durations + 8;
+    const int max_lat = cfg_.num_lanes * cfg_.lat_durations * cfg_.lat_offsets + 8;
+    lon_.reserve(max_lon);
+    lat_.reserve(max_lat);
+    for (auto* v : {&lon_s_, &lon_sd_, &lon_sdd_}) v->assign(max_lon * n_samples_, 0.0);
+    for (auto* v : {&lat_d_, &lat_dd_, &lat_ddd_}) v->assign(max_lat * n_samples_, 0.0);
+    cand_lon_.reserve(max_lon * max_lat);
+    cand_lat_.reserve(max_lon * max_lat);
+    cand_cost_.reserve(max_lon * max_lat);
+    order_.reserve(max_lon * max_lat);
+    const int max_cars = 64;
+    car_s_.assign(max_cars * n_samples_, 0.0);
+    car_d_.assign(max_cars, 0.0);
+    car_v_.assign(max_cars, 0.0);
+    car_s0_.assign(max_cars, 0.0);
+    prev_s_.assign(n_samples_, 0.0);
+    prev_d_.assign(n_samples_, 0.0);
+    for (auto* v : {&ref_s_, &ref_sd_, &ref_sdd_, &ref_d_, &ref_dd_, &ref_ddd_}) {
+      v->assign(n_samples_, 0.0);
+    }
+    for (auto* v : {&tk_s_, &tk_sd_, &tk_sdd_, &tk_d_, &tk_dd_, &tk_ddd_}) {
+      v->assign(n_ticks_ + 1, 0.0);
+    }
+    const int path_cap = kHistory + cfg_.output_points + n_ticks_ + 8;
+    chk_x_.assign(path_cap, 0.0);
+    chk_y_.assign(path_cap, 0.0);
+    for (auto* v : {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_,
+                    &plan_y_}) {
+      v->assign(cfg_.output_points + 1, 0.0);
+    }
+    hist_x_.assign(kHistory, 0.0);
+    hist_y_.assign(kHistory, 0.0);
+    per_term_.assign(costs_->size(), 0.0);
+    result_.x.reserve(cfg_.output_points + 1);
+    result_.y.reserve(cfg_.output_points + 1);
+    result_.summary.winner_costs.resize(costs_->size());
+    for (int i = 0; i < costs_->size(); ++i) {
+      result_.summary.winner_costs[i].name = costs_->name(i);
+      result_.summary.winner_costs[i].weight = costs_->weight(i);
+    }
+    opt_ = nlopt_create(AlgorithmFromName(config.refine_algorithm()), 4);
+    if (opt_ != nullptr) {
+      nlopt_set_min_objective(opt_, &SearchPlanner::RefineObjective, this);
+      constraints_ok_ = nlopt_add_inequality_constraint(opt_, &SearchPlanner::RefineConstraint,
+                                                        this, 1e-6) == NLOPT_SUCCESS;
+      nlopt_set_maxeval(opt_, cfg_.refine_iterations);
+    }
+    Reset();
+  }
+
+  ~SearchPlanner() override {
+    if (opt_ != nullptr) nlopt_destroy(opt_);
+  }
+
+  std::string_view name() const override { return "search"; }
+
+  void set_trace(CycleTrace* trace, int max_candidates) override {
+    trace_ = trace;
+    trace_max_ = max_candidates;
+  }
+
+  void Reset() override {
+    have_plan_ = false;
+    plan_n_ = 0;
+    plan_start_index_ = 0;
+    hist_n_ = 0;
+    have_prev_traj_ = false;
+    prev_target_lane_ = -1;
+    lane_before_change_ = -1;
+    time_since_change_ = 1e9;
+    predictor_->Reset();
+  }
+
+  const PlanResult& Plan(const Telemetry& t) override {
+    t0_ = Clock::now();
+    PlanSummary& sum = result_.summary;
+    ResetSummary(sum);
+    result_.status = PlanStatus::kOk;
+    result_.x.clear();
+    result_.y.clear();
+    if (trace_ != nullptr) trace_->candidates.clear();
+
+    const bool ego_ok = Finite(t.x) && Finite(t.y) && Finite(t.yaw) && Finite(t.speed) &&
+                        std::abs(t.x) < 1e6 && std::abs(t.y) < 1e6 && t.speed > -1 &&
+                        t.speed < 100;
+    bool prev_ok = t.previous_path_x.size() == t.previous_path_y.size();
+    for (size_t i = 0; prev_ok && i < t.previous_path_x.size(); ++i) {
+      prev_ok = Finite(t.previous_path_x[i]) && Finite(t.previous_path_y[i]);
+    }
+    bool invalid = !ego_ok || !prev_ok;
+
+    // Continuity: learn how many points were consumed and whether previous_path is ours.
+    int consumed = 0;
+    bool synced = false;
+    const int n_prev = prev_ok ? static_cast<int>(t.previous_path_x.size()) : -1;
+    if (have_plan_ && n_prev > 0 && n_prev <= plan_n_) {
+      consumed = plan_n_ - n_prev;
+      const double tol = cfg_.resync_tolerance;
+      synced = std::abs(t.previous_path_x[0] - plan_x_[consumed]) < tol &&
+               std::abs(t.previous_path_y[0] - plan_y_[consumed]) < tol &&
+               std::abs(t.previous_path_x[n_prev - 1] - plan_x_[plan_n_ - 1]) < tol &&
+               std::abs(t.previous_path_y[n_prev - 1] - plan_y_[plan_n_ - 1]) < tol;
+    }
+    if (!synced && !ego_ok && have_plan_ && plan_n_ > cfg_.keep_points + 1) {
+      // Unusable telemetry: carry on along our own plan as if one tick passed.
+      consumed = 1;
+      synced = true;
+    }
+    FrenetState start;
+    int kept = 0;
+    double elapsed = 0;  // s between the previous start state and this one
+    if (synced) {
+      kept = std::min(cfg_.keep_points, plan_n_ - consumed);
+      // The driven points feed the jerk windows of the XY check.
+      PushHistory(consumed);
+      // Move the kept points to the front (destination before source: a forward copy is safe).
+      for (auto* v : {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_,
+                      &plan_y_}) {
+        std::copy(v->begin() + consumed, v->begin() + consumed + kept, v->begin());
+      }
+      const int k = kept - 1;
+      start = {plan_s_[k], plan_sd_[k], plan_sdd_[k], plan_d_[k], plan_dd_[k], plan_ddd_[k]};
+      elapsed = (consumed + kept - plan_start_index_ - 1) * kTickSeconds;
+    } else {
+      hist_n_ = 0;
+      have_prev_traj_ = false;
+      if (ego_ok) {
+        const map::FrenetPoint f = line_->ToFrenet(t.x, t.y, have_plan_ ? plan_s_[0] : t.s);
+        const double heading = line_->At(f.s).heading;
+        const double rel = t.yaw - heading;
+        const double v = std::max(t.speed, 0.0);
+        start = {f.s, v * std::cos(rel), 0.0, f.d, -v * std::sin(rel), 0.0};
+      } else {
+        start = {0.0, 0.0, 0.0, lane_center_[std::min(1, cfg_.num_lanes - 1)], 0.0, 0.0};
+      }
+      if (!start.IsFinite()) start = {0.0, 0.0, 0.0, lane_center_[0], 0.0, 0.0};
+      // s' and d' from the measured heading can be off on the very first tick; the lattice
+      // starts from rest in d' to avoid sweeping across the road.
+      start.d_d = std::clamp(start.d_d, -2.0, 2.0);
+      start.s_d = std::clamp(start.s_d, 0.0, cfg_.max_speed);
+      invalid = invalid || !ego_ok;
+    }
+    if (start.s >= line_->length() || start.s < 0) Rebase(start, kept);
+    sum.points_kept = kept;
+    kept_ = kept;
+    start_ = start;
+    t_keep_ = kept * kTickSeconds;
+    time_since_change_ += elapsed;
+    if (have_prev_traj_) prev_elapsed_ = elapsed;
+
+    // Prediction (relative to the start state's s; the observation is "now").
+    predictor_->Observe(t.sensor_fusion, start.s);
+    BuildContext();
+    sum.ms_prepare = MsSince(t0_);
+
+    bool found = false;
+    bool over_budget = false;
+    if (!invalid || synced) {
+      GenerateBundles();
+      sum.candidates_generated = static_cast<int>(cand_lon_.size());
+      sum.ms_generate = MsSince(t0_) - sum.ms_prepare;
+      const double t_score = MsSince(t0_);
+      Score();
+      sum.candidates_scored = static_cast<int>(cand_lon_.size());
+      sum.ms_score = MsSince(t0_) - t_score;
+      const double t_check = MsSince(t0_);
+      found = CheckLazily(&over_budget);
+      sum.ms_check = MsSince(t0_) - t_check;
+      if (found && cfg_.refine && opt_ != nullptr &&
+          MsSince(t0_) + cfg_.refine_budget_ms < 0.8 * cfg_.budget_ms) {
+        const double t_ref = MsSince(t0_);
+        Refine();
+        sum.ms_refine = MsSince(t0_) - t_ref;
+      }
+    }
+    const double t_out = MsSince(t0_);
+    if (found) {
+      FillTicks(winner_);
+      sum.winner_lane = lat_[winner_lat_].lane;
+      sum.winner_end_speed = winner_.lon.At(winner_.lon.duration).v;
+      sum.winner_duration = winner_.lon.duration;
+      RecordDecision(sum.winner_lane);
+      EvaluateWinnerCosts();
+    } else {
+      BuildFallback();
+      have_prev_traj_ = false;
+    }
+    Output();
+    sum.ms_output = MsSince(t0_) - t_out;
+    sum.ms_total = MsSince(t0_);
+    if (invalid) {
+      result_.status = PlanStatus::kInvalidInput;
+    } else if (over_budget) {
+      result_.status = PlanStatus::kOverBudget;
+    } else if (!found) {
+      result_.status = PlanStatus::kFallbackUsed;
+    }
+    return result_;
+  }
+
+ private:
+  static nlopt_algorithm AlgorithmFromName(const std::string& name) {
+    const nlopt_algorithm a = nlopt_algorithm_from_string(name.c_str());
+    return static_cast<int>(a) < 0 ? NLOPT_LN_COBYLA : a;
+  }
+
+  static void ResetSummary(PlanSummary& s) {
+    s.candidates_generated = s.candidates_scored = s.candidates_checked = 0;
+    s.candidates_feasible = 0;
+    s.rejections.fill(0);
+    for (auto& c : s.winner_costs) c.value = 0;
+    s.winner_total_cost = 0;
+    s.winner_lane = -1;
+    s.winner_end_speed = s.winner_duration = 0;
+    s.refine_iterations = 0;
+    s.refine_cost_before = s.refine_cost_after = 0;
+    s.points_kept = 0;
+    s.ms_prepare = s.ms_generate = s.ms_score = s.ms_check = s.ms_refine = s.ms_output = 0;
+    s.ms_total = 0;
+  }
+
+  void PushHistory(int consumed) {
+    // Keep the last kHistory driven points, oldest first.
+    for (int i = 0; i < consumed; ++i) {
+      if (hist_n_ == kHistory) {
+        std::copy(hist_x_.begin() + 1, hist_x_.end(), hist_x_.begin());
+        std::copy(hist_y_.begin() + 1, hist_y_.end(), hist_y_.begin());
+        --hist_n_;
+      }
+      hist_x_[hist_n_] = plan_x_[i];
+      hist_y_[hist_n_] = plan_y_[i];
+      ++hist_n_;
+    }
+  }
+
+  // Keeps s in [0, L): shifts everything stored by whole loops (wrap is free for the line).
+  void Rebase(FrenetState& start, int kept) {
+    const double L = line_->length();
+    const double shift = std::floor(start.s / L) * L;
+    start.s -= shift;
+    for (int i = 0; i < kept; ++i) plan_s_[i] -= shift;
+    prev_traj_.lon.poly.c[0] -= shift;
+  }
+
+  int LaneOf(double d) const {
+    int best = 0;
+    for (int l = 1; l < cfg_.num_lanes; ++l) {
+      if (std::abs(d - lane_center_[l]) < std::abs(d - lane_center_[best])) best = l;
+    }
+    return best;
+  }
+
+  void BuildContext() {
+    cost::CostContext& c = ctx_;
+    c.num_samples = n_samples_;
+    c.dt = cfg_.score_dt;
+    c.lane_width = cfg_.lane_width;
+    c.num_lanes = cfg_.num_lanes;
+    c.car_length = cfg_.car_length;
+    c.car_width = cfg_.car_width;
+    c.start_s = start_.s;
+    c.start_d = start_.d;
+    c.start_speed = start_.s_d;
+    c.current_lane = LaneOf(start_.d);
+    c.previous_target_lane = prev_target_lane_;
+    c.time_since_lane_change = time_since_change_;
+    c.lane_before_change = lane_before_change_;
+    // Lane speed limits: the XY speed of an offset curve is s' (1 + kappa d) with d to the right
+    // and kappa positive to the left, so the outer lane of a left bend is faster in XY.
+    const double reach = cfg_.max_speed * cfg_.score_horizon + 20;
+    double kmax = 0, kmin = 0;
+    for (double ds = -10; ds <= reach; ds += 2.0) {
+      const double k = line_->At(start_.s + ds).kappa;
+      if (Finite(k)) {
+        kmax = std::max(kmax, k);
+        kmin = std::min(kmin, k);
+      }
+    }
+    for (int l = 0; l < cfg_.num_lanes; ++l) {
+      c.lane_center[l] = lane_center_[l];
+      const double d = lane_center_[l];
+      const double factor = std::max({1.0, 1.0 + kmax * d, 1.0 + kmin * d});
+      // A little below the cap: lateral motion and the splice add a few cm/s in XY.
+      c.lane_speed_limit[l] = cfg_.max_speed / factor - 0.05;
+    }
+    // Previous choice at this cycle's sample times.
+    if (have_prev_traj_) {
+      for (int k = 0; k < n_samples_; ++k) {
+        const FrenetState p = prev_traj_.At(k * cfg_.score_dt + prev_elapsed_);
+        prev_s_[k] = p.s;
+        prev_d_[k] = p.d;
+      }
+      c.previous_s = prev_s_.data();
+      c.previous_d = prev_d_.data();
+    } else {
+      c.previous_s = c.previous_d = nullptr;
+    }
+    // Traffic: relevant cars only. A car behind in the ego's own lane is its follower's problem
+    // (the simulator's traffic brakes for the car ahead).
+    const auto cars = predictor_->cars();
+    int nc = 0;
+    for (int i = 0; i < static_cast<int>(cars.size()) && nc < 64; ++i) {
+      const TrackedCar& car = cars[i];
+      if (car.s < -cfg_.car_length && std::abs(car.d - start_.d) < 0.5 * cfg_.lane_width) continue;
+      car_d_[nc] = car.d;
+      car_v_[nc] = car.v_s;
+      car_s0_[nc] = start_.s + car.s;  // at the observation instant, in the start's s frame
+      for (int k = 0; k < n_samples_; ++k) {
+        car_s_[nc * n_samples_ + k] = car_s0_[nc] + car.v_s * (k * cfg_.score_dt + t_keep_);
+      }
+      ++nc;
+    }
+    c.num_cars = nc;
+    c.car_s = car_s_.data();
+    c.car_d = car_d_.data();
+    c.car_v = car_v_.data();
+  }
+
+  // ---- Generation ---------------------------------------------------------------------------
+
+  void AddLon(const LonTraj& l) {
+    if (!l.traj.poly.IsFinite()) return;
+    const int i = static_cast<int>(lon_.size());
+    lon_.push_back(l);
+    lon_.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+    for (int k = 0; k < n_samples_; ++k) {
+      const traj::State1d st = l.traj.At(k * cfg_.score_dt);
+      lon_s_[i * n_samples_ + k] = st.p;
+      lon_sd_[i * n_samples_ + k] = st.v;
+      lon_sdd_[i * n_samples_ + k] = st.a;
+    }
+  }
+
+  void AddLat(const LatTraj& l) {
+    if (!l.traj.poly.IsFinite()) return;
+    const int i = static_cast<int>(lat_.size());
+    lat_.push_back(l);
+    lat_.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+    for (int k = 0; k < n_samples_; ++k) {
+      const traj::State1d st = l.traj.At(k * cfg_.score_dt);
+      lat_d_[i * n_samples_ + k] = st.p;
+      lat_dd_[i * n_samples_ + k] = st.v;
+      lat_ddd_[i * n_samples_ + k] = st.a;
+    }
+  }
+
+  LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, double lead_s,
+                  double lead_v) const {
+    LonTraj l;
+    l.kind = kind;
+    l.lane = lane;
+    l.param = param;
+    l.lead_s = lead_s;
+    l.lead_v = lead_v;
+    l.traj.duration = T;
+    const FrenetState& s0 = start_;
+    switch (kind) {
+      case cost::LonKind::kVelocityKeeping:
+        l.traj.poly = traj::SolveQuartic(s0.s, s0.s_d, s0.s_dd, std::max(param, 0.0), 0.0, T);
+        break;
+      case cost::LonKind::kFollowing: {
+        // Constant time-gap law: s_target = s_lead(T) - (D0 + tau v_lead), minus `param` more.
+        const double s_lead = lead_s + lead_v * (T + t_keep_);
+        const double target = s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_v) - param;
+        l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_v, 0.0, T);
+        break;
+      }
+      case cost::LonKind::kStopping:
+        l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, s0.s + std::max(param, 0.0), 0.0,
+                                         0.0, T);
+        break;
+    }
+    return l;
+  }
+
+  LatTraj MakeLat(int lane, double offset, double T) const {
+    LatTraj l;
+    l.lane = lane;
+    l.offset = offset;
+    l.traj.duration = T;
+    const double target = std::clamp(lane_center_[lane] + offset, cfg_.d_min, cfg_.d_max);
+    l.traj.poly = traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, target, 0.0, 0.0, T);
+    return l;
+  }
+
+  // The nearest car ahead in `lane` at the start instant, or -1.
+  int Leader(int lane) const {
+    int best = -1;
+    double best_s = 1e18;
+    for (int c = 0; c < ctx_.num_cars; ++c) {
+      if (std::abs(car_d_[c] - lane_center_[lane]) > 0.6 * cfg_.lane_width) continue;
+      const double s_at_start = car_s0_[c] + car_v_[c] * t_keep_;
+      if (s_at_start <= start_.s) continue;
+      if (s_at_start < best_s) {
+        best_s = s_at_start;
+        best = c;
+      }
+    }
+    return best;
+  }
+
+  void GenerateBundles() {
+    lon_.clear();
+    lat_.clear();
+    cand_lon_.clear();
+    cand_lat_.clear();
+    // Lanes within reach: the current one and its neighbours.
+    bool reachable[cost::kMaxLanes] = {};
+    for (int l = 0; l < cfg_.num_lanes; ++l) {
+      reachable[l] = std::abs(lane_center_[l] - start_.d) <= 1.5 * cfg_.lane_width;
+    }
+    for (int di = 0; di < cfg_.durations; ++di) {
+      const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
+      for (int vi = 0; vi < cfg_.speeds; ++vi) {
+        // Velocity keeping to end speeds from 0 to the fastest lane's limit.
+        double vmax = 0;
+        for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ctx_.lane_speed_limit[l]);
+        AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T,
+                       0, 0));
+      }
+      if (cfg_.stop) {
+        AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start_.s_d * T, T, 0, 0));
+      }
+      for (int l = 0; l < cfg_.num_lanes; ++l) {
+        if (!reachable[l]) continue;
+        const int lead = Leader(l);
+        if (lead < 0) continue;
+        for (int g = 0; g < cfg_.follow_gaps; ++g) {
+          // Longer time gaps are extra distance on top of the base law.
+          const double extra = g * cfg_.follow_tau_step * car_v_[lead];
+          LonTraj lt = MakeLon(cost::LonKind::kFollowing, l, extra, T, car_s0_[lead], car_v_[lead]);
+          AddLon(lt);
+        }
+      }
+    }
+    for (int l = 0; l < cfg_.num_lanes; ++l) {
+      if (!reachable[l]) continue;
+      for (int ti = 0; ti < cfg_.lat_durations; ++ti) {
+        const double T =
+            Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, cfg_.lat_durations, ti);
+        for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
+          const double off = (oi - cfg_.lat_offsets / 2) * cfg_.lat_offset_step;
+          AddLat(MakeLat(l, off, T));
+        }
+      }
+    }
+    for (int i = 0; i < static_cast<int>(lon_.size()); ++i) {
+      for (int j = 0; j < static_cast<int>(lat_.size()); ++j) {
+        if (lon_[i].lane >= 0 && lon_[i].lane != lat_[j].lane) continue;
+        cand_lon_.push_back(i);
+        cand_lat_.push_back(j);
+      }
+    }
+  }
+
+  // ---- Scoring ------------------------------------------------------------------------------
+
+  cost::CostInput InputFor(int i, int j) const {
+    cost::CostInput in;
+    const int oi = i * n_samples_, oj = j * n_samples_;
+    in.s = lon_s_.data() + oi;
+    in.s_d = lon_sd_.data() + oi;
+    in.s_dd = lon_sdd_.data() + oi;
+    in.d = lat_d_.data() + oj;
+    in.d_d = lat_dd_.data() + oj;
+    in.d_dd = lat_ddd_.data() + oj;
+    in.lon_duration = lon_[i].traj.duration;
+    in.lat_duration = lat_[j].traj.duration;
+    in.lon_jerk_squared = lon_[i].jerk2;
+    in.lat_jerk_squared = lat_[j].jerk2;
+    in.end_speed = lon_[i].traj.poly.V(lon_[i].traj.duration);
+    in.end_d = lat_d_[oj + n_samples_ - 1];
+    in.target_lane = lat_[j].lane;
+    in.kind = lon_[i].kind;
+    return in;
+  }
+
+  void Score() {
+    const int n = static_cast<int>(cand_lon_.size());
+    cand_cost_.resize(n);
+    order_.resize(n);
+    for (int c = 0; c < n; ++c) {
+      const double v = costs_->Evaluate(ctx_, InputFor(cand_lon_[c], cand_lat_[c]));
+      cand_cost_[c] = Finite(v) ? v : 1e300;
+      order_[c] = c;
+    }
+    // Ties break by index: the comparison is a strict total order.
+    std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+      return cand_cost_[a] < cand_cost_[b] || (cand_cost_[a] == cand_cost_[b] && a < b);
+    });
+  }
+
+  // ---- Hard checks --------------------------------------------------------------------------
+
+  // Samples a trajectory at every tick of the check horizon into the tick buffers.
+  void FillTicks(const FrenetTrajectory& tr) {
+    for (int i = 1; i <= n_ticks_; ++i) {
+      const FrenetState st = tr.At(i * kTickSeconds);
+      tk_s_[i] = st.s;
+      tk_sd_[i] = st.s_d;
+      tk_sdd_[i] = st.s_dd;
+      tk_d_[i] = st.d;
+      tk_dd_[i] = st.d_d;
+      tk_ddd_[i] = st.d_dd;
+    }
+  }
+
+  // Builds history | kept | ticks in the XY buffers; returns the path length.
+  int BuildXyPath() {
+    int n = 0;
+    for (int i = 0; i < hist_n_; ++i, ++n) {
+      chk_x_[n] = hist_x_[i];
+      chk_y_[n] = hist_y_[i];
+    }
+    for (int i = 0; i < kept_; ++i, ++n) {
+      chk_x_[n] = plan_x_[i];
+      chk_y_[n] = plan_y_[i];
+    }
+    first_new_ = n;
+    for (int i = 1; i <= n_ticks_; ++i, ++n) {
+      const map::CartesianPose p = line_->ToCartesian(tk_s_[i], tk_d_[i]);
+      chk_x_[n] = p.x;
+      chk_y_[n] = p.y;
+    }
+    return n;
+  }
+
+  // The worst normalised excess over all limits (<= 0: feasible), and the first reason.
+  double Violation(Reject* reason) {
+    double worst = -1e9;
+    Reject why = Reject::kCount;
+    auto take = [&](double v, Reject r) {
+      if (!(v <= worst)) {  // NaN counts as a violation
+        worst = Finite(v) ? v : 1e9;
+        why = r;
+      }
+    };
+    double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
+    for (int i = 1; i <= n_ticks_; ++i) {
+      dmin = std::min(dmin, tk_d_[i]);
+      dmax = std::max(dmax, tk_d_[i]);
+      sdmin = std::min(sdmin, tk_sd_[i]);
+    }
+    take(std::max(cfg_.d_min - dmin, dmax - cfg_.d_max) / cfg_.lane_width, Reject::kOffRoad);
+    take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
+    if (worst > 0) {  // already infeasible: skip the XY conversion
+      if (reason != nullptr) *reason = why;
+      return worst;
+    }
+    const int n = BuildXyPath();
+    const XyMeasure m = checker_.Measure(chk_x_.data(), chk_y_.data(), n, first_new_);
+    take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
+    take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
+    take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
+    if (reason != nullptr) *reason = worst > 0 ? why : Reject::kCount;
+    return worst;
+  }
+
+  // Oriented-box overlap with every relevant car over the check horizon (inflated boxes).
+  bool Collides() const {
+    const int step = std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
+    const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
+    for (int i = step; i <= n_ticks_; i += step) {
+      const double t = i * kTickSeconds;
+      const traj::OrientedBox ego{tk_s_[i], tk_d_[i],
+                                  std::atan2(tk_dd_[i], std::max(tk_sd_[i], 0.5)), hl, hw};
+      for (int c = 0; c < ctx_.num_cars; ++c) {
+        const double cs = car_s0_[c] + car_v_[c] * (t + t_keep_);
+        if (std::abs(cs - ego.cx) > 12 || std::abs(car_d_[c] - ego.cy) > 5) continue;
+        const traj::OrientedBox car{cs, car_d_[c], 0.0, hl + cfg_.margin_s, hw + cfg_.margin_d};
+        if (traj::Overlap(ego, car)) return true;
+      }
+    }
+    return false;
+  }
+
+  FrenetTrajectory Candidate(int c) const {
+    return {lon_[cand_lon_[c]].traj, lat_[cand_lat_[c]].traj};
+  }
+
+  bool CheckLazily(bool* over_budget) {
+    PlanSummary& sum = result_.summary;
+    const int n = static_cast<int>(order_.size());
+    for (int r = 0; r < n; ++r) {
+      if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+        *over_budget = true;
+        return false;
+      }
+      const int c = order_[r];
+      FillTicks(Candidate(c));
+      ++sum.candidates_checked;
+      // Cheapest first: the Frenet-only collision test skips the XY conversion for the many
+      // candidates that run into traffic.
+      if (Collides()) {
+        ++sum.rejections[static_cast<int>(Reject::kCollision)];
+        Trace(r, false, static_cast<int>(Reject::kCollision));
+        continue;
+      }
+      Reject why = Reject::kCount;
+      if (Violation(&why) > 0) {
+        ++sum.rejections[static_cast<int>(why)];
+        Trace(r, false, static_cast<int>(why));
+        continue;
+      }
+      ++sum.candidates_feasible;
+      winner_index_ = c;
+      winner_ = Candidate(c);
+      winner_lon_ = cand_lon_[c];
+      winner_lat_ = cand_lat_[c];
+      winner_cost_ = cand_cost_[c];
+      Trace(r, true, -1);
+      for (int rr = r + 1; rr < n && trace_ != nullptr &&
+                           static_cast<int>(trace_->candidates.size()) < trace_max_;
+           ++rr) {
+        Trace(rr, false, -1);
+      }
+      return true;
+    }
+    return false;
+  }
+
+  void Trace(int rank, bool winner, int reject) {
+    if (trace_ == nullptr || static_cast<int>(trace_->candidates.size()) >= trace_max_) return;
+    const int c = order_[rank];
+    CandidateTrace ct;
+    ct.lane = lat_[cand_lat_[c]].lane;
+    const LonTraj& lt = lon_[cand_lon_[c]];
+    ct.end_speed = lt.traj.poly.V(lt.traj.duration);
+    ct.duration = lt.traj.duration;
+    ct.total_cost = cand_cost_[c];
+    ct.checked = winner || reject >= 0;
+    ct.winner = winner;
+    ct.reject = reject;
+    const FrenetTrajectory tr = Candidate(c);
+    for (double tt = 0; tt <= cfg_.score_horizon + 1e-9; tt += 0.25) {
+      const FrenetState st = tr.At(tt);
+      const map::CartesianPose p = line_->ToCartesian(st.s, st.d);
+      ct.x.push_back(p.x);
+      ct.y.push_back(p.y);
+    }
+    costs_->Evaluate(ctx_, InputFor(cand_lon_[c], cand_lat_[c]), per_term_.data());
+    for (int i = 0; i < costs_->size(); ++i) {
+      ct.costs.push_back({costs_->name(i), costs_->weight(i), per_term_[i]});
+    }
+    trace_->candidates.push_back(std::move(ct));
+  }
+
+  // ---- Refinement ---------------------------------------------------------------------------
+
+  // Builds the trajectory for refinement parameters x = [param, T, T_lat, offset].
+  FrenetTrajectory FromParams(const double* x) const {
+    const LonTraj& base = lon_[winner_lon_];
+    const LatTraj& lbase = lat_[winner_lat_];
+    LonTraj l = MakeLon(base.kind, base.lane, x[0], x[1], base.lead_s, base.lead_v);
+    LatTraj d = MakeLat(lbase.lane, x[3], x[2]);
+    return {l.traj, d.traj};
+  }
+
+  // Weighted cost of a trajectory (samples it like the bundles).
+  double CostOf(const FrenetTrajectory& tr, const LonTraj& lbase, const LatTraj& dbase) {
+    for (int k = 0; k < n_samples_; ++k) {
+      const FrenetState st = tr.At(k * cfg_.score_dt);
+      ref_s_[k] = st.s;
+      ref_sd_[k] = st.s_d;
+      ref_sdd_[k] = st.s_dd;
+      ref_d_[k] = st.d;
+      ref_dd_[k] = st.d_d;
+      ref_ddd_[k] = st.d_dd;
+    }
+    cost::CostInput in;
+    in.s = ref_s_.data();
+    in.s_d = ref_sd_.data();
+    in.s_dd = ref_sdd_.data();
+    in.d = ref_d_.data();
+    in.d_d = ref_dd_.data();
+    in.d_dd = ref_ddd_.data();
+    in.lon_duration = tr.lon.duration;
+    in.lat_duration = tr.lat.duration;
+    in.lon_jerk_squared = tr.lon.poly.JerkSquaredIntegral(tr.lon.duration);
+    in.lat_jerk_squared = tr.lat.poly.JerkSquaredIntegral(tr.lat.duration);
+    in.end_speed = tr.lon.poly.V(tr.lon.duration);
+    in.end_d = ref_d_[n_samples_ - 1];
+    in.target_lane = dbase.lane;
+    in.kind = lbase.kind;
+    const double v = costs_->Evaluate(ctx_, in);
+    return Finite(v) ? v : 1e300;
+  }
+
+  static double RefineObjective(unsigned n, const double* x, double* grad, void* data) {
+    (void)n;
+    (void)grad;  // derivative-free
+    auto* self = static_cast<SearchPlanner*>(data);
+    ++self->refine_evals_;
+    const FrenetTrajectory tr = self->FromParams(x);
+    double v = self->CostOf(tr, self->lon_[self->winner_lon_], self->lat_[self->winner_lat_]);
+    if (!self->constraints_ok_) {
+      // Algorithms without constraint support get the limits as a steep penalty.
+      self->FillTicks(tr);
+      v += 1e3 * std::max(0.0, self->Violation(nullptr));
+    }
+    return v;
+  }
+
+  static double RefineConstraint(unsigned n, const double* x, double* grad, void* data) {
+    (void)n;
+    (void)grad;
+    auto* self = static_cast<SearchPlanner*>(data);
+    self->FillTicks(self->FromParams(x));
+    return self->Violation(nullptr);
+  }
+
+  void Refine() {
+    PlanSummary& sum = result_.summary;
+    const LonTraj& lb = lon_[winner_lon_];
+    const LatTraj& db = lat_[winner_lat_];
+    double x[4] = {lb.param, lb.traj.duration, db.traj.duration, db.offset};
+    double lo[4], hi[4];
+    switch (lb.kind) {
+      case cost::LonKind::kVelocityKeeping:
+        lo[0] = 0;
+        hi[0] = ctx_.lane_speed_limit[db.lane];
+        break;
+      case cost::LonKind::kFollowing:
+        lo[0] = -5;
+        hi[0] = 30;
+        break;
+      case cost::LonKind::kStopping:
+        lo[0] = 0;
+        hi[0] = std::max(1.0, start_.s_d * cfg_.max_duration);
+        break;
+    }
+    lo[1] = cfg_.min_duration;
+    hi[1] = cfg_.max_duration;
+    lo[2] = std::min(cfg_.lat_min_duration, db.traj.duration);
+    hi[2] = std::max(cfg_.lat_max_duration, db.traj.duration);
+    lo[3] = -0.5;
+    hi[3] = 0.5;
+    for (int i = 0; i < 4; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
+    const double before = CostOf(winner_, lb, db);
+    sum.refine_cost_before = before;
+    sum.refine_cost_after = before;
+    nlopt_set_lower_bounds(opt_, lo);
+    nlopt_set_upper_bounds(opt_, hi);
+    const double remaining = 0.8 * cfg_.budget_ms - MsSince(t0_);
+    nlopt_set_maxtime(opt_, std::max(1e-3, std::min(cfg_.refine_budget_ms, remaining)) * 1e-3);
+    refine_evals_ = 0;
+    double best = 0;
+    const nlopt_result r = nlopt_optimize(opt_, x, &best);
+    sum.refine_iterations = refine_evals_;
+    if (r < 0 || !Finite(best) || best >= before) return;
+    // Safety re-check of the refined trajectory; keep the unrefined winner if it fails.
+    const FrenetTrajectory refined = FromParams(x);
+    FillTicks(refined);
+    if (Violation(nullptr) > 0 || Collides()) return;
+    winner_ = refined;
+    sum.refine_cost_after = CostOf(refined, lb, db);
+  }
+
+  // ---- Decision memory, costs, fallback, output ---------------------------------------------
+
+  void RecordDecision(int lane) {
+    const int committed = prev_target_lane_ >= 0 ? prev_target_lane_ : LaneOf(start_.d);
+    if (lane != committed) {
+      lane_before_change_ = committed;
+      time_since_change_ = 0;
+    }
+    prev_target_lane_ = lane;
+    prev_traj_ = winner_;
+    have_prev_traj_ = true;
+  }
+
+  void EvaluateWinnerCosts() {
+    const double total = CostOf(winner_, lon_[winner_lon_], lat_[winner_lat_]);
+    cost::CostInput in;  // CostOf left the samples in ref_*: evaluate per term on them
+    in.s = ref_s_.data();
+    in.s_d = ref_sd_.data();
+    in.s_dd = ref_sdd_.data();
+    in.d = ref_d_.data();
+    in.d_d = ref_dd_.data();
+    in.d_dd = ref_ddd_.data();
+    in.lon_duration = winner_.lon.duration;
+    in.lat_duration = winner_.lat.duration;
+    in.lon_jerk_squared = winner_.lon.poly.JerkSquaredIntegral(winner_.lon.duration);
+    in.lat_jerk_squared = winner_.lat.poly.JerkSquaredIntegral(winner_.lat.duration);
+    in.end_speed = winner_.lon.poly.V(winner_.lon.duration);
+    in.end_d = ref_d_[n_samples_ - 1];
+    in.target_lane = lat_[winner_lat_].lane;
+    in.kind = lon_[winner_lon_].kind;
+    costs_->Evaluate(ctx_, in, per_term_.data());
+    for (int i = 0; i < costs_->size(); ++i) result_.summary.winner_costs[i].value = per_term_[i];
+    result_.summary.winner_total_cost = total;
+  }
+
+  // Keep-lane braking at a jerk-limited constant deceleration, integrated tick by tick; it
+  // never exceeds the limits. The first braking level that clears the traffic wins, else the
+  // hardest.
+  void BuildFallback() {
+    const double levels[3] = {cfg_.fallback_decel,
+                              std::min(2 * cfg_.fallback_decel, 0.75 * cfg_.max_accel),
+                              0.85 * cfg_.max_accel};
+    const int lane = LaneOf(start_.d);
+    Trajectory1d lat{traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, lane_center_[lane], 0,
+                                        0, cfg_.fallback_lat_duration),
+                     cfg_.fallback_lat_duration};
+    for (int level = 0; level < 3; ++level) {
+      const double decel = levels[level];
+      const double jerk = std::min(cfg_.fallback_jerk, 0.8 * cfg_.max_jerk);
+      double s = start_.s, v = std::max(start_.s_d, 0.0), a = start_.s_dd;
+      for (int i = 1; i <= n_ticks_; ++i) {
+        // Aim at -decel, but ease off near standstill so a reaches 0 when v does.
+        const double target = v > 0 ? -std::min(decel, std::sqrt(2.0 * jerk * v)) : 0.0;
+        const double da = std::clamp(target - a, -jerk * kTickSeconds, jerk * kTickSeconds);
+        a += da;
+        v += a * kTickSeconds;
+        if (v <= 0) {
+          v = 0;
+          a = 0;
+        }
+        s += v * kTickSeconds;
+        const traj::State1d d = lat.At(i * kTickSeconds);
+        tk_s_[i] = s;
+        tk_sd_[i] = v;
+        tk_sdd_[i] = a;
+        tk_d_[i] = d.p;
+        tk_dd_[i] = d.v;
+        tk_ddd_[i] = d.a;
+      }
+      if (!Collides()) break;
+    }
+  }
+
+  void Output() {
+    const int new_points = cfg_.output_points - kept_;
+    for (int i = 1; i <= new_points; ++i) {
+      const int k = kept_ + i - 1;
+      plan_s_[k] = tk_s_[i];
+      plan_sd_[k] = tk_sd_[i];
+      plan_sdd_[k] = tk_sdd_[i];
+      plan_d_[k] = tk_d_[i];
+      plan_dd_[k] = tk_dd_[i];
+      plan_ddd_[k] = tk_ddd_[i];
+      const map::CartesianPose p = line_->ToCartesian(tk_s_[i], tk_d_[i]);
+      plan_x_[k] = p.x;
+      plan_y_[k] = p.y;
+    }
+    plan_n_ = cfg_.output_points;
+    plan_start_index_ = kept_ > 0 ? kept_ - 1 : -1;
+    // Last resort against NaN from anywhere: repeat the last finite point.
+    double lx = 0, ly = 0;
+    bool have = false;
+    for (int k = 0; k < plan_n_; ++k) {
+      if (Finite(plan_x_[k]) && Finite(plan_y_[k])) {
+        lx = plan_x_[k];
+        ly = plan_y_[k];
+        have = true;
+      }
+    }
+    for (int k = 0; k < plan_n_; ++k) {
+      if (!Finite(plan_x_[k]) || !Finite(plan_y_[k])) {
+        plan_x_[k] = have ? lx : 0.0;
+        plan_y_[k] = have ? ly : 0.0;
+      }
+      result_.x.push_back(plan_x_[k]);
+      result_.y.push_back(plan_y_[k]);
+    }
+    have_plan_ = true;
+  }
+
+  Settings cfg_;
+  std::shared_ptr<const map::ReferenceLine> line_;
+  std::shared_ptr<const cost::CostSet> costs_;
+  std::unique_ptr<Predictor> predictor_;
+  XyChecker checker_;
+  nlopt_opt opt_ = nullptr;
+  bool constraints_ok_ = false;
+  int refine_evals_ = 0;
+
+  double lane_center_[cost::kMaxLanes] = {};
+  int n_samples_ = 0, n_ticks_ = 0;
+  Clock::time_point t0_;
+  CycleTrace* trace_ = nullptr;
+  int trace_max_ = 0;
+
+  // Per cycle.
+  FrenetState start_;
+  int kept_ = 0;
+  double t_keep_ = 0;
+  cost::CostContext ctx_;
+  std::vector<LonTraj> lon_;
+  std::vector<LatTraj> lat_;
+  std::vector<double> lon_s_, lon_sd_, lon_sdd_, lat_d_, lat_dd_, lat_ddd_;
+  std::vector<int> cand_lon_, cand_lat_, order_;
+  std::vector<double> cand_cost_;
+  std::vector<double> car_s_, car_d_, car_v_, car_s0_;
+  std::vector<double> prev_s_, prev_d_;
+  std::vector<double> ref_s_, ref_sd_, ref_sdd_, ref_d_, ref_dd_, ref_ddd_;
+  std::vector<double> tk_s_, tk_sd_, tk_sdd_, tk_d_, tk_dd_, tk_ddd_;
+  std::vector<double> chk_x_, chk_y_;
+  std::vector<double> per_term_;
+  int first_new_ = 0;
+  int winner_index_ = -1, winner_lon_ = -1, winner_lat_ = -1;
+  double winner_cost_ = 0;
+  FrenetTrajectory winner_;
+
+  // Across cycles.
+  bool have_plan_ = false;
+  int plan_n_ = 0;
+  int plan_start_index_ = 0;  // index of the start state of the stored plan's new part
+  std::vector<double> plan_s_, plan_sd_, plan_sdd_, plan_d_, plan_dd_, plan_ddd_, plan_x_,
+      plan_y_;
+  std::vector<double> hist_x_, hist_y_;
+  int hist_n_ = 0;
+  bool have_prev_traj_ = false;
+  FrenetTrajectory prev_traj_;
+  double prev_elapsed_ = 0;
+  int prev_target_lane_ = -1, lane_before_change_ = -1;
+  double time_since_change_ = 1e9;
+
+  PlanResult result_;
+};
+
+}  // namespace
+
+std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
+                                           std::shared_ptr<const map::ReferenceLine> line,
+                                           std::shared_ptr<const cost::CostSet> costs) {
+  return std::make_unique<SearchPlanner>(config, std::move(line), std::move(costs));
+}
+
+}  // namespace frenetic::plan

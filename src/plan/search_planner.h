@@ -1,0 +1,23 @@
+// The `search` planner: a Frenet lattice after Werling, Ziegler, Kammel and Thrun, "Optimal
+// Trajectory Generation for Dynamic Street Scenarios in a Frenet Frame", ICRA 2010 — quartic
+// velocity keeping, quintic following (constant time-gap law) and stopping, quintic lateral
+// moves to lane centres, every lon x lat pair scored by the weighted cost set, then checked
+// lazily in cost order on the XY path, refined with NLopt, with a keep-lane braking fallback.
+#pragma once
+
+#include <memory>
+
+#include "frenetic/cost/cost_set.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/plan/planner_config.h"
+
+namespace frenetic::plan {
+
+std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
+                                           std::shared_ptr<const map::ReferenceLine> line,
+                                           std::shared_ptr<const cost::CostSet> costs);
+
+std::unique_ptr<Planner> MakeBaselinePlanner(const PlannerConfig& config,
+                                             std::shared_ptr<const map::ReferenceLine> line);
+
+}  // namespace frenetic::plan

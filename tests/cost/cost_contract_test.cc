@@ -1,0 +1,237 @@
+// Every registered cost term through the same property checks, and the registry against
+// config/planner.yaml.
+#include <cmath>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "frenetic/cost/cost_registry.h"
+#include "frenetic/cost/cost_set.h"
+
+namespace frenetic::cost {
+namespace {
+
+constexpr int kN = 25;
+
+// A candidate with its sample storage.
+struct Fixture {
+  std::vector<double> s, s_d, s_dd, d, d_d, d_dd, car_s, car_d, car_v, prev_s, prev_d;
+  CostContext ctx;
+  CostInput in;
+
+  void Wire() {
+    in.s = s.data(); in.s_d = s_d.data(); in.s_dd = s_dd.data();
+    in.d = d.data(); in.d_d = d_d.data(); in.d_dd = d_dd.data();
+    ctx.car_s = car_s.data(); ctx.car_d = car_d.data(); ctx.car_v = car_v.data();
+    ctx.num_cars = static_cast<int>(car_d.size());
+    ctx.previous_s = prev_s.empty() ? nullptr : prev_s.data();
+    ctx.previous_d = prev_d.empty() ? nullptr : prev_d.data();
+  }
+};
+
+void SetLanes(CostContext& ctx) {
+  ctx.num_samples = kN;
+  ctx.dt = 0.25;
+  ctx.lane_width = 4;
+  ctx.num_lanes = 3;
+  for (int l = 0; l < 3; ++l) {
+    ctx.lane_center[l] = 2 + 4 * l;
+    ctx.lane_speed_limit[l] = 22.0;
+  }
+}
+
+// Ideal lane keeping: middle lane, at the limit, no traffic, same as last cycle.
+Fixture IdealLaneKeeping() {
+  Fixture f;
+  SetLanes(f.ctx);
+  for (int k = 0; k < kN; ++k) {
+    f.s.push_back(100 + 22.0 * k * 0.25);
+    f.s_d.push_back(22.0);
+    f.s_dd.push_back(0);
+    f.d.push_back(6);
+    f.d_d.push_back(0);
+    f.d_dd.push_back(0);
+  }
+  f.prev_s = f.s;
+  f.prev_d = f.d;
+  f.ctx.start_s = 100;
+  f.ctx.start_d = 6;
+  f.ctx.start_speed = 22;
+  f.ctx.current_lane = 1;
+  f.ctx.previous_target_lane = 1;
+  f.in.end_speed = 22;
+  f.in.end_d = 6;
+  f.in.target_lane = 1;
+  f.in.lon_duration = 3;
+  f.in.lat_duration = 3;
+  f.Wire();
+  return f;
+}
+
+// Random, often hostile candidates and traffic (finite values).
+Fixture RandomFixture(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  Fixture f;
+  SetLanes(f.ctx);
+  double s = 50 * u(rng), v = 30 * u(rng);
+  for (int k = 0; k < kN; ++k) {
+    const double a = -8 + 16 * u(rng);
+    f.s.push_back(s);
+    f.s_d.push_back(v);
+    f.s_dd.push_back(a);
+    f.d.push_back(-1 + 14 * u(rng));
+    f.d_d.push_back(-3 + 6 * u(rng));
+    f.d_dd.push_back(-5 + 10 * u(rng));
+    s += std::max(v, 0.0) * 0.25;
+    v = std::max(0.0, v + a * 0.25);
+  }
+  const int cars = static_cast<int>(u(rng) * 12);
+  for (int c = 0; c < cars; ++c) {
+    const double s0 = -50 + 150 * u(rng), vc = 25 * u(rng);
+    for (int k = 0; k < kN; ++k) f.car_s.push_back(s0 + vc * k * 0.25);
+    f.car_d.push_back(12 * u(rng));
+    f.car_v.push_back(vc);
+  }
+  if (u(rng) < 0.5) {
+    for (int k = 0; k < kN; ++k) {
+      f.prev_s.push_back(f.s[k] + 20 * (u(rng) - 0.5));
+      f.prev_d.push_back(12 * u(rng));
+    }
+  }
+  f.ctx.current_lane = static_cast<int>(u(rng) * 3);
+  f.ctx.previous_target_lane = static_cast<int>(u(rng) * 4) - 1;
+  f.ctx.lane_before_change = static_cast<int>(u(rng) * 4) - 1;
+  f.ctx.time_since_lane_change = 10 * u(rng);
+  f.in.end_speed = v;
+  f.in.end_d = f.d.back();
+  f.in.target_lane = static_cast<int>(u(rng) * 3);
+  f.in.lon_jerk_squared = 1000 * u(rng);
+  f.in.lat_jerk_squared = 1000 * u(rng);
+  f.in.lon_duration = 1.5 + 4.5 * u(rng);
+  f.in.lat_duration = 2 + 2 * u(rng);
+  f.in.kind = static_cast<LonKind>(static_cast<int>(u(rng) * 3));
+  f.Wire();
+  return f;
+}
+
+class CostContractTest : public testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<CostTerm> Make() {
+    auto made = CostRegistry::Global().Make(GetParam());
+    EXPECT_TRUE(made.ok()) << made.message();
+    std::unique_ptr<CostTerm> term = std::move(made.value());
+    std::vector<double> defaults;
+    for (const auto& spec : term->ParamSpecs()) {
+      EXPECT_LE(spec.lo, spec.default_value) << spec.key;
+      EXPECT_LE(spec.default_value, spec.hi) << spec.key;
+      if (spec.log_scale) {
+        EXPECT_GT(spec.lo, 0) << spec.key;
+      }
+      defaults.push_back(spec.default_value);
+    }
+    term->Configure(defaults);
+    return term;
+  }
+};
+
+TEST_P(CostContractTest, FiniteNonNegativeAndDeterministic) {
+  auto term = Make();
+  std::mt19937 rng(1234);
+  for (int i = 0; i < 2000; ++i) {
+    Fixture f = RandomFixture(rng);
+    const double a = term->Evaluate(f.ctx, f.in);
+    const double b = term->Evaluate(f.ctx, f.in);
+    ASSERT_TRUE(std::isfinite(a)) << "case " << i;
+    ASSERT_GE(a, 0.0) << "case " << i;
+    ASSERT_EQ(a, b) << "case " << i;
+  }
+}
+
+TEST_P(CostContractTest, NearZeroOnIdealLaneKeeping) {
+  auto term = Make();
+  Fixture f = IdealLaneKeeping();
+  EXPECT_NEAR(term->Evaluate(f.ctx, f.in), 0.0, 1e-6);
+}
+
+TEST_P(CostContractTest, DetectsSomethingOnHostileInputs) {
+  // A term that is 0 everywhere measures nothing: some random case must give a positive value.
+  auto term = Make();
+  std::mt19937 rng(99);
+  double max_value = 0;
+  for (int i = 0; i < 500; ++i) {
+    Fixture f = RandomFixture(rng);
+    max_value = std::max(max_value, term->Evaluate(f.ctx, f.in));
+  }
+  EXPECT_GT(max_value, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllRegistered, CostContractTest,
+                         testing::ValuesIn(CostRegistry::Global().Names()),
+                         [](const testing::TestParamInfo<std::string>& info) { return info.param; });
+
+TEST(CostRegistryTest, RegisteredNamesEqualConfigNames) {
+  const YAML::Node root = YAML::LoadFile(FRENETIC_SOURCE_DIR "/config/planner.yaml");
+  std::set<std::string> config_names;
+  for (const auto& kv : root["costs"]) config_names.insert(kv.first.as<std::string>());
+  const std::vector<std::string> registered = CostRegistry::Global().Names();
+  EXPECT_EQ(std::set<std::string>(registered.begin(), registered.end()), config_names);
+  EXPECT_GE(registered.size(), 8u);
+}
+
+TEST(CostRegistryTest, UnknownTermIsAnErrorNamingIt) {
+  auto made = CostRegistry::Global().Make("warp_drive");
+  ASSERT_FALSE(made.ok());
+  EXPECT_NE(made.message().find("warp_drive"), std::string::npos);
+}
+
+TEST(CostSetTest, WeightedSumInConfigOrderAndErrors) {
+  auto set = CostSet::Build({{"efficiency", 2.0, {}}, {"lane_change", 3.0, {{"switch_back", 1.0}}}});
+  ASSERT_TRUE(set.ok()) << set.message();
+  ASSERT_EQ((*set)->size(), 2);
+  EXPECT_EQ((*set)->name(0), "efficiency");
+  Fixture f = IdealLaneKeeping();
+  f.in.end_speed = 11;  // half the limit
+  f.in.target_lane = 0;  // a lane change
+  double per[2];
+  const double total = (*set)->Evaluate(f.ctx, f.in, per);
+  EXPECT_GT(per[0], 0);
+  EXPECT_EQ(per[1], 1.0);
+  EXPECT_DOUBLE_EQ(total, 2 * per[0] + 3 * per[1]);
+
+  auto bad_key = CostSet::Build({{"jerk", 1.0, {{"colour", 1.0}}}});
+  ASSERT_FALSE(bad_key.ok());
+  EXPECT_NE(bad_key.message().find("colour"), std::string::npos);
+  auto bad_value = CostSet::Build({{"jerk", 1.0, {{"scale", -1.0}}}});
+  ASSERT_FALSE(bad_value.ok());
+  EXPECT_NE(bad_value.message().find("jerk.scale"), std::string::npos);
+  auto bad_weight = CostSet::Build({{"jerk", std::nan(""), {}}});
+  EXPECT_FALSE(bad_weight.ok());
+}
+
+TEST(CostBehaviourTest, TermsRankTheObviousChoices) {
+  auto collision = CostRegistry::Global().Make("collision");
+  auto buffer = CostRegistry::Global().Make("buffer");
+  ASSERT_TRUE(collision.ok() && buffer.ok());
+  std::vector<double> c_def{0.5, 2.0}, b_def{8.0, 1.2};
+  (*collision)->Configure(c_def);
+  (*buffer)->Configure(b_def);
+  Fixture f = IdealLaneKeeping();
+  // A stopped car 30 m ahead in the ego's lane: the lane-keeping candidate runs into it.
+  for (int k = 0; k < kN; ++k) f.car_s.push_back(130);
+  f.car_d.push_back(6);
+  f.car_v.push_back(0);
+  f.Wire();
+  EXPECT_GT((*collision)->Evaluate(f.ctx, f.in), 0.02);
+  EXPECT_GT((*buffer)->Evaluate(f.ctx, f.in), 0.1);
+  // The same car in the next lane is harmless.
+  f.car_d[0] = 10;
+  EXPECT_EQ((*collision)->Evaluate(f.ctx, f.in), 0.0);
+  EXPECT_EQ((*buffer)->Evaluate(f.ctx, f.in), 0.0);
+}
+
+}  // namespace
+}  // namespace frenetic::cost

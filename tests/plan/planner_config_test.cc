@@ -1,0 +1,123 @@
+#include "frenetic/plan/planner_config.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "frenetic/cost/cost_registry.h"
+
+namespace frenetic::plan {
+namespace {
+
+std::string DefaultYaml() {
+  std::ifstream in(PlannerConfig::DefaultPath());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(PlannerConfigTest, LoadsTheShippedFile) {
+  auto c = PlannerConfig::LoadDefault();
+  ASSERT_TRUE(c.ok()) << c.message();
+  EXPECT_DOUBLE_EQ(c->budget_ms(), 15);
+  EXPECT_DOUBLE_EQ(*c->Get("limits.max_speed_mph"), 49.5);
+  EXPECT_DOUBLE_EQ(*c->Get("weights.collision"), 10);
+  EXPECT_EQ(c->refine_algorithm(), "LN_COBYLA");
+  const auto terms = c->cost_terms();
+  ASSERT_FALSE(terms.empty());
+  EXPECT_EQ(terms.front().name, "collision");  // config order, not alphabetical
+  EXPECT_EQ(terms.size(), cost::CostRegistry::Global().Names().size());
+}
+
+TEST(PlannerConfigTest, UnknownKeyIsAnErrorNamingKeyAndFile) {
+  auto d = PlannerConfig::Parse("limits:\n  max_sped: 3\ncosts: {}\n", "my.yaml");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.message().find("limits.max_sped"), std::string::npos) << d.message();
+  EXPECT_NE(d.message().find("my.yaml"), std::string::npos) << d.message();
+  auto e = PlannerConfig::Parse("warp:\n  factor: 9\n", "x.yaml");
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.message().find("warp"), std::string::npos) << e.message();
+}
+
+TEST(PlannerConfigTest, UnknownCostTermAndParameterAreErrors) {
+  std::string yaml = DefaultYaml();
+  std::string with_term = yaml;
+  with_term.replace(with_term.find("  collision:\n"), 13, "  colision:\n");
+  auto t = PlannerConfig::Parse(with_term, "b.yaml");
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.message().find("colision"), std::string::npos) << t.message();
+  std::string with_param = yaml;
+  with_param.replace(with_param.find("    margin: 0.5"), 15, "    margn: 0.5");
+  auto p = PlannerConfig::Parse(with_param, "c.yaml");
+  ASSERT_FALSE(p.ok());
+  EXPECT_NE(p.message().find("costs.collision.margn"), std::string::npos) << p.message();
+}
+
+TEST(PlannerConfigTest, MissingWeightIsAnError) {
+  std::string yaml = DefaultYaml();
+  yaml.replace(yaml.find("    weight: 6\n"), 14, "");  // efficiency loses its weight
+  auto c = PlannerConfig::Parse(yaml, "w.yaml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.message().find("efficiency"), std::string::npos) << c.message();
+  EXPECT_NE(c.message().find("weight"), std::string::npos) << c.message();
+  // A term left out entirely is a missing weight too.
+  std::string dropped = DefaultYaml();
+  const size_t at = dropped.find("  consistency:\n");
+  dropped.erase(at, dropped.find("s_scale", at) + 20 - at);
+  auto d = PlannerConfig::Parse(dropped, "w.yaml");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.message().find("consistency"), std::string::npos) << d.message();
+}
+
+TEST(PlannerConfigTest, SetGetRangesAndRoundTrip) {
+  auto c = PlannerConfig::LoadDefault();
+  ASSERT_TRUE(c.ok());
+  EXPECT_TRUE(c->Set("weights.efficiency", 7.5).ok());
+  EXPECT_DOUBLE_EQ(*c->Get("weights.efficiency"), 7.5);
+  EXPECT_TRUE(c->Set("costs.buffer.headway", 2.0).ok());
+  Status bad = c->Set("limits.max_speed_mph", 80);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("limits.max_speed_mph"), std::string::npos);
+  Status unknown = c->Set("weights.nonsense", 1);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.message().find("weights.nonsense"), std::string::npos);
+  EXPECT_FALSE(c->Get("no.such").ok());
+
+  auto back = PlannerConfig::Parse(c->ToYaml(), "roundtrip");
+  ASSERT_TRUE(back.ok()) << back.message() << "\n" << c->ToYaml();
+  const auto a = c->Params(), b = back->Params();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].key, b[i].key);
+    EXPECT_DOUBLE_EQ(a[i].value, b[i].value) << a[i].key;
+  }
+  EXPECT_EQ(back->refine_algorithm(), c->refine_algorithm());
+}
+
+TEST(PlannerConfigTest, ParamsCoverWeightsAndHaveSaneRanges) {
+  auto c = PlannerConfig::LoadDefault();
+  ASSERT_TRUE(c.ok());
+  int weights = 0;
+  for (const auto& p : c->Params()) {
+    EXPECT_LE(p.lo, p.value) << p.key;
+    EXPECT_LE(p.value, p.hi) << p.key;
+    EXPECT_LT(p.lo, p.hi) << p.key;
+    if (p.log_scale) {
+      EXPECT_GT(p.lo, 0) << p.key;
+    }
+    if (p.key.rfind("weights.", 0) == 0) ++weights;
+  }
+  EXPECT_EQ(weights, static_cast<int>(cost::CostRegistry::Global().Names().size()));
+  EXPECT_NE(PlannerConfig::Load("/nonexistent/planner.yaml").message().find("/nonexistent"),
+            std::string::npos);
+  auto broken = PlannerConfig::Parse("limits: [1, 2", "broken.yaml");
+  ASSERT_FALSE(broken.ok());
+  EXPECT_NE(broken.message().find("broken.yaml"), std::string::npos);
+  auto text = PlannerConfig::Parse("budget_ms: fast\n", "t.yaml");
+  ASSERT_FALSE(text.ok());
+  EXPECT_NE(text.message().find("budget_ms"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace frenetic::plan

@@ -1,0 +1,518 @@
+// Planners on the Udacity map in a small closed loop written here (the simulator's path-trimming
+// rule, 1-3 points consumed per cycle, traffic at constant velocity), plus fuzzing and the
+// no-allocation property of the search planner.
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "frenetic/map/reference_line.h"
+#include "frenetic/map/track.h"
+#include "frenetic/plan/feasibility.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/plan/planner_config.h"
+#include "frenetic/plan/predictor.h"
+
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
+// Counting global operator new: counts only while g_count_allocations is set.
+static std::atomic<bool> g_count_allocations{false};
+static std::atomic<long> g_allocations{0};
+void* operator new(std::size_t n) {
+  if (g_count_allocations.load(std::memory_order_relaxed)) ++g_allocations;
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace frenetic::plan {
+namespace {
+
+constexpr double kMph = 0.44704;
+
+std::shared_ptr<const map::ReferenceLine> UdacityLine() {
+  static std::shared_ptr<const map::ReferenceLine> line = [] {
+    std::shared_ptr<const map::ReferenceLine> l;
+    auto track = map::LoadTrack(FRENETIC_SHARED_DIR "/data/highway_map.csv");
+    if (!track.ok()) return l;
+    auto fit = map::ReferenceLine::Fit(*track);
+    if (fit.ok()) l = *fit;
+    return l;
+  }();
+  return line;
+}
+
+#define REQUIRE_MAP(line)                                                                \
+  auto line = UdacityLine();                                                             \
+  if (line == nullptr) {                                                                 \
+    GTEST_SKIP() << "Udacity map not found at " FRENETIC_SHARED_DIR "/data/highway_map.csv"; \
+  }
+
+PlannerConfig Config() {
+  auto c = PlannerConfig::LoadDefault();
+  EXPECT_TRUE(c.ok()) << c.message();
+  return c.ok() ? *c : PlannerConfig::Defaults();
+}
+
+struct Car {
+  int id;
+  double s, d, v;
+};
+
+// A minimal closed loop: the simulator's control handling (§4.2) and one point per tick.
+class Loop {
+ public:
+  Loop(std::shared_ptr<const map::ReferenceLine> line, Planner* planner, double s0, double d0,
+       double v0, std::uint32_t seed)
+      : line_(std::move(line)), planner_(planner), rng_(seed) {
+    const map::CartesianPose p = line_->ToCartesian(s0, d0);
+    x_ = p.x;
+    y_ = p.y;
+    yaw_ = p.heading;
+    speed_ = v0;
+    driven_x_.push_back(x_);
+    driven_y_.push_back(y_);
+  }
+
+  std::vector<Car> cars;
+  std::vector<double> driven_x_, driven_y_;
+  double min_same_lane_gap = 1e9;  // centre to centre along s, cars ahead in the ego's lane
+  bool collided = false;
+  int fallbacks = 0;
+  PlanStatus last_status = PlanStatus::kOk;
+
+  Telemetry Make() const {
+    Telemetry t;
+    t.x = x_;
+    t.y = y_;
+    t.yaw = yaw_;
+    t.speed = speed_;
+    const map::FrenetPoint f = line_->ToFrenet(x_, y_);
+    t.s = f.s;
+    t.d = f.d;
+    for (size_t i = 0; i < path_x_.size(); ++i) {
+      t.previous_path_x.push_back(static_cast<float>(path_x_[i]));
+      t.previous_path_y.push_back(static_cast<float>(path_y_[i]));
+    }
+    for (const Car& c : cars) {
+      const map::CartesianPose p = line_->ToCartesian(c.s, c.d);
+      t.sensor_fusion.push_back({c.id, p.x, p.y, c.v * std::cos(p.heading),
+                                 c.v * std::sin(p.heading), line_->WrapS(c.s), c.d});
+    }
+    return t;
+  }
+
+  // One exchange: plan, apply with the trimming rule, then advance 1-3 ticks.
+  void Cycle() {
+    const Telemetry t = Make();
+    const PlanResult& r = planner_->Plan(t);
+    last_status = r.status;
+    if (r.status == PlanStatus::kFallbackUsed) ++fallbacks;
+    ASSERT_GE(r.x.size(), static_cast<size_t>(kMinPathPoints));
+    int k = 0;
+    double best = 10000;
+    for (size_t i = 0; i < r.x.size(); ++i) {
+      const double dd = std::hypot(r.x[i] - x_, r.y[i] - y_);
+      if (dd < best) {
+        best = dd;
+        k = static_cast<int>(i);
+      }
+    }
+    const int drop = k > 0 ? k + 1 : (best == 0 ? 1 : 0);
+    path_x_.assign(r.x.begin() + drop, r.x.end());
+    path_y_.assign(r.y.begin() + drop, r.y.end());
+    const int ticks = 1 + static_cast<int>(rng_() % 3);
+    for (int i = 0; i < ticks; ++i) Tick();
+  }
+
+  void Tick() {
+    for (Car& c : cars) c.s += c.v * kTickSeconds;
+    if (path_x_.size() >= 2) {
+      const double nx = path_x_[0], ny = path_y_[0];
+      speed_ = std::hypot(nx - x_, ny - y_) / kTickSeconds;
+      x_ = nx;
+      y_ = ny;
+      yaw_ = std::atan2(path_y_[1] - ny, path_x_[1] - nx);
+    } else {
+      speed_ = 0;
+    }
+    if (!path_x_.empty()) {
+      path_x_.erase(path_x_.begin());
+      path_y_.erase(path_y_.begin());
+    }
+    driven_x_.push_back(x_);
+    driven_y_.push_back(y_);
+    const map::FrenetPoint e = line_->ToFrenet(x_, y_, ego_s_hint_);
+    ego_s_hint_ = e.s;
+    ego_d_.push_back(e.d);
+    for (const Car& c : cars) {
+      const double ds = line_->DiffS(line_->WrapS(c.s), e.s);
+      if (std::abs(c.d - e.d) < 2.0 && ds > 0) min_same_lane_gap = std::min(min_same_lane_gap, ds);
+      if (std::abs(ds) < 4.5 && std::abs(c.d - e.d) < 2.2) collided = true;
+    }
+  }
+
+  double speed() const { return speed_; }
+  double s() const { return ego_s_hint_; }
+  double d() const { return ego_d_.empty() ? 0 : ego_d_.back(); }
+  const std::vector<double>& ego_d() const { return ego_d_; }
+
+ private:
+  std::shared_ptr<const map::ReferenceLine> line_;
+  Planner* planner_;
+  std::mt19937 rng_;
+  double x_, y_, yaw_, speed_;
+  double ego_s_hint_ = 0;
+  std::vector<double> path_x_, path_y_, ego_d_;
+};
+
+std::unique_ptr<Planner> Make(const std::string& name,
+                              std::shared_ptr<const map::ReferenceLine> line) {
+  auto p = MakePlanner(name, Config(), std::move(line));
+  EXPECT_TRUE(p.ok()) << p.message();
+  return p.ok() ? std::move(p.value()) : nullptr;
+}
+
+// Runs the loop for `seconds` of simulated time (cycles are 1-3 ticks).
+void RunFor(Loop& loop, double seconds) {
+  const size_t target = loop.driven_x_.size() + static_cast<size_t>(seconds / kTickSeconds);
+  while (loop.driven_x_.size() < target) {
+    loop.Cycle();
+    if (testing::Test::HasFatalFailure()) return;
+  }
+}
+
+XyMeasure WorstSlidingMeasure(const Loop& loop, int from) {
+  XyChecker checker(static_cast<int>(loop.driven_x_.size()) + 8);
+  return checker.Measure(loop.driven_x_.data(), loop.driven_y_.data(),
+                         static_cast<int>(loop.driven_x_.size()), from);
+}
+
+TEST(PlannerFactoryTest, NamesAndErrors) {
+  EXPECT_EQ(PlannerNames(), (std::vector<std::string>{"search", "baseline"}));
+  EXPECT_STREQ(ToString(PlanStatus::kFallbackUsed), "fallback_used");
+  EXPECT_STREQ(ToString(Reject::kCollision), "collision");
+  auto none = MakePlanner("search", PlannerConfig::Defaults(), nullptr);
+  EXPECT_FALSE(none.ok());
+  REQUIRE_MAP(line);
+  auto bad = MakePlanner("teleport", Config(), line);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("teleport"), std::string::npos);
+}
+
+TEST(SearchPlannerTest, FromStandstillReaches45MphWithinLimitsMeasuredLikeTheSimulator) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  ASSERT_NE(planner, nullptr);
+  Loop loop(line, planner.get(), 124.83, 6.0, 0.0, 1);
+  double reached = -1;
+  int cycles = 0;
+  while (loop.driven_x_.size() < 15 / kTickSeconds + 1) {
+    loop.Cycle();
+    ASSERT_FALSE(HasFatalFailure());
+    ++cycles;
+    if (reached < 0 && loop.speed() >= 45 * kMph) reached = loop.driven_x_.size() * kTickSeconds;
+  }
+  RecordProperty("seconds_to_45mph", std::to_string(reached));
+  EXPECT_GT(reached, 0) << "never reached 45 mph in 15 s";
+  for (int phase = 0; phase < 10; ++phase) {
+    const XyMeasure m = MeasureLikeSimulator(loop.driven_x_, loop.driven_y_, phase);
+    EXPECT_LT(m.max_speed, 50 * kMph) << "phase " << phase;
+    EXPECT_LE(m.max_accel, 9.0) << "phase " << phase;
+    EXPECT_LE(m.max_jerk, 9.0) << "phase " << phase;
+  }
+  EXPECT_EQ(loop.fallbacks, 0);
+  EXPECT_FALSE(loop.collided);
+}
+
+TEST(SearchPlannerTest, ChangesLaneAroundASlowCarWhenTheNeighbourIsFree) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  Loop loop(line, planner.get(), 300, 6.0, 20.0, 2);
+  loop.cars.push_back({0, 345, 6.0, 10.0});  // slow car ahead in the middle lane
+  RunFor(loop, 15.0);
+  EXPECT_FALSE(loop.collided);
+  const double d = loop.d();
+  EXPECT_TRUE(d < 4.0 || d > 8.0) << "still in the middle lane, d = " << d;
+  // Decisive: never more than 3 s astride a lane line.
+  int astride = 0, worst = 0;
+  for (double dd : loop.ego_d()) {
+    astride = ((dd > 3.2 && dd < 4.8) || (dd > 7.2 && dd < 8.8)) ? astride + 1 : 0;
+    worst = std::max(worst, astride);
+  }
+  EXPECT_LT(worst, 150);
+  const XyMeasure m = WorstSlidingMeasure(loop, 60);
+  EXPECT_LT(m.max_speed, 50 * kMph);
+  EXPECT_LT(m.max_accel, 10.0);
+  EXPECT_LT(m.max_jerk, 10.0);
+}
+
+TEST(SearchPlannerTest, FollowsWhenAllLanesAreBlocked) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  Loop loop(line, planner.get(), 1000, 6.0, 18.0, 3);
+  loop.cars.push_back({0, 1040, 2.0, 12.0});
+  loop.cars.push_back({1, 1045, 6.0, 12.0});
+  loop.cars.push_back({2, 1042, 10.0, 12.0});
+  RunFor(loop, 20.0);
+  EXPECT_FALSE(loop.collided);
+  EXPECT_GE(loop.min_same_lane_gap, 10.0);
+  EXPECT_NEAR(loop.speed(), 12.0, 2.0);  // settled behind the wall of cars
+  const XyMeasure m = WorstSlidingMeasure(loop, 60);
+  EXPECT_LT(m.max_accel, 10.0);
+  EXPECT_LT(m.max_jerk, 10.0);
+}
+
+TEST(SearchPlannerTest, BrakesWithinLimitsForACutIn) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  Loop loop(line, planner.get(), 2000, 6.0, 20.0, 4);
+  // Neighbours in both side lanes so that swerving is not the easy way out.
+  loop.cars.push_back({1, 1990, 2.0, 20.0});
+  loop.cars.push_back({2, 1990, 10.0, 20.0});
+  RunFor(loop, 4.0);
+  ASSERT_FALSE(HasFatalFailure());
+  // A car cuts in 15 m ahead, slower.
+  loop.cars.push_back({0, loop.s() + 15.0, 6.0, 14.0});
+  const int from = static_cast<int>(loop.driven_x_.size());
+  RunFor(loop, 8.0);
+  EXPECT_GE(loop.min_same_lane_gap, 6.0);
+  EXPECT_FALSE(loop.collided);
+  EXPECT_LT(loop.speed(), 17.0);  // it slowed down
+  const XyMeasure m = WorstSlidingMeasure(loop, from);
+  EXPECT_LT(m.max_accel, 10.0);
+  EXPECT_LT(m.max_jerk, 10.0);
+}
+
+TEST(SearchPlannerTest, SplicesSmoothlyAtSpeedOnTheWholeLoop) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  // Cross the seam: start 400 m before the end of the loop.
+  Loop loop(line, planner.get(), line->length() - 400, 10.0 - 0.2, 21.0, 5);
+  RunFor(loop, 40.0);
+  const XyMeasure m = WorstSlidingMeasure(loop, 60);
+  EXPECT_LT(m.max_speed, 50 * kMph);
+  EXPECT_LT(m.max_accel, 9.5);
+  EXPECT_LT(m.max_jerk, 9.5);
+  EXPECT_EQ(loop.fallbacks, 0);
+  EXPECT_GT(loop.speed(), 45 * kMph);
+}
+
+TEST(SearchPlannerTest, SummaryIsFilled) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  Loop loop(line, planner.get(), 500, 6.0, 15.0, 6);
+  loop.cars.push_back({0, 540, 6.0, 12.0});
+  RunFor(loop, 1.0);
+  const PlanResult& r = planner->Plan(loop.Make());
+  const PlanSummary& s = r.summary;
+  EXPECT_GE(s.candidates_generated, 300);
+  EXPECT_EQ(s.candidates_scored, s.candidates_generated);
+  EXPECT_GE(s.candidates_checked, 1);
+  EXPECT_EQ(s.candidates_feasible, 1);
+  EXPECT_EQ(s.points_kept, 6);
+  EXPECT_EQ(r.x.size(), 100u);
+  ASSERT_EQ(s.winner_costs.size(), 8u);
+  EXPECT_EQ(s.winner_costs[0].name, "collision");
+  double total = 0;
+  for (const auto& c : s.winner_costs) total += c.weight * c.value;
+  EXPECT_NEAR(total, s.winner_total_cost, 1e-9);
+  EXPECT_LE(s.refine_cost_after, s.refine_cost_before);
+  EXPECT_GT(s.refine_iterations, 0);
+  EXPECT_GT(s.ms_total, 0);
+  RecordProperty("candidates", s.candidates_generated);
+  std::printf("candidates %d checked %d score %.3f ms check %.3f ms refine %.3f ms (%d evals, "
+              "%.4f -> %.4f) total %.3f ms\n",
+              s.candidates_generated, s.candidates_checked, s.ms_score, s.ms_check, s.ms_refine,
+              s.refine_iterations, s.refine_cost_before, s.refine_cost_after, s.ms_total);
+
+  CycleTrace trace;
+  planner->set_trace(&trace, 5);
+  planner->Plan(loop.Make());
+  planner->set_trace(nullptr, 0);
+  ASSERT_FALSE(trace.candidates.empty());
+  EXPECT_LE(trace.candidates.size(), 5u);
+  int winners = 0;
+  for (const auto& c : trace.candidates) winners += c.winner;
+  EXPECT_EQ(winners, 1);
+}
+
+TEST(SearchPlannerTest, NoAllocationAfterWarmUp) {
+  REQUIRE_MAP(line);
+  auto planner = Make("search", line);
+  Loop loop(line, planner.get(), 800, 6.0, 15.0, 7);
+  for (int i = 0; i < 12; ++i) loop.cars.push_back({i, 780.0 + 25 * i, 2.0 + 4 * (i % 3), 15.0});
+  RunFor(loop, 2.0);
+  long total = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Telemetry t = loop.Make();  // built outside the counted region
+    g_allocations = 0;
+    g_count_allocations = true;
+    const PlanResult& r = planner->Plan(t);
+    g_count_allocations = false;
+    total += g_allocations;
+    ASSERT_GE(r.x.size(), 50u);
+    loop.Cycle();
+  }
+  EXPECT_EQ(total, 0);
+}
+
+// Corrupts a plausible telemetry in one of many ways.
+Telemetry Corrupt(Telemetry t, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double wild[] = {nan, inf, -inf, 1e300, -1e300, 0, 1e7, -5};
+  auto pick = [&] { return wild[rng() % 8]; };
+  const int kind = static_cast<int>(rng() % 12);
+  switch (kind) {
+    case 0: t.x = pick(); break;
+    case 1: t.y = pick(); t.yaw = pick(); break;
+    case 2: t.speed = pick(); break;
+    case 3: t.previous_path_x.clear(); t.previous_path_y.clear(); break;
+    case 4: if (!t.previous_path_x.empty()) t.previous_path_x.pop_back(); break;
+    case 5:
+      for (auto& v : t.previous_path_x) v += 50 * (u(rng) - 0.5);
+      break;
+    case 6:
+      if (!t.previous_path_y.empty()) t.previous_path_y[rng() % t.previous_path_y.size()] = pick();
+      break;
+    case 7: t.sensor_fusion.clear(); break;
+    case 8:
+      for (auto& c : t.sensor_fusion) {
+        c.x = u(rng) < 0.3 ? pick() : c.x;
+        c.vx = u(rng) < 0.3 ? pick() : c.vx;
+        c.s = 0;
+        c.d = 0;
+      }
+      break;
+    case 9:
+      for (int i = 0; i < 40; ++i) {
+        t.sensor_fusion.push_back({static_cast<int>(rng() % 5), t.x + 100 * (u(rng) - 0.5),
+                                   t.y + 100 * (u(rng) - 0.5), 60 * u(rng), 60 * u(rng), 0, 0});
+      }
+      break;
+    case 10:
+      t.previous_path_x.assign(rng() % 300, u(rng) * 3000);
+      t.previous_path_y.assign(t.previous_path_x.size(), u(rng) * 3000);
+      break;
+    default:
+      t.x += 200 * (u(rng) - 0.5);
+      t.y += 200 * (u(rng) - 0.5);
+      break;
+  }
+  return t;
+}
+
+class FuzzTest : public testing::TestWithParam<std::string> {};
+
+TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
+  REQUIRE_MAP(line);
+  auto planner = Make(GetParam(), line);
+  ASSERT_NE(planner, nullptr);
+  std::mt19937 rng(2024);
+  Loop loop(line, planner.get(), 3000, 6.0, 18.0, 8);
+  loop.cars.push_back({0, 3040, 6.0, 12.0});
+  loop.cars.push_back({1, 3020, 2.0, 22.0});
+  int invalid = 0;
+  for (int i = 0; i < 10000; ++i) {
+    if (i % 50 == 0) loop.Cycle();  // keep a live state now and then
+    ASSERT_FALSE(HasFatalFailure());
+    const Telemetry t = Corrupt(loop.Make(), rng);
+    const PlanResult* r = nullptr;
+    ASSERT_NO_THROW(r = &planner->Plan(t)) << "case " << i;
+    ASSERT_GE(r->x.size(), static_cast<size_t>(kMinPathPoints)) << "case " << i;
+    ASSERT_EQ(r->x.size(), r->y.size());
+    for (size_t k = 0; k < r->x.size(); ++k) {
+      ASSERT_TRUE(std::isfinite(r->x[k]) && std::isfinite(r->y[k])) << "case " << i;
+    }
+    invalid += r->status == PlanStatus::kInvalidInput;
+  }
+  EXPECT_GT(invalid, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothPlanners, FuzzTest, testing::Values("search", "baseline"));
+
+TEST(BaselinePlannerTest, DrivesAndOvertakesLikeTheWalkthrough) {
+  REQUIRE_MAP(line);
+  auto planner = Make("baseline", line);
+  Loop loop(line, planner.get(), 124.83, 6.0, 0.0, 9);
+  RunFor(loop, 25.0);
+  EXPECT_GT(loop.speed(), 45 * kMph);
+  EXPECT_LT(WorstSlidingMeasure(loop, 0).max_speed, 50 * kMph);
+  loop.cars.push_back({0, loop.s() + 40, 6.0, 12.0});
+  RunFor(loop, 15.0);
+  EXPECT_FALSE(loop.collided);
+  const double d = loop.d();
+  EXPECT_TRUE(d < 4.0 || d > 8.0) << "baseline did not overtake, d = " << d;
+}
+
+TEST(PredictorTest, RepairsGlitchesAndDropsParkedCars) {
+  REQUIRE_MAP(line);
+  PredictorOptions o;
+  auto pred = MakeConstantVelocityPredictor(line, o);
+  const map::CartesianPose a = line->ToCartesian(200, 6);
+  const map::CartesianPose parked = line->ToCartesian(220, -280);
+  std::vector<SensorCar> rows = {
+      {0, a.x, a.y, 17.6 * std::cos(a.heading), 17.6 * std::sin(a.heading), 0, 0},  // s=d=0
+      {1, parked.x, parked.y, 0, 0, 6719, -280}};
+  pred->Observe(rows, 150);
+  ASSERT_EQ(pred->cars().size(), 1u);
+  EXPECT_NEAR(pred->cars()[0].s, 50, 0.1);
+  EXPECT_NEAR(pred->cars()[0].d, 6, 0.05);
+  EXPECT_NEAR(pred->cars()[0].v_s, 17.6, 0.05);
+  // The spawn spike: 2.24x for one message -> the previous speed.
+  rows[0].vx *= 2.237;
+  rows[0].vy *= 2.237;
+  pred->Observe(rows, 150);
+  EXPECT_NEAR(pred->cars()[0].v_s, 17.6, 0.05);
+  double s, d;
+  pred->Predict(0, 2.0, &s, &d);
+  EXPECT_NEAR(s, 50 + 2 * 17.6, 0.2);
+  // A first reading above the cap is the unit slip: m/s written as mph.
+  rows[0].id = 7;
+  pred->Observe(rows, 150);
+  EXPECT_NEAR(pred->cars()[0].v_s, 17.6 * 2.237 / 2.2369, 0.1);
+}
+
+TEST(FeasibilityTest, SlidingCheckBoundsTheSimulatorsMeasureAndSeesKinks) {
+  // From rest at 2 m/s^2 to 22 m/s, then straight on, with a 4 degree kink at tick 800.
+  std::vector<double> x{0}, y{0};
+  double px = 0, py = 0, heading = 0, v = 0;
+  for (int i = 1; i < 1000; ++i) {
+    if (i == 800) heading += 4.0 * M_PI / 180.0;
+    v = std::min(22.0, v + 2.0 * kTickSeconds);
+    px += v * kTickSeconds * std::cos(heading);
+    py += v * kTickSeconds * std::sin(heading);
+    x.push_back(px);
+    y.push_back(py);
+  }
+  XyChecker checker(1000);
+  const XyMeasure sliding = checker.Measure(x.data(), y.data(), 1000, 0);
+  double sim_worst = 0;
+  for (int phase = 0; phase < 10; ++phase) {
+    const XyMeasure sim = MeasureLikeSimulator(x, y, phase);
+    EXPECT_LE(sim.max_accel, sliding.max_accel + 1e-9);
+    sim_worst = std::max(sim_worst, sim.max_accel);
+  }
+  // Blocks whose boundary splits the kink's triple do not see it: some phase does.
+  EXPECT_GT(sim_worst, 9.0);
+  EXPECT_GT(sliding.max_accel, 9.0);  // the kink is an incident
+  EXPECT_NEAR(sliding.max_speed, 22, 1e-9);
+  // Before the kink the path is clean (2 m/s^2; the jerk of switching it off is 2 m/s^3).
+  const XyMeasure clean = checker.Measure(x.data(), y.data(), 790, 0);
+  EXPECT_NEAR(clean.max_accel, 2.0, 1e-6);
+  EXPECT_LT(clean.max_jerk, 2.0 + 1e-6);
+}
+
+}  // namespace
+}  // namespace frenetic::plan

@@ -1,0 +1,123 @@
+#include "frenetic/report/page.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "report/synthetic_record.h"
+
+namespace frenetic::report {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+using json = nlohmann::json;
+
+RunData ReadSynthetic(const testing::SyntheticOptions& options) {
+  std::istringstream in(testing::SyntheticRecord(options));
+  auto run = ReadRecord(in, "run.jsonl");
+  EXPECT_TRUE(run.ok()) << run.message();
+  return std::move(run).value();
+}
+
+int Count(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(PageDataTest, IsValidJsonWithColumnsOfOneLength) {
+  testing::SyntheticOptions options;
+  options.exchanges = 50;
+  options.incident = true;
+  options.incident_at = 20;
+  const RunData run = ReadSynthetic(options);
+  const json data = json::parse(PageDataJson(run, "run.jsonl"));
+  EXPECT_EQ(data["format"], "frenetic-report");
+  EXPECT_EQ(data["version"], 1);
+  EXPECT_EQ(data["n"], 50);
+  for (const auto& [name, column] : data["ex"].items()) {
+    EXPECT_EQ(column.size(), 50u) << name;
+  }
+  EXPECT_EQ(data["path"]["off"].size(), 51u);
+  EXPECT_EQ(data["path"]["x"].size(), data["path"]["off"].back().get<size_t>());
+  EXPECT_EQ(data["traffic"]["id"].size(), data["traffic"]["off"].back().get<size_t>());
+  // Constant weights collapse to one number; values stay per exchange.
+  ASSERT_EQ(data["terms"].size(), 3u);
+  EXPECT_TRUE(data["terms"][0]["weight"].is_number());
+  EXPECT_EQ(data["terms"][0]["value"].size(), 50u);
+  ASSERT_EQ(data["incidents"].size(), 1u);
+  EXPECT_EQ(data["incidents"][0]["e"], 20);
+  EXPECT_EQ(data["incidents"][0]["kind"], "collision");
+  EXPECT_EQ(data["header"]["lanes"], 3);
+  EXPECT_EQ(data["header"]["config"]["weights"]["comfort"], 1.0);
+  EXPECT_EQ(data["footer"]["incidents_total"], 1);
+  // Candidate rows: [lane, end_speed, duration, total, flags, reject, x, y, costs].
+  const json& c0 = data["candidates"][0];
+  EXPECT_EQ(c0["e"], 0);
+  EXPECT_EQ(c0["c"][0].size(), 9u);
+  EXPECT_TRUE(c0["c"][0][5].is_string());  // rejected best candidate of cycle 0
+  EXPECT_EQ(c0["c"][1][4], 3);             // checked and winner
+  EXPECT_EQ(c0["c"][1][8].size(), 9u);     // three terms as (index, weight, value)
+}
+
+TEST(PageDataTest, RoundsNumbersAndWritesNullForMissing) {
+  testing::SyntheticOptions options;
+  options.exchanges = 40;
+  RunData run = ReadSynthetic(options);
+  run.x[0] = 1234.56789;
+  run.gap[0] = std::nan("");
+  run.y[0] = -0.001;
+  const json data = json::parse(PageDataJson(run, "run.jsonl"));
+  EXPECT_DOUBLE_EQ(data["ex"]["x"][0].get<double>(), 1234.57);
+  EXPECT_TRUE(data["ex"]["gap"][0].is_null());
+  EXPECT_EQ(data["ex"]["y"][0].dump(), "0");
+  const std::string text = PageDataJson(run, "run.jsonl");
+  EXPECT_THAT(text, Not(HasSubstr("1234.56789")));
+  EXPECT_THAT(text, Not(HasSubstr("NaN")));
+}
+
+TEST(RenderPageTest, InlinesEverythingAndEscapesTheData) {
+  testing::SyntheticOptions options;
+  options.exchanges = 30;
+  RunData run = ReadSynthetic(options);
+  run.header.config_json = R"({"note":"</script><script>alert(1)</script> <!--"})";
+  const std::string page = RenderPage(run, "run.jsonl");
+  EXPECT_THAT(page, Not(HasSubstr("@FRENETIC_DATA@")));
+  EXPECT_THAT(page, Not(HasSubstr("@FRENETIC_STYLE@")));
+  EXPECT_THAT(page, Not(HasSubstr("@FRENETIC_SCRIPT@")));
+  EXPECT_THAT(page, Not(HasSubstr("alert(1)</script>")));
+  EXPECT_EQ(Count(page, "</script>"), Count(std::string(PageTemplate()), "</script>"));
+  // Self-contained: nothing is fetched when the page opens.
+  EXPECT_THAT(page, Not(HasSubstr("src=\"http")));
+  EXPECT_THAT(page, Not(HasSubstr("href=\"http")));
+  EXPECT_THAT(page, Not(HasSubstr("@import")));
+  // The data block is the JSON of PageDataJson with '<' escaped.
+  const std::string open = "<script id=\"frenetic-data\" type=\"application/json\">";
+  const size_t begin = page.find(open);
+  ASSERT_NE(begin, std::string::npos);
+  const size_t end = page.find("</script>", begin);
+  const json data = json::parse(page.substr(begin + open.size(), end - begin - open.size()));
+  EXPECT_EQ(data["header"]["config"]["note"], "</script><script>alert(1)</script> <!--");
+  EXPECT_EQ(data["n"], 30);
+}
+
+TEST(WriteFileTest, WritesAndNamesAnUnwritablePath) {
+  const std::string path = ::testing::TempDir() + "/frenetic_report_write_test.html";
+  ASSERT_TRUE(WriteFile(path, "abc").ok());
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "abc");
+  std::remove(path.c_str());
+  const Status bad = WriteFile("/nonexistent/dir/out.html", "abc");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(bad.message(), HasSubstr("/nonexistent/dir/out.html"));
+}
+
+}  // namespace
+}  // namespace frenetic::report

@@ -1,0 +1,111 @@
+#include "frenetic/traj/polynomial.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "frenetic/traj/box.h"
+#include "frenetic/traj/frenet.h"
+
+namespace frenetic::traj {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+TEST(PolynomialTest, QuinticMeetsBoundaryConditions) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5.0, 5.0), dur(0.5, 8.0);
+  for (int i = 0; i < 200; ++i) {
+    const double x0 = 10 * u(rng), v0 = u(rng), a0 = u(rng);
+    const double x1 = 10 * u(rng), v1 = u(rng), a1 = u(rng), T = dur(rng);
+    const Polynomial5 p = SolveQuintic(x0, v0, a0, x1, v1, a1, T);
+    // Relative tolerance on the end position: values reach ~100 m.
+    EXPECT_NEAR(p.P(0), x0, kTol);
+    EXPECT_NEAR(p.V(0), v0, kTol);
+    EXPECT_NEAR(p.A(0), a0, kTol);
+    EXPECT_NEAR(p.P(T), x1, kTol * 100);
+    EXPECT_NEAR(p.V(T), v1, kTol * 100);
+    EXPECT_NEAR(p.A(T), a1, kTol * 100);
+  }
+}
+
+TEST(PolynomialTest, QuarticMeetsBoundaryConditions) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-5.0, 5.0), dur(0.5, 8.0);
+  for (int i = 0; i < 200; ++i) {
+    const double x0 = 10 * u(rng), v0 = u(rng), a0 = u(rng), v1 = u(rng), a1 = u(rng);
+    const double T = dur(rng);
+    const Polynomial5 p = SolveQuartic(x0, v0, a0, v1, a1, T);
+    EXPECT_EQ(p.c[5], 0.0);
+    EXPECT_NEAR(p.P(0), x0, kTol);
+    EXPECT_NEAR(p.V(0), v0, kTol);
+    EXPECT_NEAR(p.A(0), a0, kTol);
+    EXPECT_NEAR(p.V(T), v1, kTol * 100);
+    EXPECT_NEAR(p.A(T), a1, kTol * 100);
+  }
+}
+
+TEST(PolynomialTest, DerivativesMatchFiniteDifferences) {
+  const Polynomial5 p = SolveQuintic(1, 2, -1, 40, 10, 0.5, 4.0);
+  const double h = 1e-5;
+  for (double t = 0.1; t < 4.0; t += 0.37) {
+    EXPECT_NEAR(p.V(t), (p.P(t + h) - p.P(t - h)) / (2 * h), 1e-5);
+    EXPECT_NEAR(p.A(t), (p.V(t + h) - p.V(t - h)) / (2 * h), 1e-5);
+    EXPECT_NEAR(p.J(t), (p.A(t + h) - p.A(t - h)) / (2 * h), 1e-5);
+  }
+}
+
+TEST(PolynomialTest, JerkIntegralMatchesQuadrature) {
+  const Polynomial5 p = SolveQuintic(0, 15, 1, 80, 20, 0, 4.5);
+  const int n = 100000;
+  const double T = 4.5, h = T / n;
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const double j = p.J((i + 0.5) * h);
+    sum += j * j * h;
+  }
+  EXPECT_NEAR(p.JerkSquaredIntegral(T), sum, 1e-6 * sum);
+  EXPECT_GT(sum, 0);
+}
+
+TEST(PolynomialTest, VelocityKeepingQuarticIsMonotonicFromRest) {
+  const Polynomial5 p = SolveQuartic(0, 0, 0, 22, 0, 6.0);
+  double last = -1;
+  for (double t = 0; t <= 6.0; t += 0.02) {
+    EXPECT_GE(p.V(t), last);
+    last = p.V(t);
+  }
+}
+
+TEST(PolynomialTest, DegenerateDurationKeepsStartState) {
+  const Polynomial5 p = SolveQuintic(3, 4, 5, 100, 0, 0, 0.0);
+  EXPECT_TRUE(p.IsFinite());
+  EXPECT_DOUBLE_EQ(p.P(0), 3);
+  EXPECT_DOUBLE_EQ(p.V(0), 4);
+}
+
+TEST(TrajectoryTest, ContinuesAtConstantVelocityAfterItsEnd) {
+  Trajectory1d t{SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0};
+  const State1d end = t.At(3.0), later = t.At(5.0);
+  EXPECT_NEAR(later.v, 20, 1e-9);
+  EXPECT_NEAR(later.p, end.p + 2 * 20, 1e-9);
+  EXPECT_EQ(later.a, 0);
+  FrenetTrajectory ft{t, Trajectory1d{SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0}};
+  EXPECT_NEAR(ft.At(2.5).d, 2, 1e-9);
+  EXPECT_TRUE(ft.At(1.0).IsFinite());
+}
+
+TEST(BoxTest, OverlapSeparatingAxis) {
+  const OrientedBox a{0, 0, 0, 2.4, 1.2};
+  EXPECT_TRUE(Overlap(a, OrientedBox{4.7, 0, 0, 2.4, 1.2}));
+  EXPECT_FALSE(Overlap(a, OrientedBox{4.9, 0, 0, 2.4, 1.2}));
+  EXPECT_FALSE(Overlap(a, OrientedBox{0, 2.5, 0, 2.4, 1.2}));
+  // Rotated by 90 degrees: the long side now reaches across.
+  EXPECT_TRUE(Overlap(a, OrientedBox{0, 3.5, 1.5707963267948966, 2.4, 1.2}));
+  // Diagonal corner cases: axis-aligned bounding boxes would overlap, the real ones do not.
+  EXPECT_FALSE(Overlap(OrientedBox{0, 0, 0.785, 2.0, 0.3}, OrientedBox{2.2, -2.2, 0.785, 2.0, 0.3}));
+  EXPECT_FALSE(Overlap(a, OrientedBox{std::nan(""), 0, 0, 1, 1}));
+}
+
+}  // namespace
+}  // namespace frenetic::traj
