@@ -44,3 +44,15 @@ configure_and_build() {
   log "building with $JOBS jobs"
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }
+
+# A separate build with AddressSanitizer + UndefinedBehaviorSanitizer (tests only, no benchmarks).
+configure_and_build_asan() {
+  local dir="$FRENETIC_ROOT/build-asan" generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  if [ ! -f "$dir/CMakeCache.txt" ]; then
+    cmake -S "$FRENETIC_ROOT" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DFRENETIC_SANITIZE=address,undefined -DFRENETIC_BUILD_BENCHMARKS=OFF \
+      -DFRENETIC_SHARED_DIR="${SHARED_DIR:-$FRENETIC_ROOT/../shared}" >/dev/null
+  fi
+  cmake --build "$dir" -j "$JOBS"
+}

@@ -1,20 +1,48 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds frenetic with its tests, and runs every test.
-#   scripts/test.sh [--shared DIR]     DIR holds data/highway_map.csv and realdata/ (default ../shared)
+# Installs what is missing, builds frenetic with its tests, and runs every test:
+#   1. the ctest suite (unit, scenario, network, browser and end-to-end tests);
+#   2. `frenetic fidelity` against the real simulator recordings (when the shared dir has them);
+#   3. the frame-parser fuzzer for FRENETIC_FUZZ_SECONDS (default 60) in a clang build;
+#   4. the ctest suite again under AddressSanitizer + UndefinedBehaviorSanitizer.
+#   scripts/test.sh [--shared DIR] [--quick]
+#     --shared DIR   holds data/highway_map.csv and realdata/telemetry/ (default: ../shared)
+#     --quick        steps 1 and 2 only
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 SHARED_DIR="$FRENETIC_ROOT/../shared"
+QUICK=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --shared) SHARED_DIR="$2"; shift 2 ;;
-    *) echo "usage: scripts/test.sh [--shared DIR]" >&2; exit 2 ;;
+    --quick) QUICK=1; shift ;;
+    *) echo "usage: scripts/test.sh [--shared DIR] [--quick]" >&2; exit 2 ;;
   esac
 done
 SHARED_DIR="$(cd "$SHARED_DIR" 2>/dev/null && pwd || echo "$SHARED_DIR")"
 
-TEST_PACKAGES=(python3 python3-websockets clang libclang-rt-14-dev)
+TEST_PACKAGES=(python3 python3-websockets clang libclang-rt-14-dev nodejs npm chromium)
 ensure_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+bash "$FRENETIC_ROOT/scripts/report-test-deps.sh"
 configure_and_build -DFRENETIC_BUILD_TESTS=ON -DFRENETIC_SHARED_DIR="$SHARED_DIR"
 
-log "running the test suite"
-cd "$BUILD_DIR"
-ctest --output-on-failure -j "$JOBS" --timeout 600
+start=$SECONDS
+log "step 1/4: ctest suite"
+(cd "$BUILD_DIR" && ctest --output-on-failure -j "$JOBS" --timeout 900)
+
+log "step 2/4: fidelity against the real simulator recordings"
+if [ -d "$SHARED_DIR/realdata/telemetry" ] && [ -f "$SHARED_DIR/data/highway_map.csv" ]; then
+  "$BUILD_DIR/frenetic" fidelity --recordings "$SHARED_DIR/realdata/telemetry" \
+    --map "$SHARED_DIR/data/highway_map.csv"
+else
+  log "skipped: no $SHARED_DIR/realdata/telemetry"
+fi
+[ "$QUICK" -eq 1 ] && { log "done in $((SECONDS - start)) s (quick)"; exit 0; }
+
+log "step 3/4: frame-parser fuzzer"
+bash "$FRENETIC_ROOT/scripts/fuzz.sh" "${FRENETIC_FUZZ_SECONDS:-60}"
+
+log "step 4/4: ctest under AddressSanitizer + UndefinedBehaviorSanitizer"
+FRENETIC_BUILD_DIR="$FRENETIC_ROOT/build-asan" configure_and_build_asan
+(cd "$FRENETIC_ROOT/build-asan" &&
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --output-on-failure -j "$JOBS" --timeout 1800 -E "${FRENETIC_ASAN_EXCLUDE:-^$}")
+log "all tests passed in $((SECONDS - start)) s"

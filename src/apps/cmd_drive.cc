@@ -1,16 +1,196 @@
-// Placeholder until the drive command lands.
+// frenetic drive: runs a planner in the headless simulator, faster than real time, and reports
+// what the Udacity simulator would have measured.
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
 #include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
 
 #include "apps/commands.h"
+#include "apps/drive_connect.h"
+#include "frenetic/map/track.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/plan/planner_config.h"
+#include "frenetic/sim/episode.h"
+#include "frenetic/sim/record.h"
+#include "frenetic/sim/scenario.h"
+#include "frenetic/sim/world.h"
 
 namespace frenetic::apps {
+namespace {
+
+struct DriveArgs {
+  std::string map_path;
+  std::string scenario = "udacity";
+  std::int64_t seed = -1;
+  double laps = 0, miles = 0, seconds = 0;
+  std::string planner = "search";
+  std::string config_path;
+  std::string record_path;
+  bool json = false;
+  std::string latency;
+  int episodes = 1;
+  int jobs = 0;
+  bool progress = false;
+  bool no_timing = false;
+  std::string connect;
+  bool realtime = false;
+};
+
+int Fail(const std::string& message) {
+  std::fprintf(stderr, "frenetic drive: %s\n", message.c_str());
+  return 1;
+}
+
+int Drive(const DriveArgs& a) {
+  auto scenario = sim::LoadScenario(a.scenario);
+  if (!scenario.ok()) return Fail(scenario.message());
+  if (!a.latency.empty()) {
+    auto mode = sim::ParseTimingMode(a.latency);
+    if (!mode.ok()) return Fail("--latency: " + mode.message());
+    scenario->timing.mode = *mode;
+  }
+  const std::uint64_t seed = a.seed >= 0 ? static_cast<std::uint64_t>(a.seed) : scenario->seed;
+  sim::EpisodeLimits limits;
+  limits.laps = a.laps;
+  limits.miles = a.miles;
+  limits.seconds = a.seconds;
+  if (a.laps <= 0 && a.miles <= 0 && a.seconds <= 0) limits.laps = 1;
+  if (Status s = limits.Validate(); !s.ok()) return Fail(s.message());
+
+  const std::string map_path = a.map_path.empty() ? map::DefaultTrackPath() : a.map_path;
+  auto world = sim::LoadWorld(map_path);
+  if (!world.ok()) return Fail(world.message());
+
+  if (!a.connect.empty()) {
+    if (a.episodes > 1 || !a.record_path.empty()) {
+      return Fail("--connect drives one episode without --record");
+    }
+    ConnectOptions connect{a.connect, a.realtime};
+    auto report = DriveOverNetwork(*world, *scenario, seed, limits, connect);
+    if (!report.ok()) return Fail(report.message());
+    std::printf("%s", a.json ? (report->ToJson().dump() + "\n").c_str() : report->ToText().c_str());
+    return 0;
+  }
+
+  const std::string config_path =
+      a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
+  auto config = plan::PlannerConfig::Load(config_path);
+  if (!config.ok()) return Fail(config.message());
+  auto shared_config = std::make_shared<const plan::PlannerConfig>(std::move(config).value());
+  std::shared_ptr<const map::ReferenceLine> line = (*world)->line;
+  const std::string planner_name = a.planner;
+  sim::PlannerFactory factory = [planner_name, shared_config, line] {
+    return plan::MakePlanner(planner_name, *shared_config, line);
+  };
+  auto probe = factory();
+  if (!probe.ok()) return Fail("planner \"" + planner_name + "\": " + probe.message());
+
+  const bool tty = isatty(fileno(stderr)) != 0;
+  if (a.episodes > 1) {
+    if (!a.record_path.empty()) return Fail("--record needs a single episode (--episodes 1)");
+    auto agg = sim::RunEpisodes(*world, *scenario, seed, a.episodes, a.jobs, limits, factory,
+                                !a.no_timing);
+    if (!agg.ok()) return Fail(agg.message());
+    if (a.json) {
+      std::printf("%s\n", agg->ToJson().dump().c_str());
+    } else {
+      std::printf("%s", agg->ToText().c_str());
+    }
+    return 0;
+  }
+
+  std::unique_ptr<sim::RecordWriter> record;
+  sim::RunOptions options;
+  options.timing = !a.no_timing;
+  if (!a.record_path.empty()) {
+    auto writer = sim::RecordWriter::Open(a.record_path);
+    if (!writer.ok()) return Fail(writer.message());
+    record = std::move(writer).value();
+    options.record = record.get();
+    std::ifstream in(config_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    options.planner_config = sim::YamlToJson(text.str());
+  }
+  if (a.progress || tty) {
+    options.progress = [](const sim::Episode& ep) {
+      if (ep.exchanges() % 50 != 0 && !ep.done()) return;
+      const sim::Simulator& s = ep.sim();
+      std::fprintf(stderr, "\r%8.1f m  %6.1f s  %5.1f mph  %d incidents   ",
+                   s.monitor().distance(), s.time(), s.ego().speed() * sim::kMpsToMph,
+                   s.monitor().total());
+      if (ep.done()) std::fprintf(stderr, "\n");
+    };
+  }
+  auto report = sim::RunEpisode(*world, *scenario, seed, limits, **probe, options);
+  if (!report.ok()) return Fail(report.message());
+  if (a.json) {
+    std::printf("%s\n", report->ToJson().dump().c_str());
+  } else {
+    std::printf("%s", report->ToText().c_str());
+  }
+  return 0;
+}
+
+}  // namespace
 
 void RegisterDrive(CLI::App& app) {
-  auto* sub = app.add_subcommand("drive", "(not built yet)");
-  sub->callback([] {
-    std::fprintf(stderr, "frenetic drive: not built yet\n");
-    ExitWith(2);
-  });
+  auto args = std::make_shared<DriveArgs>();
+  auto* sub = app.add_subcommand(
+      "drive",
+      "Drive a planner in the headless Udacity-faithful simulator, faster than real time, and "
+      "report distance, speed, incidents (as the simulator counts them) and planning time.\n"
+      "Incidents are results: the exit status is 0 unless the run itself failed (1).");
+  sub->add_option("--map", args->map_path,
+                  "Track file (x y s dx dy per line). Default: the bundled track " +
+                      map::DefaultTrackPath());
+  sub->add_option("--scenario", args->scenario,
+                  "Scenario name (config/scenarios/NAME.yaml) or YAML file. Default: udacity");
+  sub->add_option("--seed", args->seed,
+                  "Random seed of traffic and latency (integer >= 0). Default: the scenario's")
+      ->check(CLI::NonNegativeNumber);
+  auto* laps = sub->add_option("--laps", args->laps, "Length in laps of the track. Default: 1")
+                   ->check(CLI::PositiveNumber);
+  auto* miles = sub->add_option("--miles", args->miles, "Length in miles driven")
+                    ->check(CLI::PositiveNumber);
+  auto* secs = sub->add_option("--seconds", args->seconds, "Length in simulated seconds")
+                   ->check(CLI::PositiveNumber);
+  laps->excludes(miles, secs);
+  miles->excludes(secs);
+  sub->add_option("--planner", args->planner, "Planner: search or baseline. Default: search");
+  sub->add_option("--config", args->config_path,
+                  "Planner configuration YAML. Default: config/planner.yaml");
+  sub->add_option("--record", args->record_path,
+                  "Write one JSON line per exchange to this file (header, exchanges, footer)");
+  sub->add_flag("--json", args->json, "Print the report as one JSON object on stdout");
+  sub->add_option("--latency", args->latency,
+                  "Timing: lockstep (1 tick per exchange), fixed (the scenario's l_old, l_new "
+                  "ticks) or random (its ranges). Default: the scenario's (udacity: lockstep)");
+  sub->add_option("--episodes", args->episodes,
+                  "Run N episodes with seeds seed, seed+1, ... and report the aggregate. "
+                  "Default: 1")
+      ->check(CLI::Range(1, 100000));
+  sub->add_option("--jobs", args->jobs,
+                  "Threads for --episodes (0 = all cores). Results do not depend on it. "
+                  "Default: 0")
+      ->check(CLI::Range(0, 1024));
+  sub->add_flag("--progress", args->progress,
+                "Show the live progress line on stderr even when it is not a terminal");
+  sub->add_flag("--no-timing", args->no_timing,
+                "Report and record planning times as 0, so the same seed gives byte-identical "
+                "records");
+  sub->add_option("--connect", args->connect,
+                  "Play the simulator's side over a WebSocket against a planner server, e.g. "
+                  "ws://127.0.0.1:4567/socket.io/?EIO=4&transport=websocket (planning times are "
+                  "then round-trip times). Default: drive in-process");
+  sub->add_flag("--realtime", args->realtime,
+                "With --connect: pace the exchange at simulated time, 50 ticks per second, as "
+                "the Unity simulator does. Default: as fast as the server answers");
+  sub->callback([args] { ExitWith(Drive(*args)); });
 }
 
 }  // namespace frenetic::apps

@@ -32,6 +32,8 @@ constexpr Default kDefaults[] = {
     {"continuity.keep_points", 6, 1, 40, false},
     {"continuity.output_points", 100, 50, 300, false},
     {"continuity.resync_tolerance", 0.5, 0.01, 5, true},
+    {"continuity.replan_min_ticks", 4, 1, 20, false},
+    {"continuity.replan_deviation", 0.5, 0.05, 5, true},
     {"grid.speeds", 16, 8, 64, false},
     {"grid.durations", 6, 4, 16, false},
     {"grid.min_duration", 1.5, 1, 6, false},

@@ -6,11 +6,15 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
 
 namespace frenetic::net {
+
+// The simulator reports speed as |v| (m/s) times this factor (§3.3).
+inline constexpr double kMpsToMph = 2.23693629;
 
 enum class FrameKind {
   kTelemetry,      // 42["telemetry",{...}] with a usable payload
@@ -20,6 +24,7 @@ enum class FrameKind {
   kIgnored,        // anything that is not a 42 frame and needs no answer
   kMalformed,      // a 42 frame that could not be understood: answer manual, log `error`
 };
+const char* ToString(FrameKind kind);
 
 struct ParsedFrame {
   FrameKind kind = FrameKind::kIgnored;
@@ -28,19 +33,55 @@ struct ParsedFrame {
 };
 
 // Parses one text frame. Never throws; hostile input yields kMalformed with a message.
-// Non-finite numbers are rejected, rows of sensor_fusion that are malformed are dropped with a
-// message (the rest is kept), unequal previous_path arrays are cut to the shorter one.
+// The whole frame is parsed as JSON. The ego fields (x, y, yaw, speed, s, d, end_path_s,
+// end_path_d) must be finite numbers and previous_path_x/y and sensor_fusion must be arrays,
+// else kMalformed naming the field. Within arrays everything good is kept: rows of
+// sensor_fusion that are malformed (not 7 finite numbers, id not an integer) are dropped,
+// previous_path points are cut at the first non-finite or non-number element, and unequal
+// previous_path arrays are cut to the shorter one; `error` then names the first repair (and
+// counts the others) while kind stays kTelemetry. Wire mph/degrees become m/s and radians.
 ParsedFrame ParseFrame(std::string_view frame);
 
 // Appends `42["control",{"next_x":[...],"next_y":[...]}]` to *out (cleared first). Only finite
-// numbers are written; both arrays always have the same length.
-void FormatControl(std::span<const double> x, std::span<const double> y, std::string* out);
+// numbers are written; both arrays always have the same length: min(x.size(), y.size()) points,
+// cut before the first point with a non-finite coordinate. Numbers are written with
+// kControlDigits significant digits (far below the float32 resolution the simulator parses to).
+// Returns the number of points written.
+inline constexpr int kControlDigits = 10;
+std::size_t FormatControl(std::span<const double> x, std::span<const double> y, std::string* out);
 inline constexpr std::string_view kManualFrame = R"(42["manual",{}])";
 
-// The telemetry as the simulator writes it (field names of §3.3, mph, degrees, float32 text),
-// as the JSON object alone and as a whole frame.
+// The telemetry as the simulator writes it (field names and order of §3.3, mph, degrees in
+// [0, 360), numbers as float32 with 7 significant digits like .NET float.ToString(), sensor ids
+// as integers), as the JSON object alone and as a whole frame. Non-finite numbers (which the
+// simulator never sends) are written as 0.
 std::string TelemetryToJson(const plan::Telemetry& telemetry);
 std::string FormatTelemetryFrame(const plan::Telemetry& telemetry);
 inline constexpr std::string_view kNullTelemetryFrame = R"(42["telemetry",null])";
+inline constexpr std::string_view kPingFrame = "2";
+inline constexpr std::string_view kPongFrame = "3";
+
+// What the simulator (the client side) makes of a frame the planner sent.
+enum class ReplyKind {
+  kControl,    // 42["control",{...}] with usable next_x / next_y
+  kManual,     // 42["manual",...]
+  kPong,       // engine.io "3"
+  kIgnored,    // anything else that is not a 42 frame
+  kMalformed,  // a 42 frame the real simulator would choke on (it would stall): see `error`
+};
+const char* ToString(ReplyKind kind);
+
+struct ParsedReply {
+  ReplyKind kind = ReplyKind::kIgnored;
+  std::vector<double> x, y;  // m, map frame (kControl); capacity is kept between calls
+  std::string error;         // one line naming what was wrong (kMalformed)
+};
+
+// Parses a planner's reply into *out (reused to avoid allocation). Stricter than the simulator
+// so planner bugs surface: next_x and next_y must be arrays of equal length whose elements are
+// numbers finite as float32 (the real simulator throws on null or a shorter next_y and then
+// silently stalls; a longer next_y it would tolerate is also reported here). Other fields are
+// ignored, as the simulator reads the two arrays by name. Never throws.
+void ParseReply(std::string_view frame, ParsedReply* out);
 
 }  // namespace frenetic::net

@@ -1,0 +1,333 @@
+// The full planning cycle, Plan(), on recorded scenes (bench/scenes/*.jsonl): per scene, over
+// the whole scene set (p50/p99), swept over the candidate grid size and the number of vehicles,
+// and under a tiny per-cycle deadline. Also main() of frenetic_bench and the malloc counter.
+//
+// What one iteration measures: ONE warm Plan() call. Before it, untimed, the Replay
+// (bench_util.h) rebuilds the message's previous_path from the planner's own last output, so the
+// cycle is in sync (points kept, history for the jerk windows, decision memory), like cycle N of
+// a drive; at the start of each pass over a scene the planner is Reset() and plans the first
+// message cold, also untimed.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench_util.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/plan/planner_config.h"
+
+namespace frenetic::bench {
+
+std::atomic<bool> g_count_allocations{false};
+std::atomic<std::int64_t> g_allocations{0};
+
+}  // namespace frenetic::bench
+
+// Interposing malloc in the executable counts every allocation of the process, including those
+// of shared C libraries (NLopt allocates its work arrays with malloc inside nlopt_optimize), which
+// a replaced operator new or -Wl,--wrap=malloc (static references only) would miss. glibc 2.36
+// exports __libc_malloc & co. to forward to. Left out under sanitizers, which own malloc.
+#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+extern "C" {
+void* __libc_malloc(std::size_t size);
+void* __libc_calloc(std::size_t n, std::size_t size);
+void* __libc_realloc(void* p, std::size_t size);
+
+void* malloc(std::size_t size) noexcept {
+  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
+    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) noexcept {
+  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
+    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) noexcept {
+  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
+    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+  return __libc_realloc(p, size);
+}
+}  // extern "C"
+#endif
+
+namespace frenetic::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Sums over the measured cycles of one benchmark run, turned into counters at the end.
+struct CycleStats {
+  std::vector<double> us;  // wall time of each measured Plan(), microseconds
+  double generated = 0, scored = 0, checked = 0, feasible = 0, seconds = 0;
+  double score_ms = 0, generate_ms = 0, check_ms = 0, refine_ms = 0, output_ms = 0;
+  double best_cost = 0;
+  int found = 0, over_budget = 0, fallback = 0, invalid = 0, synced = 0, reused = 0, cycles = 0;
+  double rejections[static_cast<int>(plan::Reject::kCount)] = {};
+  std::int64_t allocations = 0;
+
+  void Add(const plan::PlanResult& r, double seconds_wall, std::int64_t allocs) {
+    const plan::PlanSummary& s = r.summary;
+    us.push_back(seconds_wall * 1e6);
+    seconds += seconds_wall;
+    generated += s.candidates_generated;
+    scored += s.candidates_scored;
+    checked += s.candidates_checked;
+    feasible += s.candidates_feasible;
+    generate_ms += s.ms_generate;
+    score_ms += s.ms_score;
+    check_ms += s.ms_check;
+    refine_ms += s.ms_refine;
+    output_ms += s.ms_output;
+    if (s.candidates_feasible > 0) {
+      ++found;
+      best_cost += s.winner_total_cost;
+    }
+    over_budget += r.status == plan::PlanStatus::kOverBudget;
+    fallback += r.status == plan::PlanStatus::kFallbackUsed;
+    invalid += r.status == plan::PlanStatus::kInvalidInput;
+    synced += s.points_kept > 0;
+    // A cycle that re-sent the previous plan without searching (continuity.replan_min_ticks).
+    reused += s.candidates_generated == 0 && r.status == plan::PlanStatus::kOk;
+    for (int k = 0; k < static_cast<int>(plan::Reject::kCount); ++k) rejections[k] += s.rejections[k];
+    allocations += allocs;
+    ++cycles;
+  }
+
+  void Report(benchmark::State& state) {
+    if (cycles == 0) return;
+    const double n = cycles;
+    auto& c = state.counters;
+    c["cands"] = generated / n;
+    c["cands_per_s"] = seconds > 0 ? scored / seconds : 0;
+    c["score_ns_per_cand"] = scored > 0 ? score_ms * 1e6 / scored : 0;
+    c["checked"] = checked / n;
+    c["feasible_ratio"] = checked > 0 ? feasible / checked : 0;
+    c["best_cost"] = found > 0 ? best_cost / found : 0;
+    c["gen_us"] = generate_ms * 1e3 / n;
+    c["score_us"] = score_ms * 1e3 / n;
+    c["check_us"] = check_ms * 1e3 / n;
+    c["refine_us"] = refine_ms * 1e3 / n;
+    c["output_us"] = output_ms * 1e3 / n;
+    c["allocs"] = static_cast<double>(allocations) / n;
+    c["over_budget"] = over_budget / n;
+    c["fallback"] = fallback / n;
+    c["synced"] = synced / n;
+    if (invalid > 0) c["invalid"] = invalid / n;
+    if (reused > 0) c["reused"] = reused / n;
+    for (int k = 0; k < static_cast<int>(plan::Reject::kCount); ++k) {
+      if (rejections[k] > 0) {
+        c[std::string("rej_") + plan::ToString(static_cast<plan::Reject>(k))] = rejections[k] / n;
+      }
+    }
+    c["p50_us"] = Percentile(&us, 0.50);
+    c["p99_us"] = Percentile(&us, 0.99);
+    c["max_us"] = us.back();  // sorted by Percentile
+  }
+};
+
+// One scene's planner and replay.
+struct Rig {
+  std::unique_ptr<plan::Planner> planner;
+  std::unique_ptr<Replay> replay;
+  const plan::PlanResult* last = nullptr;
+};
+
+StatusOr<Rig> MakeRig(const Scene& scene, const plan::PlannerConfig& config) {
+  auto line = LineFor(scene.map_path);
+  if (!line.ok()) return line.status();
+  auto planner = plan::MakePlanner("search", config, *line);
+  if (!planner.ok()) return planner.status();
+  Rig rig;
+  rig.planner = std::move(planner).value();
+  rig.replay = std::make_unique<Replay>(rig.planner.get(), &scene);
+  return rig;
+}
+
+// The measured loop over one or more rigs, round robin (one cycle per iteration).
+void RunCycles(benchmark::State& state, std::vector<Rig>& rigs, CycleStats* stats) {
+  stats->us.reserve(1 << 16);
+  // FRENETIC_BENCH_TRACE=1 prints every measured cycle's summary to stderr (diagnosis only).
+  static const bool trace = std::getenv("FRENETIC_BENCH_TRACE") != nullptr;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    Rig& rig = rigs[k];
+    k = (k + 1) % rigs.size();
+    rig.replay->Prepare();
+    g_allocations.store(0, std::memory_order_relaxed);
+    state.ResumeTiming();
+    const auto t0 = Clock::now();
+    g_count_allocations.store(true, std::memory_order_relaxed);
+    const plan::PlanResult& r = rig.replay->Run();
+    g_count_allocations.store(false, std::memory_order_relaxed);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    state.PauseTiming();
+    stats->Add(r, dt, g_allocations.load(std::memory_order_relaxed));
+    if (trace) {
+      const auto& rej = r.summary.rejections;
+      std::fprintf(stderr,
+                   "cycle: %s %.1f us, %d candidates, %d checked (rejected: speed %d accel %d "
+                   "jerk %d off_road %d collision %d), %d kept\n",
+                   plan::ToString(r.status), dt * 1e6, r.summary.candidates_generated,
+                   r.summary.candidates_checked, rej[0], rej[1], rej[2], rej[3], rej[4],
+                   r.summary.points_kept);
+    }
+    rig.replay->Finish(r);
+    state.ResumeTiming();
+  }
+}
+
+// config/planner.yaml with a full search in every cycle: continuity.replan_min_ticks = 1 turns
+// off the re-sending of the previous plan (a cycle that reuses it costs a few microseconds and
+// does not search), so every measured cycle is a search cycle, the case the budget is about.
+// BM_PlanSceneSet/as_configured measures the configuration as it is, reuse included.
+StatusOr<plan::PlannerConfig> DefaultConfig(bool search_every_cycle = true) {
+  auto config = plan::PlannerConfig::LoadDefault();
+  if (config.ok() && search_every_cycle && config->Get("continuity.replan_min_ticks").ok()) {
+    if (Status s = config->Set("continuity.replan_min_ticks", 1); !s.ok()) return s;
+  }
+  return config;
+}
+
+// Plan() on one scene with an optional grid size (state.range(0) nominal candidates, 0 = the
+// default grid), number of vehicles (0 = as recorded) and budget (0 = as configured).
+void PlanScene(benchmark::State& state, const Scene* recorded, int nominal, int vehicles,
+               double budget_ms) {
+  auto config = DefaultConfig();
+  if (!config.ok()) return state.SkipWithError(config.message().c_str());
+  if (nominal > 0) {
+    if (Status s = ApplyShape(ShapeFor(nominal), &*config); !s.ok()) {
+      return state.SkipWithError(s.message().c_str());
+    }
+  }
+  if (budget_ms > 0) {
+    if (Status s = config->Set("budget_ms", budget_ms); !s.ok()) {
+      return state.SkipWithError(s.message().c_str());
+    }
+  }
+  Scene scene = *recorded;
+  if (vehicles > 0) {
+    auto line = LineFor(recorded->map_path);
+    if (!line.ok()) return state.SkipWithError(line.message().c_str());
+    scene = WithVehicles(*recorded, vehicles, **line);
+  }
+  auto rig = MakeRig(scene, *config);
+  if (!rig.ok()) return state.SkipWithError(rig.message().c_str());
+  std::vector<Rig> rigs;
+  rigs.push_back(std::move(rig).value());
+  CycleStats stats;
+  RunCycles(state, rigs, &stats);
+  stats.Report(state);
+  state.counters["vehicles"] = static_cast<double>(scene.messages[0].sensor_fusion.size());
+  if (nominal > 0) state.SetComplexityN(static_cast<std::int64_t>(stats.generated /
+                                                                  std::max(1, stats.cycles)));
+  if (budget_ms > 0) {
+    state.counters["budget_ms"] = budget_ms;
+    // How far past the deadline the cycle ran: mean and worst cycle over the budget.
+    state.counters["mean_over_budget_x"] =
+        stats.cycles > 0 ? stats.seconds * 1e3 / stats.cycles / budget_ms : 0;
+    state.counters["max_over_budget_x"] = stats.us.empty() ? 0 : stats.us.back() / 1e3 / budget_ms;
+  }
+}
+
+const Scene* Find(const std::vector<Scene>& scenes, const std::string& name) {
+  for (const Scene& s : scenes) {
+    if (s.name == name) return &s;
+  }
+  return scenes.empty() ? nullptr : &scenes.front();
+}
+
+}  // namespace
+
+void RegisterPlanBenchmarks(const std::vector<Scene>& scenes) {
+  if (scenes.empty()) return;
+  // 1. Each recorded scene as recorded, default configuration.
+  for (const Scene& scene : scenes) {
+    benchmark::RegisterBenchmark(("BM_Plan/" + scene.name).c_str(),
+                                 [&scene](benchmark::State& st) { PlanScene(st, &scene, 0, 0, 0); })
+        ->Unit(benchmark::kMicrosecond);
+  }
+  // 2. The scene set round robin: p50 / p99 / max over every scene's warm cycles; searching
+  // every cycle, and as configured (plan reuse on: most lockstep cycles then do not search).
+  for (const bool as_configured : {false, true}) {
+  benchmark::RegisterBenchmark(
+      as_configured ? "BM_PlanSceneSet/as_configured" : "BM_PlanSceneSet/search_every_cycle",
+      [&scenes, as_configured](benchmark::State& st) {
+    auto config = DefaultConfig(!as_configured);
+    if (!config.ok()) return st.SkipWithError(config.message().c_str());
+    std::vector<Rig> rigs;
+    for (const Scene& scene : scenes) {
+      auto rig = MakeRig(scene, *config);
+      if (!rig.ok()) return st.SkipWithError(rig.message().c_str());
+      rigs.push_back(std::move(rig).value());
+    }
+    CycleStats stats;
+    RunCycles(st, rigs, &stats);
+    stats.Report(st);
+    st.counters["scenes"] = static_cast<double>(rigs.size());
+  })->Unit(benchmark::kMicrosecond);
+  }
+  // 3. Candidate grid x vehicles on the free-road scene (12 cars recorded, more added).
+  const Scene* free_road = Find(scenes, "free_road");
+  for (int vehicles : {12, 24, 48}) {
+    auto* b = benchmark::RegisterBenchmark(
+        ("BM_PlanGrid/" + free_road->name + "/vehicles:" + std::to_string(vehicles)).c_str(),
+        [free_road, vehicles](benchmark::State& st) {
+          PlanScene(st, free_road, static_cast<int>(st.range(0)), vehicles, 0);
+        });
+    b->ArgName("cands")->Unit(benchmark::kMicrosecond)->Complexity(benchmark::oN);
+    for (int n = 64; n <= 4096; n *= 2) b->Arg(n);
+  }
+  // 4. Default grid, vehicles swept, on the dense scene.
+  const Scene* dense = Find(scenes, "dense_traffic");
+  auto* v = benchmark::RegisterBenchmark(
+      ("BM_PlanVehicles/" + dense->name).c_str(),
+      [dense](benchmark::State& st) { PlanScene(st, dense, 0, static_cast<int>(st.range(0)), 0); });
+  v->ArgName("vehicles")->Unit(benchmark::kMicrosecond)->Arg(12)->Arg(24)->Arg(48);
+  // 5. The deadline: a large grid under budgets from 1 ms (the smallest accepted) up.
+  auto* bud = benchmark::RegisterBenchmark(
+      ("BM_PlanBudget/" + dense->name + "/cands:4096").c_str(),
+      [dense](benchmark::State& st) {
+        PlanScene(st, dense, 4096, 0, static_cast<double>(st.range(0)));
+      });
+  bud->ArgName("budget_ms")->Unit(benchmark::kMicrosecond)->Arg(1)->Arg(2)->Arg(5)->Arg(15);
+}
+
+}  // namespace frenetic::bench
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  std::vector<frenetic::bench::Scene> scenes;
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(frenetic::bench::SceneDir(), ec)) {
+    if (e.path().extension() == ".jsonl") files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    std::fprintf(stderr, "frenetic_bench: no scenes in %s: only the stage benchmarks run\n",
+                 frenetic::bench::SceneDir().c_str());
+  }
+  for (const std::string& f : files) {
+    auto scene = frenetic::bench::LoadScene(f);
+    if (!scene.ok()) {
+      std::fprintf(stderr, "frenetic_bench: %s\n", scene.message().c_str());
+      return 1;
+    }
+    scenes.push_back(std::move(scene).value());
+  }
+  frenetic::bench::RegisterPlanBenchmarks(scenes);
+  frenetic::bench::RegisterStageBenchmarks(scenes);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

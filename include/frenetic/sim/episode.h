@@ -1,0 +1,100 @@
+// One drive: the exchange loop with the latency rules of udacity-sim.md §2, one exchange at a
+// time (telemetry out, path in), so that an in-process planner and a network client run the
+// same loop and get the same outcome; RunEpisode / RunEpisodes drive a plan::Planner through it.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "frenetic/plan/planner.h"
+#include "frenetic/sim/drive_report.h"
+#include "frenetic/sim/simulator.h"
+#include "frenetic/status.h"
+
+namespace frenetic::sim {
+
+// When a drive ends: the first of distance (laps or miles; m driven), simulated time, or a
+// stall (the ego moved less than 1 m in `stall_seconds`). 0 disables a limit; at least one of
+// laps, miles, seconds must be > 0.
+struct EpisodeLimits {
+  double laps = 1;
+  double miles = 0;
+  double seconds = 0;
+  double stall_seconds = 60;
+  Status Validate() const;
+};
+
+class RecordWriter;  // sim/record.h
+
+class Episode {
+ public:
+  Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits);
+
+  // The telemetry to send now (valid until Submit).
+  const plan::Telemetry& telemetry() const { return telemetry_; }
+  // The reply to telemetry(): l_old ticks on the old path, the new path applied, l_new ticks,
+  // new telemetry. A rejected path (non-finite, unequal lengths) is reported and skipped, as
+  // the simulator would ignore it, and the ticks still run.
+  Status Submit(std::span<const double> x, std::span<const double> y);
+
+  bool done() const { return !stop_reason_.empty(); }
+  const std::string& stop_reason() const { return stop_reason_; }  // "distance", "time", "stall"
+  int exchanges() const { return exchanges_; }
+  int last_l_old() const { return last_l_old_; }
+  int last_l_new() const { return last_l_new_; }
+  double target_distance() const { return target_distance_; }  // m, +inf without one
+  Simulator& sim() { return *sim_; }
+  const Simulator& sim() const { return *sim_; }
+
+ private:
+  void CheckDone();
+
+  std::unique_ptr<Simulator> sim_;
+  EpisodeLimits limits_;
+  double target_distance_;
+  std::mt19937_64 latency_rng_;
+  plan::Telemetry telemetry_;
+  std::string stop_reason_;
+  int exchanges_ = 0, last_l_old_ = 0, last_l_new_ = 0;
+  double stall_ref_distance_ = 0, stall_ref_time_ = 0;
+};
+
+// The report of an episode driven so far; `plan_ms` are the per-exchange planning (or round-trip)
+// times and `fallbacks` the exchanges whose plan status was not ok.
+DriveReport MakeReport(const Episode& episode, std::string_view planner,
+                       const std::vector<double>& plan_ms, int fallbacks);
+
+struct RunOptions {
+  RecordWriter* record = nullptr;  // one line per exchange when set
+  bool timing = true;   // false: planning times are recorded and reported as 0 (byte-stable)
+  int trace_candidates = 20;  // candidates per cycle in the record
+  nlohmann::json planner_config;  // written into the record's header (object or text)
+  // Called after every exchange (e.g. a progress line); may be empty.
+  std::function<void(const Episode&)> progress;
+};
+
+// Drives `planner` (Reset first) through one episode. Fails only if the simulator cannot be
+// built or the record cannot be written.
+StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scenario& scenario,
+                                 std::uint64_t seed, const EpisodeLimits& limits,
+                                 plan::Planner& planner, const RunOptions& options);
+
+using PlannerFactory = std::function<StatusOr<std::unique_ptr<plan::Planner>>()>;
+
+// Runs `episodes` episodes with seeds first_seed, first_seed + 1, ... on `jobs` threads (0 =
+// hardware concurrency), each with its own simulator and planner. Results are in seed order and
+// do not depend on `jobs`. Fails with the first failing episode's message.
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
+                                      const Scenario& scenario, std::uint64_t first_seed,
+                                      int episodes, int jobs, const EpisodeLimits& limits,
+                                      const PlannerFactory& factory, bool timing = true);
+
+}  // namespace frenetic::sim

@@ -1,0 +1,30 @@
+// `frenetic drive --connect URL`: the headless simulator plays the Unity simulator's side over a
+// real WebSocket against any Udacity-compatible planner server.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "frenetic/sim/drive_report.h"
+#include "frenetic/sim/episode.h"
+#include "frenetic/sim/scenario.h"
+#include "frenetic/sim/world.h"
+#include "frenetic/status.h"
+
+namespace frenetic::apps {
+
+struct ConnectOptions {
+  std::string url;        // ws://HOST:PORT/PATH
+  bool realtime = false;  // pace frames at simulated time (as the Unity simulator does)
+  double timeout = 10.0;  // s for connecting and for each reply
+};
+
+// Drives one episode over the network. The report's planning times are round-trip times per
+// exchange (telemetry sent to reply received), measured on this side.
+StatusOr<sim::DriveReport> DriveOverNetwork(std::shared_ptr<const sim::World> world,
+                                            const sim::Scenario& scenario, std::uint64_t seed,
+                                            const sim::EpisodeLimits& limits,
+                                            const ConnectOptions& options);
+
+}  // namespace frenetic::apps

@@ -1,0 +1,180 @@
+#include "frenetic/sim/drive_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <spdlog/fmt/fmt.h>
+
+namespace frenetic::sim {
+namespace {
+
+nlohmann::json Finite(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+std::string Maybe(double v, const char* fmt_unit) {
+  return std::isfinite(v) ? fmt::format(fmt::runtime(fmt_unit), v) : std::string("none");
+}
+
+}  // namespace
+
+double DriveReport::per_mile(IncidentKind kind) const {
+  const double mi = miles();
+  return mi > 0 ? incidents_by_kind[static_cast<int>(kind)] / mi : 0;
+}
+
+nlohmann::json DriveReport::ToJson() const {
+  nlohmann::json by_kind = nlohmann::json::object(), per_mile_j = nlohmann::json::object();
+  for (int k = 0; k < kIncidentKinds; ++k) {
+    const auto kind = static_cast<IncidentKind>(k);
+    by_kind[ToString(kind)] = incidents_by_kind[k];
+    per_mile_j[ToString(kind)] = per_mile(kind);
+  }
+  nlohmann::json log = nlohmann::json::array();
+  for (const Incident& i : incident_log) {
+    log.push_back({{"t", i.t}, {"s", i.s}, {"d", i.d}, {"lane", i.lane},
+                   {"kind", ToString(i.kind)}, {"value", i.value}});
+  }
+  return {{"scenario", scenario},
+          {"planner", planner},
+          {"map", map},
+          {"seed", seed},
+          {"stop_reason", stop_reason},
+          {"distance_m", distance_m},
+          {"miles", miles()},
+          {"sim_seconds", sim_seconds},
+          {"exchanges", exchanges},
+          {"avg_speed_mph", avg_speed_mph},
+          {"miles_to_first_incident", miles_to_first_incident},
+          {"best_miles_without_incident", best_miles_without_incident},
+          {"incidents", incidents},
+          {"incidents_by_kind", by_kind},
+          {"incidents_per_mile", per_mile_j},
+          {"max_speed_mph", max_speed_mph},
+          {"max_acc", max_acc},
+          {"max_jerk", max_jerk},
+          {"mean_squared_jerk", mean_squared_jerk},
+          {"lane_changes", lane_changes},
+          {"min_gap_m", Finite(min_gap_m)},
+          {"min_headway_s", Finite(min_headway_s)},
+          {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
+          {"plan_fallbacks", plan_fallbacks},
+          {"incident_log", log}};
+}
+
+std::string DriveReport::ToText() const {
+  std::ostringstream o;
+  o << fmt::format("scenario {}  seed {}  planner {}  map {}\n", scenario, seed, planner, map);
+  o << fmt::format("distance        {:.1f} m ({:.3f} mi) in {:.1f} s simulated, {} exchanges ({})\n",
+                   distance_m, miles(), sim_seconds, exchanges, stop_reason);
+  o << fmt::format("average speed   {:.2f} mph\n", avg_speed_mph);
+  o << fmt::format("first incident  after {:.3f} mi{}; best {:.3f} mi without incident\n",
+                   miles_to_first_incident, incidents == 0 ? " (none)" : "",
+                   best_miles_without_incident);
+  o << "incidents       " << incidents;
+  for (int k = 0; k < kIncidentKinds; ++k) {
+    if (incidents_by_kind[k] > 0) {
+      o << fmt::format("  {} {}", ToString(static_cast<IncidentKind>(k)), incidents_by_kind[k]);
+    }
+  }
+  o << "\n";
+  o << fmt::format("maxima          speed {:.2f} mph, acceleration {:.2f} m/s^2, jerk {:.2f} m/s^3\n",
+                   max_speed_mph, max_acc, max_jerk);
+  o << fmt::format("lane changes    {}\n", lane_changes);
+  o << "closest ahead   gap " << Maybe(min_gap_m, "{:.1f} m") << ", headway "
+    << Maybe(min_headway_s, "{:.2f} s") << "\n";
+  o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
+                   plan_ms_p50, plan_ms_p99, plan_ms_max, plan_fallbacks);
+  for (const Incident& i : incident_log) {
+    o << fmt::format("  t {:8.2f} s  s {:8.1f}  d {:6.2f}  lane {:2d}  {:<12} {:.2f}\n", i.t, i.s,
+                     i.d, i.lane, ToString(i.kind), i.value);
+  }
+  return o.str();
+}
+
+AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
+  AggregateReport a;
+  a.episodes = std::move(episodes);
+  std::array<int, kIncidentKinds> counts{};
+  double sum_speed = 0;
+  for (const DriveReport& r : a.episodes) {
+    a.total_miles += r.miles();
+    a.incidents += r.incidents;
+    for (int k = 0; k < kIncidentKinds; ++k) counts[k] += r.incidents_by_kind[k];
+    sum_speed += r.avg_speed_mph;
+    a.plan_ms_p50 = std::max(a.plan_ms_p50, r.plan_ms_p50);
+    a.plan_ms_p99 = std::max(a.plan_ms_p99, r.plan_ms_p99);
+    a.plan_ms_max = std::max(a.plan_ms_max, r.plan_ms_max);
+  }
+  for (int k = 0; k < kIncidentKinds; ++k) {
+    a.per_100_miles[k] = a.total_miles > 0 ? 100.0 * counts[k] / a.total_miles : 0;
+  }
+  const double n = static_cast<double>(a.episodes.size());
+  if (n > 0) {
+    a.avg_speed_mph = sum_speed / n;
+    double var = 0;
+    for (const DriveReport& r : a.episodes) {
+      var += (r.avg_speed_mph - a.avg_speed_mph) * (r.avg_speed_mph - a.avg_speed_mph);
+    }
+    a.avg_speed_stddev = std::sqrt(var / n);
+  }
+  // Worst: most incidents per mile, then the slowest; ties keep the first seed.
+  double worst_rate = -1, worst_speed = 0;
+  for (std::size_t i = 0; i < a.episodes.size(); ++i) {
+    const DriveReport& r = a.episodes[i];
+    const double rate = r.miles() > 0 ? r.incidents / r.miles()
+                                      : (r.incidents > 0 ? std::numeric_limits<double>::max() : 0);
+    if (rate > worst_rate || (rate == worst_rate && r.avg_speed_mph < worst_speed)) {
+      worst_rate = rate;
+      worst_speed = r.avg_speed_mph;
+      a.worst = static_cast<int>(i);
+    }
+  }
+  return a;
+}
+
+nlohmann::json AggregateReport::ToJson() const {
+  nlohmann::json per100 = nlohmann::json::object();
+  for (int k = 0; k < kIncidentKinds; ++k) {
+    per100[ToString(static_cast<IncidentKind>(k))] = per_100_miles[k];
+  }
+  nlohmann::json eps = nlohmann::json::array();
+  for (const DriveReport& r : episodes) eps.push_back(r.ToJson());
+  return {{"episodes", static_cast<int>(episodes.size())},
+          {"total_miles", total_miles},
+          {"incidents", incidents},
+          {"incidents_per_100_miles", per100},
+          {"avg_speed_mph", avg_speed_mph},
+          {"avg_speed_stddev_mph", avg_speed_stddev},
+          {"worst_episode", worst >= 0 ? nlohmann::json(episodes[worst].seed) : nlohmann::json()},
+          {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
+          {"per_episode", eps}};
+}
+
+std::string AggregateReport::ToText() const {
+  std::ostringstream o;
+  o << fmt::format("episodes        {}  total {:.2f} mi, {} incidents\n", episodes.size(),
+                   total_miles, incidents);
+  o << "per 100 miles  ";
+  for (int k = 0; k < kIncidentKinds; ++k) {
+    o << fmt::format(" {} {:.2f}", ToString(static_cast<IncidentKind>(k)), per_100_miles[k]);
+  }
+  o << "\n";
+  o << fmt::format("average speed   {:.2f} mph (sd {:.2f} over episodes)\n", avg_speed_mph,
+                   avg_speed_stddev);
+  o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms (worst episode)\n",
+                   plan_ms_p50, plan_ms_p99, plan_ms_max);
+  for (const DriveReport& r : episodes) {
+    o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi\n",
+                     r.seed, r.miles(), r.avg_speed_mph, r.incidents, r.miles_to_first_incident);
+  }
+  if (worst >= 0) {
+    o << fmt::format("worst episode   seed {} ({} incidents in {:.3f} mi)\n", episodes[worst].seed,
+                     episodes[worst].incidents, episodes[worst].miles());
+  }
+  return o.str();
+}
+
+}  // namespace frenetic::sim

@@ -1,0 +1,217 @@
+#include "frenetic/sim/episode.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <thread>
+
+#include "frenetic/net/protocol.h"
+#include "frenetic/sim/record.h"
+
+namespace frenetic::sim {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = static_cast<std::size_t>(std::ceil(q * v.size())) - (q > 0 ? 1 : 0);
+  return v[std::min(i, v.size() - 1)];
+}
+
+}  // namespace
+
+DriveReport MakeReport(const Episode& ep, std::string_view planner,
+                       const std::vector<double>& plan_ms, int fallbacks) {
+  const Simulator& sim = ep.sim();
+  const IncidentMonitor& m = sim.monitor();
+  DriveReport r;
+  r.scenario = sim.scenario().name;
+  r.planner = std::string(planner);
+  r.map = sim.world().map_path;
+  r.stop_reason = ep.stop_reason();
+  r.seed = sim.seed();
+  r.distance_m = m.distance();
+  r.sim_seconds = sim.time();
+  r.exchanges = ep.exchanges();
+  r.avg_speed_mph = r.sim_seconds > 0 ? r.distance_m / r.sim_seconds * kMpsToMph : 0;
+  r.miles_to_first_incident = m.distance_to_first_incident() / kMetersPerMile;
+  r.best_miles_without_incident = m.best_miles();
+  r.incidents_by_kind = m.counts();
+  r.incidents = m.total();
+  r.max_speed_mph = m.max_speed() * kMpsToMph;
+  r.max_acc = m.max_acc();
+  r.max_jerk = m.max_abs_jerk();
+  r.mean_squared_jerk = m.jerk_samples() > 0 ? m.sum_sq_jerk() / m.jerk_samples() : 0;
+  r.lane_changes = sim.lane_changes();
+  r.min_gap_m = sim.min_gap();
+  r.min_headway_s = sim.min_headway();
+  r.plan_ms_p50 = Percentile(plan_ms, 0.5);
+  r.plan_ms_p99 = Percentile(plan_ms, 0.99);
+  r.plan_ms_max = plan_ms.empty() ? 0 : *std::max_element(plan_ms.begin(), plan_ms.end());
+  r.plan_fallbacks = fallbacks;
+  r.incident_log = m.log();
+  return r;
+}
+
+Status EpisodeLimits::Validate() const {
+  if (!(laps >= 0) || !(miles >= 0) || !(seconds >= 0) || !(stall_seconds >= 0) ||
+      !std::isfinite(laps + miles + seconds + stall_seconds)) {
+    return Status::Error("drive limits must be finite and >= 0");
+  }
+  if (laps <= 0 && miles <= 0 && seconds <= 0) {
+    return Status::Error("drive limits: one of laps, miles, seconds must be > 0");
+  }
+  return Status::Ok();
+}
+
+Episode::Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits)
+    : sim_(std::move(sim)),
+      limits_(limits),
+      target_distance_(kInf),
+      // A stream of its own, so the latency draws do not shift the traffic's random numbers.
+      latency_rng_(sim_->seed() ^ 0x9E3779B97F4A7C15ULL) {
+  if (limits_.laps > 0) target_distance_ = limits_.laps * sim_->world().track.max_s;
+  if (limits_.miles > 0) target_distance_ = std::min(target_distance_, limits_.miles * kMetersPerMile);
+  telemetry_.previous_path_x.reserve(256);
+  telemetry_.previous_path_y.reserve(256);
+  sim_->GetTelemetry(&telemetry_);
+}
+
+Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
+  const TimingOptions& t = sim_->scenario().timing;
+  int l_old = 0, l_new = 1;
+  auto draw = [&](int lo, int hi) {
+    return lo + static_cast<int>(latency_rng_() % static_cast<std::uint64_t>(hi - lo + 1));
+  };
+  switch (t.mode) {
+    case TimingOptions::Mode::kLockstep: break;
+    case TimingOptions::Mode::kFixed:
+      l_old = t.l_old;
+      l_new = t.l_new;
+      break;
+    case TimingOptions::Mode::kRandom:
+      l_old = draw(t.l_old_min, t.l_old_max);
+      l_new = draw(t.l_new_min, t.l_new_max);
+      break;
+  }
+  last_l_old_ = l_old;
+  last_l_new_ = l_new;
+  sim_->Advance(l_old);
+  Status status = sim_->ApplyPath(x, y);
+  sim_->Advance(l_new);
+  ++exchanges_;
+  CheckDone();
+  sim_->GetTelemetry(&telemetry_);
+  return status;
+}
+
+void Episode::CheckDone() {
+  const double dist = sim_->monitor().distance();
+  const double time = sim_->time();
+  if (dist >= target_distance_) {
+    stop_reason_ = "distance";
+  } else if (limits_.seconds > 0 && time >= limits_.seconds - 1e-9) {
+    stop_reason_ = "time";
+  } else if (dist - stall_ref_distance_ >= 1.0) {
+    stall_ref_distance_ = dist;
+    stall_ref_time_ = time;
+  } else if (limits_.stall_seconds > 0 && time - stall_ref_time_ >= limits_.stall_seconds) {
+    stop_reason_ = "stall";
+  }
+}
+
+StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scenario& scenario,
+                                 std::uint64_t seed, const EpisodeLimits& limits,
+                                 plan::Planner& planner, const RunOptions& options) {
+  if (Status s = limits.Validate(); !s.ok()) return s;
+  auto sim = Simulator::Create(std::move(world), scenario, seed);
+  if (!sim.ok()) return sim.status();
+  Episode ep(std::move(*sim), limits);
+  planner.Reset();
+  plan::CycleTrace trace;
+  RecordWriter* record = options.record;
+  if (record != nullptr) {
+    record->set_timing(options.timing);
+    planner.set_trace(&trace, options.trace_candidates);
+    record->WriteHeader(ep.sim(), std::string(planner.name()), options.planner_config);
+  }
+  std::vector<double> plan_ms;
+  plan_ms.reserve(20000);
+  int fallbacks = 0, bad_paths = 0;
+  std::string telemetry_json;
+  while (!ep.done()) {
+    const double t_sent = ep.sim().time();
+    if (record != nullptr) telemetry_json = net::TelemetryToJson(ep.telemetry());
+    trace.candidates.clear();
+    const auto t0 = std::chrono::steady_clock::now();
+    const plan::PlanResult& result = planner.Plan(ep.telemetry());
+    const double ms =
+        options.timing
+            ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count()
+            : 0.0;
+    plan_ms.push_back(ms);
+    if (result.status != plan::PlanStatus::kOk) ++fallbacks;
+    const std::size_t first_incident = ep.sim().monitor().log().size();
+    const int index = ep.exchanges();
+    if (Status s = ep.Submit(result.x, result.y); !s.ok() && bad_paths++ == 0) {
+      spdlog::warn("{} (the simulator ignores such a path)", s.message());
+    }
+    if (record != nullptr) {
+      record->WriteExchange(index, t_sent, telemetry_json, result, &trace, ms, ep.sim(),
+                            first_incident, ep.last_l_old(), ep.last_l_new());
+    }
+    if (options.progress) options.progress(ep);
+  }
+  if (record != nullptr) planner.set_trace(nullptr, 0);
+  DriveReport report = MakeReport(ep, planner.name(), plan_ms, fallbacks);
+  if (record != nullptr) {
+    record->WriteFooter(report);
+    if (Status s = record->status(); !s.ok()) return s;
+  }
+  return report;
+}
+
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
+                                      const Scenario& scenario, std::uint64_t first_seed,
+                                      int episodes, int jobs, const EpisodeLimits& limits,
+                                      const PlannerFactory& factory, bool timing) {
+  if (episodes < 1) return Status::Error("episodes must be >= 1");
+  if (Status s = limits.Validate(); !s.ok()) return s;
+  if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  jobs = std::min(jobs, episodes);
+  std::vector<std::optional<StatusOr<DriveReport>>> results(episodes);
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int i = next++; i < episodes; i = next++) {
+      auto planner = factory();
+      if (!planner.ok()) {
+        results[i] = planner.status();
+        continue;
+      }
+      RunOptions options;
+      options.timing = timing;
+      results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, options);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  std::vector<DriveReport> reports;
+  reports.reserve(episodes);
+  for (auto& r : results) {
+    if (!r->ok()) return r->status();
+    reports.push_back(std::move(r->value()));
+  }
+  return AggregateReport::From(std::move(reports));
+}
+
+}  // namespace frenetic::sim

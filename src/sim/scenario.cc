@@ -1,0 +1,417 @@
+#include "frenetic/sim/scenario.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace frenetic::sim {
+namespace {
+
+// Reads the keys of one YAML map, remembering which were asked for, so that the rest can be
+// reported as unknown. yaml-cpp throws on bad conversions; they are caught here, at the edge,
+// and turned into a message that names the file and the key.
+class MapReader {
+ public:
+  MapReader(const YAML::Node& node, std::string prefix, std::string source, Status* status)
+      : node_(node), prefix_(std::move(prefix)), source_(std::move(source)), status_(status) {
+    if (node_ && !node_.IsNull() && !node_.IsMap()) {
+      Fail(prefix_.empty() ? "the document" : prefix_.substr(0, prefix_.size() - 1),
+           "must be a map");
+    }
+  }
+
+  template <typename T>
+  void Read(const char* key, T* out) {
+    known_.insert(key);
+    if (!status_->ok() || !node_ || !node_.IsMap()) return;
+    const YAML::Node v = node_[key];
+    if (!v) return;
+    try {
+      if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
+      *out = v.as<T>();
+      if constexpr (std::is_floating_point_v<T>) {
+        if (!std::isfinite(*out)) throw YAML::Exception(YAML::Mark(), "not finite");
+      }
+    } catch (const YAML::Exception&) {
+      Fail(prefix_ + key, std::string("is not a valid ") + TypeName<T>());
+    }
+  }
+
+  // A [lo, hi] pair of numbers.
+  void ReadRange(const char* key, double* lo, double* hi) {
+    known_.insert(key);
+    if (!status_->ok() || !node_ || !node_.IsMap()) return;
+    const YAML::Node v = node_[key];
+    if (!v) return;
+    try {
+      if (!v.IsSequence() || v.size() != 2) throw YAML::Exception(YAML::Mark(), "pair");
+      double a = v[0].as<double>(), b = v[1].as<double>();
+      if (!std::isfinite(a) || !std::isfinite(b)) throw YAML::Exception(YAML::Mark(), "finite");
+      *lo = a;
+      *hi = b;
+    } catch (const YAML::Exception&) {
+      Fail(prefix_ + key, "must be a pair of numbers [min, max]");
+    }
+  }
+  void ReadRange(const char* key, int* lo, int* hi) {
+    double a = *lo, b = *hi;
+    ReadRange(key, &a, &b);
+    if (status_->ok() && (a != std::floor(a) || b != std::floor(b))) {
+      Fail(prefix_ + key, "must be a pair of integers [min, max]");
+    }
+    *lo = static_cast<int>(a);
+    *hi = static_cast<int>(b);
+  }
+
+  MapReader Sub(const char* key) {
+    known_.insert(key);
+    YAML::Node child;
+    if (node_ && node_.IsMap()) child = node_[key];
+    return MapReader(child, prefix_ + key + ".", source_, status_);
+  }
+  void MarkKnown(const char* key) { known_.insert(key); }
+  bool Has(const char* key) const { return node_ && node_.IsMap() && node_[key]; }
+  const YAML::Node& node() const { return node_; }
+
+  // Reports the first key that was not asked for.
+  void Finish() {
+    if (!status_->ok() || !node_ || !node_.IsMap()) return;
+    for (const auto& kv : node_) {
+      std::string key;
+      try {
+        key = kv.first.as<std::string>();
+      } catch (const YAML::Exception&) {
+        key = "?";
+      }
+      if (!known_.count(key)) {
+        *status_ = Status::Error(source_ + ": unknown key '" + prefix_ + key + "'");
+        return;
+      }
+    }
+  }
+  void Fail(const std::string& key, const std::string& what) {
+    if (status_->ok()) *status_ = Status::Error(source_ + ": '" + key + "' " + what);
+  }
+
+ private:
+  template <typename T>
+  static const char* TypeName() {
+    if constexpr (std::is_same_v<T, bool>) return "boolean";
+    if constexpr (std::is_integral_v<T>) return "integer";
+    if constexpr (std::is_floating_point_v<T>) return "number";
+    return "string";
+  }
+
+  YAML::Node node_;
+  std::string prefix_, source_;
+  Status* status_;
+  std::set<std::string> known_;
+};
+
+Status Check(bool ok, const std::string& what) {
+  return ok ? Status::Ok() : Status::Error(what);
+}
+
+}  // namespace
+
+const char* ToString(TimingOptions::Mode mode) {
+  switch (mode) {
+    case TimingOptions::Mode::kLockstep: return "lockstep";
+    case TimingOptions::Mode::kFixed: return "fixed";
+    case TimingOptions::Mode::kRandom: return "random";
+  }
+  return "?";
+}
+
+StatusOr<TimingOptions::Mode> ParseTimingMode(std::string_view text) {
+  if (text == "lockstep") return TimingOptions::Mode::kLockstep;
+  if (text == "fixed") return TimingOptions::Mode::kFixed;
+  if (text == "random") return TimingOptions::Mode::kRandom;
+  return Status::Error("unknown timing mode '" + std::string(text) +
+                       "' (expected lockstep, fixed or random)");
+}
+
+Status TimingOptions::Validate() const {
+  if (l_old < 0 || l_old > 50) return Status::Error("timing.l_old must be in [0, 50]");
+  if (l_new < 1 || l_new > 50) return Status::Error("timing.l_new must be in [1, 50]");
+  if (l_old_min < 0 || l_old_max < l_old_min || l_old_max > 50)
+    return Status::Error("timing.l_old_range must satisfy 0 <= min <= max <= 50");
+  if (l_new_min < 1 || l_new_max < l_new_min || l_new_max > 50)
+    return Status::Error("timing.l_new_range must satisfy 1 <= min <= max <= 50");
+  return Status::Ok();
+}
+
+Status TrafficOptions::Validate() const {
+  Status s;
+  auto check = [&](bool ok, const char* what) {
+    if (s.ok() && !ok) s = Status::Error(std::string("traffic.") + what);
+  };
+  check(cars >= 0 && cars <= 200, "cars must be in [0, 200]");
+  check(respawn_distance > 0, "respawn_distance must be > 0");
+  check(batch_min >= 1 && batch_max >= batch_min, "batch must satisfy 1 <= min <= max");
+  check(period_min_frames >= 1 && period_max_frames >= period_min_frames,
+        "period_frames must satisfy 1 <= min <= max");
+  check(frame_ticks >= 1, "frame_ticks must be >= 1");
+  check(spawn_retries >= 1, "spawn_retries must be >= 1");
+  check(spawn_clearance >= 0, "spawn_clearance must be >= 0");
+  check(behind_offset_min <= behind_offset_max, "behind_offsets must satisfy min <= max");
+  check(ahead_offset_min <= ahead_offset_max, "ahead_offsets must satisfy min <= max");
+  check(behind_speed_min_mph > 0 && behind_speed_max_mph >= behind_speed_min_mph,
+        "behind_speed_mph must satisfy 0 < min <= max");
+  check(ahead_speed_min_mph > 0 && ahead_speed_max_mph >= ahead_speed_min_mph,
+        "ahead_speed_mph must satisfy 0 < min <= max");
+  check(max_accel > 0, "max_accel must be > 0");
+  check(throttle_gain > 0, "throttle_gain must be > 0");
+  check(drag >= 0, "drag must be >= 0");
+  check(brake_decel > 0, "brake_decel must be > 0");
+  check(brake_gap_min >= 0 && brake_gap_max >= brake_gap_min,
+        "brake_gap must satisfy 0 <= min <= max");
+  check(follow_lateral > 0, "follow_lateral must be > 0");
+  check(wander_min >= 0 && wander_max >= wander_min && wander_max <= 2,
+        "wander must satisfy 0 <= min <= max <= 2");
+  check(wander_period_min > 0 && wander_period_max >= wander_period_min,
+        "wander_period must satisfy 0 < min <= max");
+  check(throttle_wander >= 0 && throttle_wander < 1, "throttle_wander must be in [0, 1)");
+  check(lane_change_gap >= 0, "lane_change_gap must be >= 0");
+  check(lane_change_ego_band >= 0, "lane_change_ego_band must be >= 0");
+  check(lane_change_spacing_ticks >= 0, "lane_change_spacing_ticks must be >= 0");
+  check(lane_change_evaluations >= 0, "lane_change_evaluations must be >= 0");
+  check(lane_change_duration > 0, "lane_change_duration must be > 0");
+  check(waypoint_window > 0, "waypoint_window must be > 0");
+  check(seam_glitch_window >= 0, "seam_glitch_window must be >= 0");
+  check(cut_in_rate >= 0, "cut_in.rate must be >= 0");
+  check(cut_in_min_gap >= 0 && cut_in_max_gap >= cut_in_min_gap,
+        "cut_in.gap must satisfy 0 <= min <= max");
+  check(cut_in_duration > 0, "cut_in.duration must be > 0");
+  check(hard_brake_rate >= 0, "hard_brake.rate must be >= 0");
+  check(hard_brake_decel > 0, "hard_brake.decel must be > 0");
+  check(hard_brake_duration > 0, "hard_brake.duration must be > 0");
+  check(hard_brake_max_distance > 0, "hard_brake.max_distance must be > 0");
+  check(event_cooldown >= 0, "event_cooldown must be >= 0");
+  check(blockade_distance > 0, "blockade.distance must be > 0");
+  check(blockade_speed >= 0, "blockade.speed must be >= 0");
+  check(blockade_seconds >= 0, "blockade.seconds must be >= 0");
+  check(!blockade || cars >= 3, "blockade needs at least 3 cars");
+  return s;
+}
+
+Status IncidentOptions::Validate() const {
+  if (!(speed_limit_mph > 0)) return Status::Error("incidents.speed_limit_mph must be > 0");
+  if (!(acc_limit > 0)) return Status::Error("incidents.acc_limit must be > 0");
+  if (!(jerk_limit > 0)) return Status::Error("incidents.jerk_limit must be > 0");
+  if (lane_line_ticks < 0) return Status::Error("incidents.lane_line_ticks must be >= 0");
+  if (display_hold_frames < 0) return Status::Error("incidents.display_hold_frames must be >= 0");
+  if (merge_ticks < 0) return Status::Error("incidents.merge_ticks must be >= 0");
+  return Status::Ok();
+}
+
+Status Scenario::Validate() const {
+  const std::string where = source.empty() ? name : source;
+  auto wrap = [&](Status s) {
+    return s.ok() ? s : Status::Error(where + ": " + s.message());
+  };
+  if (Status s = Check(car_length > 0 && car_width > 0 && car_length < 50 && car_width < 20,
+                       "car length and width must be in (0, 50) and (0, 20) m");
+      !s.ok())
+    return wrap(s);
+  if (Status s = timing.Validate(); !s.ok()) return wrap(s);
+  if (Status s = traffic.Validate(); !s.ok()) return wrap(s);
+  if (Status s = incidents.Validate(); !s.ok()) return wrap(s);
+  return Status::Ok();
+}
+
+StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view source_view) {
+  const std::string source(source_view);
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::Exception& e) {
+    return Status::Error(source + ": YAML error at line " + std::to_string(e.mark.line + 1) +
+                         ": " + e.msg);
+  }
+  Scenario sc;
+  sc.source = source;
+  Status st;
+  MapReader r(root, "", source, &st);
+  r.Read("name", &sc.name);
+  r.Read("description", &sc.description);
+  r.Read("seed", &sc.seed);
+
+  {
+    MapReader car = r.Sub("car");
+    car.Read("length", &sc.car_length);
+    car.Read("width", &sc.car_width);
+    car.Finish();
+  }
+  if (r.Has("start")) {
+    const YAML::Node node = root["start"];
+    if (node.IsScalar()) {
+      r.MarkKnown("start");
+      std::string v = node.as<std::string>();
+      if (v != "auto") r.Fail("start", "must be 'auto' or a map with x, y or s, lane/d");
+    } else {
+      MapReader start = r.Sub("start");
+      StartPose& p = sc.start;
+      bool has_xy = start.Has("x") || start.Has("y");
+      bool has_s = start.Has("s");
+      if (has_xy && has_s) start.Fail("start", "has both x/y and s");
+      if (has_xy) {
+        if (!start.Has("x") || !start.Has("y")) start.Fail("start", "needs both x and y");
+        p.kind = StartPose::Kind::kXY;
+      } else if (has_s) {
+        p.kind = StartPose::Kind::kFrenet;
+      }
+      start.Read("x", &p.x);
+      start.Read("y", &p.y);
+      start.Read("yaw", &p.yaw_deg);
+      start.Read("s", &p.s);
+      start.Read("d", &p.d);
+      if (start.Has("lane")) {
+        int lane = 1;
+        start.Read("lane", &lane);
+        if (st.ok() && (lane < 0 || lane > 2)) start.Fail("start.lane", "must be 0, 1 or 2");
+        if (start.Has("d")) start.Fail("start", "has both lane and d");
+        p.d = 2 + 4 * lane;
+      } else {
+        int unused = 0;
+        start.Read("lane", &unused);
+      }
+      start.Finish();
+    }
+  } else {
+    r.Sub("start");
+  }
+  {
+    MapReader t = r.Sub("timing");
+    std::string mode = ToString(sc.timing.mode);
+    t.Read("mode", &mode);
+    if (st.ok()) {
+      auto m = ParseTimingMode(mode);
+      if (!m.ok()) t.Fail("timing.mode", "'" + mode + "' is not lockstep, fixed or random");
+      else sc.timing.mode = *m;
+    }
+    t.Read("l_old", &sc.timing.l_old);
+    t.Read("l_new", &sc.timing.l_new);
+    t.ReadRange("l_old_range", &sc.timing.l_old_min, &sc.timing.l_old_max);
+    t.ReadRange("l_new_range", &sc.timing.l_new_min, &sc.timing.l_new_max);
+    t.Finish();
+  }
+  {
+    TrafficOptions& o = sc.traffic;
+    MapReader t = r.Sub("traffic");
+    t.Read("cars", &o.cars);
+    t.Read("respawn_distance", &o.respawn_distance);
+    t.ReadRange("batch", &o.batch_min, &o.batch_max);
+    t.ReadRange("period_frames", &o.period_min_frames, &o.period_max_frames);
+    t.Read("frame_ticks", &o.frame_ticks);
+    t.Read("spawn_retries", &o.spawn_retries);
+    t.Read("spawn_clearance", &o.spawn_clearance);
+    t.ReadRange("behind_offsets", &o.behind_offset_min, &o.behind_offset_max);
+    t.ReadRange("ahead_offsets", &o.ahead_offset_min, &o.ahead_offset_max);
+    t.ReadRange("behind_speed_mph", &o.behind_speed_min_mph, &o.behind_speed_max_mph);
+    t.ReadRange("ahead_speed_mph", &o.ahead_speed_min_mph, &o.ahead_speed_max_mph);
+    t.Read("max_accel", &o.max_accel);
+    t.Read("throttle_gain", &o.throttle_gain);
+    t.Read("drag", &o.drag);
+    t.Read("brake_decel", &o.brake_decel);
+    t.ReadRange("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
+    t.Read("follow_lateral", &o.follow_lateral);
+    t.ReadRange("wander", &o.wander_min, &o.wander_max);
+    t.ReadRange("wander_period", &o.wander_period_min, &o.wander_period_max);
+    t.Read("throttle_wander", &o.throttle_wander);
+    t.Read("lane_changes", &o.lane_changes);
+    t.Read("lane_change_gap", &o.lane_change_gap);
+    t.Read("lane_change_ego_band", &o.lane_change_ego_band);
+    t.Read("lane_change_min_mph", &o.lane_change_min_mph);
+    t.Read("lane_change_spacing_ticks", &o.lane_change_spacing_ticks);
+    t.Read("lane_change_evaluations", &o.lane_change_evaluations);
+    t.Read("lane_change_duration", &o.lane_change_duration);
+    t.Read("waypoint_window", &o.waypoint_window);
+    t.Read("spawn_speed_quirk", &o.spawn_speed_quirk);
+    t.Read("seam_glitch", &o.seam_glitch);
+    t.Read("seam_glitch_window", &o.seam_glitch_window);
+    t.Read("event_cooldown", &o.event_cooldown);
+    {
+      MapReader c = t.Sub("cut_in");
+      c.Read("rate", &o.cut_in_rate);
+      c.ReadRange("gap", &o.cut_in_min_gap, &o.cut_in_max_gap);
+      c.Read("duration", &o.cut_in_duration);
+      c.Finish();
+    }
+    {
+      MapReader h = t.Sub("hard_brake");
+      h.Read("rate", &o.hard_brake_rate);
+      h.Read("decel", &o.hard_brake_decel);
+      h.Read("duration", &o.hard_brake_duration);
+      h.Read("max_distance", &o.hard_brake_max_distance);
+      h.Finish();
+    }
+    {
+      MapReader b = t.Sub("blockade");
+      b.Read("enabled", &o.blockade);
+      b.Read("distance", &o.blockade_distance);
+      b.Read("speed", &o.blockade_speed);
+      b.Read("seconds", &o.blockade_seconds);
+      b.Finish();
+    }
+    t.Finish();
+  }
+  {
+    IncidentOptions& o = sc.incidents;
+    MapReader i = r.Sub("incidents");
+    i.Read("speed_limit_mph", &o.speed_limit_mph);
+    i.Read("acc_limit", &o.acc_limit);
+    i.Read("jerk_limit", &o.jerk_limit);
+    i.Read("lane_line_ticks", &o.lane_line_ticks);
+    i.Read("display_hold_frames", &o.display_hold_frames);
+    i.Read("merge_ticks", &o.merge_ticks);
+    i.Finish();
+  }
+  r.Finish();
+  if (!st.ok()) return st;
+  if (!r.Has("name")) sc.name = std::filesystem::path(source).stem().string();
+  if (Status s = sc.Validate(); !s.ok()) return s;
+  return sc;
+}
+
+std::string ScenarioDir() { return std::string(FRENETIC_SOURCE_DIR) + "/config/scenarios"; }
+
+std::vector<std::string> ScenarioNames() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(ScenarioDir(), ec)) {
+    if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+StatusOr<Scenario> LoadScenario(const std::string& name_or_path) {
+  const bool is_name =
+      !name_or_path.empty() &&
+      std::all_of(name_or_path.begin(), name_or_path.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+      });
+  const std::string path = is_name ? ScenarioDir() + "/" + name_or_path + ".yaml" : name_or_path;
+  std::ifstream in(path);
+  if (!in) {
+    if (is_name) {
+      std::string known;
+      for (const auto& n : ScenarioNames()) known += (known.empty() ? "" : ", ") + n;
+      return Status::Error("unknown scenario '" + name_or_path + "' (known: " + known + ")");
+    }
+    return Status::Error(path + ": cannot open scenario file");
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  auto sc = ParseScenario(ss.str(), path);
+  if (sc.ok() && is_name && sc->name.empty()) sc->name = name_or_path;
+  return sc;
+}
+
+}  // namespace frenetic::sim

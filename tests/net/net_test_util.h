@@ -1,0 +1,190 @@
+// Shared by the net tests: the real first telemetry message, a fake planner and a small Beast
+// WebSocket client whose every step has a timeout (so a broken server fails a test, not hangs it).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "frenetic/net/server.h"
+#include "frenetic/plan/planner.h"
+
+namespace frenetic::net::testing {
+
+// The simulator's first message after "Select" (udacity-sim.md §3.3, §4.3): field order, number
+// text and the just-spawned car 0 as logged; the parked cars 1–11 as in the real recording.
+inline constexpr std::string_view kFirstTelemetryJson =
+    R"({"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,"d":6.164833,)"
+    R"("previous_path_x":[],"previous_path_y":[],"end_path_s":0,"end_path_d":0,)"
+    R"("sensor_fusion":[[0,1056.788,1164.296,37.39919,15.43803,275.7777,5.999895],)"
+    R"([1,775.8,1425.2,0,0,6719.219,-280.1494],[2,775.8,1429,0,0,6716.599,-282.9019],)"
+    R"([3,775.8,1432.9,0,0,6713.911,-285.7268],[4,775.8,1436.3,0,0,6711.566,-288.1896],)"
+    R"([5,775.8,1441.7,0,0,6661.772,-291.7797],[6,762.1,1421.6,0,0,6711.778,-268.0965],)"
+    R"([7,762.1,1425.2,0,0,6709.296,-270.7039],[8,762.1,1429,0,0,6663.543,-273.1828],)"
+    R"([9,762.1,1432.9,0,0,6660.444,-275.5511],[10,762.1,1436.3,0,0,6657.743,-277.6157],)"
+    R"([11,762.1,1441.7,0,0,6653.453,-280.8947]]})";
+
+inline std::string FirstTelemetryFrame() {
+  return "42[\"telemetry\"," + std::string(kFirstTelemetryJson) + "]";
+}
+
+// A telemetry frame with the ego at (x, y) and a short previous path.
+inline std::string TelemetryFrameAt(double x, double y) {
+  return "42[\"telemetry\",{\"x\":" + std::to_string(x) + ",\"y\":" + std::to_string(y) +
+         R"(,"yaw":0,"speed":10,"s":1,"d":6,"previous_path_x":[1,2],"previous_path_y":[3,4],)"
+         R"("end_path_s":0,"end_path_d":0,"sensor_fusion":[[0,1,2,3,4,5,6]]})"
+         "]";
+}
+
+// Deterministic planner: point i is (x + i, y + cycles), where cycles counts this instance's
+// Plan() calls from 1, so a reply tells both whose telemetry and which planner produced it.
+class FakePlanner : public plan::Planner {
+ public:
+  enum class Mode { kGood, kNaN, kUnequal, kShort };
+  explicit FakePlanner(Mode mode = Mode::kGood) : mode_(mode) {}
+
+  const plan::PlanResult& Plan(const plan::Telemetry& t) override {
+    ++cycles_;
+    last_ = t;
+    result_.x.clear();
+    result_.y.clear();
+    const int n = mode_ == Mode::kShort ? 3 : plan::kMinPathPoints;
+    for (int i = 0; i < n; ++i) {
+      result_.x.push_back(t.x + i);
+      result_.y.push_back(t.y + cycles_);
+    }
+    if (mode_ == Mode::kNaN) result_.x[10] = std::nan("");
+    if (mode_ == Mode::kUnequal) result_.y.resize(20);
+    result_.status = plan::PlanStatus::kOk;
+    return result_;
+  }
+  void Reset() override { cycles_ = 0; }
+  std::string_view name() const override { return "fake"; }
+
+  int cycles_ = 0;
+  plan::Telemetry last_;
+
+ private:
+  Mode mode_;
+  plan::PlanResult result_;
+};
+
+// A server on 127.0.0.1, ephemeral port, running on its own thread until destruction.
+class TestServer {
+ public:
+  explicit TestServer(ServerOptions options = {},
+                      FakePlanner::Mode mode = FakePlanner::Mode::kGood,
+                      bool refuse = false) {
+    options.bind_address = "127.0.0.1";
+    options.port = 0;
+    options.status_interval = 0;
+    auto server = Server::Create(options, [this, mode, refuse]() -> std::unique_ptr<plan::Planner> {
+      ++planners_made;
+      if (refuse) return nullptr;
+      return std::make_unique<FakePlanner>(mode);
+    });
+    if (!server.ok()) {
+      ADD_FAILURE() << server.message();
+      return;
+    }
+    server_ = std::move(server).value();
+    thread_ = std::thread([this] { server_->Run(); });
+  }
+  ~TestServer() {
+    if (!server_) return;
+    server_->Stop();
+    thread_.join();
+  }
+  int port() const { return server_ ? server_->port() : 0; }
+  Server& server() { return *server_; }
+  std::atomic<int> planners_made{0};
+
+ private:
+  std::unique_ptr<Server> server_;
+  std::thread thread_;
+};
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+
+// Synchronous-looking Beast client; each step gives up after `timeout` seconds.
+class TestClient {
+ public:
+  explicit TestClient(double timeout = 10.0) : timeout_(timeout), ws_(io_) {}
+
+  bool Connect(int port, const std::string& target = "/socket.io/?EIO=4&transport=websocket") {
+    const asio::ip::tcp::endpoint ep(asio::ip::make_address("127.0.0.1"),
+                                     static_cast<unsigned short>(port));
+    auto ec = Await([&](auto h) {
+      beast::get_lowest_layer(ws_).async_connect(ep, [h](beast::error_code e) mutable { h(e); });
+    });
+    if (ec) return false;
+    ec = Await([&](auto h) {
+      ws_.async_handshake("127.0.0.1:" + std::to_string(port), target,
+                          [h](beast::error_code e) mutable { h(e); });
+    });
+    return !ec;
+  }
+  beast::error_code Send(std::string_view frame, bool binary = false) {
+    ws_.binary(binary);
+    return Await([&](auto h) {
+      ws_.async_write(asio::buffer(frame.data(), frame.size()),
+                      [h](beast::error_code e, std::size_t) mutable { h(e); });
+    });
+  }
+  // The next message, or nullopt on error / timeout.
+  std::optional<std::string> Receive() {
+    beast::flat_buffer buffer;
+    auto ec = Await([&](auto h) {
+      ws_.async_read(buffer, [h](beast::error_code e, std::size_t) mutable { h(e); });
+    });
+    if (ec) return std::nullopt;
+    return beast::buffers_to_string(buffer.data());
+  }
+  std::optional<std::string> Exchange(std::string_view frame) {
+    if (Send(frame)) return std::nullopt;
+    return Receive();
+  }
+  void Close() {
+    Await([&](auto h) {
+      ws_.async_close(websocket::close_code::normal, [h](beast::error_code e) mutable { h(e); });
+    });
+  }
+  // Drops the TCP connection without a WebSocket close frame.
+  void Abort() {
+    beast::error_code ec;
+    beast::get_lowest_layer(ws_).socket().close(ec);
+  }
+
+ private:
+  template <typename Start>
+  beast::error_code Await(Start start) {
+    std::optional<beast::error_code> result;
+    start([&result](beast::error_code ec) { result = ec; });
+    io_.restart();
+    io_.run_for(std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(timeout_)));
+    if (result) return *result;
+    Abort();
+    io_.restart();
+    io_.run();
+    return asio::error::timed_out;
+  }
+
+  double timeout_;
+  asio::io_context io_;
+  websocket::stream<beast::tcp_stream> ws_;
+};
+
+}  // namespace frenetic::net::testing

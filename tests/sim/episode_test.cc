@@ -1,0 +1,174 @@
+#include "frenetic/sim/episode.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "frenetic/sim/record.h"
+#include "sim_test_util.h"
+
+namespace frenetic::sim {
+namespace {
+
+using testing::KeepLanePlanner;
+
+Scenario Quiet() {
+  Scenario sc;
+  sc.traffic.cars = 0;
+  return sc;
+}
+
+TEST(Episode, LockstepConsumesOnePointPerExchangeFixedLatencyThree) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  for (auto mode : {TimingOptions::Mode::kLockstep, TimingOptions::Mode::kFixed}) {
+    Scenario sc = Quiet();
+    sc.timing.mode = mode;
+    sc.timing.l_old = 1;
+    sc.timing.l_new = 2;
+    auto sim = Simulator::Create(world, sc, 1);
+    ASSERT_TRUE(sim.ok());
+    Episode ep(std::move(*sim), EpisodeLimits{0, 0, 10, 60});
+    KeepLanePlanner planner(world->line, 15);
+    int expected = mode == TimingOptions::Mode::kLockstep ? 1 : 3;
+    for (int i = 0; i < 20; ++i) {
+      const plan::PlanResult& r = planner.Plan(ep.telemetry());
+      ASSERT_TRUE(ep.Submit(r.x, r.y).ok());
+      // 50 sent; on the first exchange the l_old ticks ran on no path at all.
+      const int consumed = i == 0 ? expected - sc.timing.l_old * (expected > 1) : expected;
+      EXPECT_EQ(static_cast<int>(ep.telemetry().previous_path_x.size()), 50 - consumed)
+          << "exchange " << i;
+    }
+    EXPECT_NEAR(ep.sim().time(), 20 * expected * 0.02, 1e-9);
+  }
+}
+
+TEST(Episode, RandomLatencyStaysInItsRanges) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  Scenario sc = Quiet();
+  sc.timing.mode = TimingOptions::Mode::kRandom;
+  auto sim = Simulator::Create(world, sc, 4);
+  ASSERT_TRUE(sim.ok());
+  Episode ep(std::move(*sim), EpisodeLimits{0, 0, 30, 60});
+  KeepLanePlanner planner(world->line, 15);
+  std::array<int, 5> seen{};
+  while (!ep.done()) {
+    const plan::PlanResult& r = planner.Plan(ep.telemetry());
+    ASSERT_TRUE(ep.Submit(r.x, r.y).ok());
+    ASSERT_GE(ep.last_l_old(), 0);
+    ASSERT_LE(ep.last_l_old(), 2);
+    ASSERT_GE(ep.last_l_new(), 1);
+    ASSERT_LE(ep.last_l_new(), 2);
+    ++seen[ep.last_l_old() + ep.last_l_new()];
+  }
+  EXPECT_EQ(seen[0], 0);
+  for (int consumed = 1; consumed <= 4; ++consumed) EXPECT_GT(seen[consumed], 10) << consumed;
+  EXPECT_EQ(ep.stop_reason(), "time");
+}
+
+TEST(Episode, GentleDriveWithoutTrafficHasNoIncidents) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  KeepLanePlanner planner(world->line, 20);
+  auto report = RunEpisode(world, Quiet(), 1, EpisodeLimits{0, 1.0, 0, 60}, planner, {});
+  ASSERT_TRUE(report.ok()) << report.message();
+  EXPECT_EQ(report->stop_reason, "distance");
+  EXPECT_GE(report->miles(), 1.0);
+  EXPECT_EQ(report->incidents, 0) << report->ToText();
+  EXPECT_LT(report->max_speed_mph, 50);
+  EXPECT_GT(report->max_speed_mph, 43);
+  EXPECT_LT(report->max_acc, 5);
+  EXPECT_NEAR(report->miles_to_first_incident, report->miles(), 1e-9);
+  EXPECT_NEAR(report->best_miles_without_incident, report->miles(), 0.01);
+  EXPECT_EQ(report->lane_changes, 0);
+}
+
+TEST(Episode, StallEndsAnEpisodeWhoseCarDoesNotMove) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  KeepLanePlanner planner(world->line, 0.0, 0.0);
+  auto report = RunEpisode(world, Quiet(), 1, EpisodeLimits{1, 0, 0, 5}, planner, {});
+  ASSERT_TRUE(report.ok());
+  EXPECT_EQ(report->stop_reason, "stall");
+  EXPECT_NEAR(report->sim_seconds, 5, 0.05);
+}
+
+std::string RecordBytes(const std::shared_ptr<const World>& world, std::uint64_t seed,
+                        const std::string& path) {
+  auto writer = RecordWriter::Open(path);
+  EXPECT_TRUE(writer.ok()) << writer.message();
+  KeepLanePlanner planner(world->line, 18);
+  RunOptions options;
+  options.record = writer->get();
+  options.timing = false;
+  options.planner_config = YamlToJson("weights: {speed: 1.5, lane: 2}\nname: test\n");
+  auto report = RunEpisode(world, Scenario(), seed, EpisodeLimits{0, 0, 20, 60}, planner, options);
+  EXPECT_TRUE(report.ok()) << report.message();
+  writer->reset();
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(Record, SameSeedGivesIdenticalBytesAndTheSchemaHasItsNames) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  const std::string dir = ::testing::TempDir();
+  const std::string a = RecordBytes(world, 9, dir + "/rec_a.jsonl");
+  const std::string b = RecordBytes(world, 9, dir + "/rec_b.jsonl");
+  const std::string c = RecordBytes(world, 10, dir + "/rec_c.jsonl");
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  std::istringstream lines(a);
+  std::string line;
+  std::vector<nlohmann::json> rows;
+  while (std::getline(lines, line)) rows.push_back(nlohmann::json::parse(line));
+  ASSERT_GE(rows.size(), 3u);
+  const auto& h = rows.front();
+  EXPECT_EQ(h["type"], "header");
+  EXPECT_EQ(h["version"], 1);
+  EXPECT_EQ(h["lanes"], 3);
+  EXPECT_EQ(h["lane_width"], 4);
+  EXPECT_EQ(h["seed"], 9);
+  EXPECT_EQ(h["config"]["weights"]["lane"], 2);
+  EXPECT_GT(h["centerline"].size(), 3000u);  // every ~2 m of a 6946 m loop
+  EXPECT_EQ(h["car_length"], 4.6);
+  const auto& e = rows[1];
+  EXPECT_EQ(e["type"], "exchange");
+  EXPECT_EQ(e["i"], 0);
+  EXPECT_EQ(e["telemetry"]["sensor_fusion"].size(), 12u);
+  EXPECT_EQ(e["telemetry"]["x"], 909.48);
+  EXPECT_EQ(e["path"]["x"].size(), 50u);
+  for (const char* key : {"status", "ms_total", "candidates_generated", "rejections",
+                          "winner_costs", "candidates"}) {
+    EXPECT_TRUE(e["plan"].contains(key)) << key;
+  }
+  for (const char* key : {"speed_mph", "acc", "jerk", "lane", "gap", "headway"}) {
+    EXPECT_TRUE(e["metrics"].contains(key)) << key;
+  }
+  EXPECT_TRUE(e["incidents"].is_array());
+  EXPECT_EQ(rows.back()["type"], "footer");
+  EXPECT_NEAR(rows.back()["report"]["sim_seconds"].get<double>(), 20, 0.05);
+}
+
+TEST(RunEpisodes, ResultsDoNotDependOnTheNumberOfThreads) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  auto factory = [&]() -> StatusOr<std::unique_ptr<plan::Planner>> {
+    return std::unique_ptr<plan::Planner>(new KeepLanePlanner(world->line, 21));
+  };
+  EpisodeLimits limits{0, 0, 40, 60};
+  auto one = RunEpisodes(world, Scenario(), 5, 3, 1, limits, factory, false);
+  auto two = RunEpisodes(world, Scenario(), 5, 3, 2, limits, factory, false);
+  ASSERT_TRUE(one.ok()) << one.message();
+  ASSERT_TRUE(two.ok()) << two.message();
+  EXPECT_EQ(one->ToJson().dump(), two->ToJson().dump());
+  ASSERT_EQ(one->episodes.size(), 3u);
+  EXPECT_EQ(one->episodes[2].seed, 7u);
+  EXPECT_GT(one->total_miles, 0.3);
+  EXPECT_GE(one->worst, 0);
+}
+
+}  // namespace
+}  // namespace frenetic::sim
