@@ -28,6 +28,7 @@ struct FidelityArgs {
   std::string map;
   std::string planner = "search";
   std::string traffic_planner = "baseline";
+  std::string traffic_ego = "replay";
   std::string config;
   std::string scenario = "udacity";
   std::vector<std::string> checks = {"protocol", "frenet", "ego", "traffic"};
@@ -105,6 +106,15 @@ int RunFidelity(const FidelityArgs& args) {
     }
     options.scenario = *scenario;
     options.planner = args.traffic_planner;
+    if (args.traffic_ego == "replay") {
+      for (const auto& r : *recordings) {
+        sim::EgoProfile p = sim::RecordingEgoProfile(r);
+        if (p.duration() > 0) options.ego_profiles.push_back(std::move(p));
+      }
+      if (options.ego_profiles.empty()) {
+        return Error("--traffic-ego replay: no recording covers any simulated time");
+      }
+    }
     options.minutes = args.minutes;
     options.episode_seconds = args.episode_seconds;
     options.first_seed = args.seed;
@@ -116,12 +126,18 @@ int RunFidelity(const FidelityArgs& args) {
     if (!simulated.ok()) return Error(simulated.message());
     stats = sim::CompareTraffic(real.figures(), *simulated);
     report.Append(sim::TrafficReport(stats));
-    const int episodes =
-        static_cast<int>(std::ceil(options.minutes * 60.0 / options.episode_seconds - 1e-9));
-    traffic_setup = "scenario " + options.scenario.name + ", planner " + args.traffic_planner +
-                    ", " +
-                    std::to_string(episodes) + " x " + Number(options.episode_seconds) +
-                    " s from the start pose (seeds " + std::to_string(args.seed) + "..), " +
+    const int episodes = sim::TrafficEpisodes(options);
+    std::string ego;
+    if (options.ego_profiles.empty()) {
+      ego = "ego: planner " + args.traffic_planner + ", " + std::to_string(episodes) + " x " +
+            Number(options.episode_seconds) + " s";
+    } else {
+      ego = "ego: replays the recorded ego's speed (as a cap) and lane, " +
+            std::to_string(episodes) + " episodes cycling over " +
+            std::to_string(options.ego_profiles.size()) + " recordings";
+    }
+    traffic_setup = "scenario " + options.scenario.name + ", " + ego +
+                    " from the start pose (seeds " + std::to_string(args.seed) + "..), " +
                     "latency mode l_old " + std::to_string(options.scenario.timing.l_old_min) +
                     "-" + std::to_string(options.scenario.timing.l_old_max) + ", l_new " +
                     std::to_string(options.scenario.timing.l_new_min) + "-" +
@@ -240,6 +256,12 @@ void RegisterFidelity(CLI::App& app) {
       ->check(CLI::IsMember({"search", "baseline"}));
   sub->add_option("--config", args->config,
                   "Planner configuration YAML (default: config/planner.yaml)");
+  sub->add_option("--traffic-ego", args->traffic_ego,
+                  "Who drives the ego in the traffic runs: replay (default; a scripted ego\n"
+                  "drives each recording's speed profile and lanes, so that traffic queues\n"
+                  "behind it as in the recordings) or planner (--traffic-planner, episodes of\n"
+                  "--episode-seconds)")
+      ->check(CLI::IsMember({"replay", "planner"}));
   sub->add_option("--scenario", args->scenario,
                   "Scenario whose traffic is compared, name or YAML file (default: udacity)");
   sub->add_option("--checks", args->checks,

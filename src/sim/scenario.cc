@@ -171,6 +171,7 @@ Status TrafficOptions::Validate() const {
   check(brake_decel > 0, "brake_decel must be > 0");
   check(brake_gap_min >= 0 && brake_gap_max >= brake_gap_min,
         "brake_gap must satisfy 0 <= min <= max");
+  check(brake_delay >= 0 && brake_delay <= 2, "brake_delay must be in [0, 2] s");
   check(follow_lateral > 0, "follow_lateral must be > 0");
   check(wander_min >= 0 && wander_max >= wander_min && wander_max <= 2,
         "wander must satisfy 0 <= min <= max <= 2");
@@ -320,6 +321,7 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
     t.Read("drag", &o.drag);
     t.Read("brake_decel", &o.brake_decel);
     t.ReadRange("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
+    t.Read("brake_delay", &o.brake_delay);
     t.Read("follow_lateral", &o.follow_lateral);
     t.ReadRange("wander", &o.wander_min, &o.wander_max);
     t.ReadRange("wander_period", &o.wander_period_min, &o.wander_period_max);

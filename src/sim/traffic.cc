@@ -166,6 +166,8 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
     car.last_change_tick = tick_;
     car.hard_brake_left = 0;
     car.slow_left = 0;
+    car.blocked = false;
+    car.switch_wait = 0;
     InitWander(car);
     car.d = LaneCentre(lane) + Wander(car, time_);
     car.d_rate = 0;
@@ -332,7 +334,18 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
     // trigger later than the stopping distance of the closing speed.
     const double closing = c.v - leader_v;
     if (closing > 0) h = std::max(h, closing * closing / (2 * o_.brake_decel) + 1.0);
-    c.blocked = gap < h;
+    const bool too_close = gap < h;
+    if (too_close == c.blocked) {
+      c.switch_wait = 0;
+    } else {
+      // Unity reacts a little late both ways; the lag keeps a queued car's brake/throttle cycle
+      // going at the amplitude the recordings show instead of decaying to tick-long pulses.
+      c.switch_wait += kDt;
+      if (c.switch_wait >= o_.brake_delay - 1e-9) {
+        c.blocked = too_close;
+        c.switch_wait = 0;
+      }
+    }
     double desired = c.top_speed;
     if (c.slow_left > 0) desired = std::min(desired, c.slow_speed);
     double a;

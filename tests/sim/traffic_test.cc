@@ -130,6 +130,58 @@ TEST(Traffic, SpeedsBrakingAndDistanceBandLikeTheRealRecordings) {
   EXPECT_GT(st.spawn_offsets.size(), 12u);  // some cars were respawned
 }
 
+// One 59 mph car queued behind a ghost ego at 14.6 m/s in its lane (the recorded situation of
+// car 2 in the advanced run). Returns the share of the last 30 s spent braking hard and the
+// lowest speed there.
+std::pair<double, double> QueueBehindSlowEgo(std::shared_ptr<const World> world, double delay) {
+  TrafficOptions o;
+  o.cars = 1;
+  o.lane_changes = false;
+  o.respawn_distance = 1000;
+  o.brake_gap_max = 35;
+  o.brake_delay = delay;
+  Ghost ego{world.get(), 500, 2, 14.6};
+  Traffic traffic(world, o, 4.6, 2.4, 3, ego.View());
+  TrafficCar& car = traffic.mutable_cars()[0];
+  car.spawned = true;
+  car.lane = 0;
+  car.s = 440;
+  car.d = 2;
+  car.top_speed = 59.1 / kMph;
+  car.v = 20;
+  traffic.Place(car);
+  int hard = 0, ticks = 0;
+  double v_min = 1e9;
+  for (int tick = 0; tick < 4000; ++tick) {
+    ego.Step();
+    traffic.Tick(ego.View(), tick);
+    if (tick >= 2500) {
+      ++ticks;
+      if (traffic.cars()[0].accel < -7) ++hard;
+      v_min = std::min(v_min, traffic.cars()[0].v);
+    }
+    // Never runs into the ego.
+    EXPECT_GT(world->line->DiffS(ego.s, traffic.cars()[0].s), 4.6) << "tick " << tick;
+  }
+  return {static_cast<double>(hard) / ticks, v_min};
+}
+
+TEST(Traffic, BrakeDelaySustainsTheQueuedBrakeThrottleCycle) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  // Without a lag the cycle dies out into tick-long brake pulses; with the calibrated 0.2 s
+  // the car keeps braking hard ~10-20% of the time and dips several m/s below its leader, as
+  // the recorded queued cars do (10-16% of samples, down to ~10 m/s).
+  const auto [share0, vmin0] = QueueBehindSlowEgo(world, 0.0);
+  const auto [share2, vmin2] = QueueBehindSlowEgo(world, 0.2);
+  EXPECT_GT(share2, 0.06);
+  EXPECT_LT(share2, 0.3);
+  EXPECT_LT(vmin2, 12.0);
+  EXPECT_GT(vmin2, 2.0);
+  EXPECT_GT(vmin0, vmin2 + 1.0);
+  // A lag of 0.4 s already lets the cycle grow to near standstill.
+  EXPECT_LT(QueueBehindSlowEgo(world, 0.4).second, vmin2);
+}
+
 TEST(Traffic, SameSeedSameTrafficBitForBit) {
   FRENETIC_REQUIRE_UDACITY(world);
   auto run = [&](std::uint64_t seed) {

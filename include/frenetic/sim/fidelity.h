@@ -151,6 +151,7 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
 // One message as the traffic statistics see it.
 struct TrafficSample {
   double ego_s = 0;          // m, reported ego s
+  double ego_speed = 0;      // m/s, reported ego speed
   double dt = 0;             // s since the previous message of the same run (0 for the first)
   int consumed = 0;          // path points consumed since the previous message (0 for the first)
   std::vector<std::array<double, 7>> cars;  // sensor_fusion rows: id, x, y, vx, vy, s, d
@@ -169,6 +170,7 @@ struct TrafficFigures {
   std::vector<double> spawn_behind;   //   on-road sample of an id, and re-spawns), and behind
   std::vector<double> rel_s;          // m, car s minus ego s (wrapped), on-road samples
   std::vector<double> consumed;       // points per message
+  std::vector<double> ego_speeds;     // m/s, the ego's reported speed, every message
 };
 
 class TrafficStatsBuilder {
@@ -196,17 +198,43 @@ struct StatRow {
 };
 std::vector<StatRow> CompareTraffic(const TrafficFigures& real, const TrafficFigures& sim);
 
+// How a recorded ego drove: its reported speed and d against simulated time (points consumed
+// x 0.02 s), for replaying it in the traffic runs. The traffic statistics depend on the ego
+// (cars queue behind a slow one), so a like-for-like comparison drives the simulated ego the
+// way the recorded one drove.
+struct EgoProfile {
+  std::string name;
+  std::vector<double> t;      // s since the first message, increasing
+  std::vector<double> speed;  // m/s
+  std::vector<double> d;      // m, reported (chord) d
+  double duration() const { return t.empty() ? 0.0 : t.back(); }
+  // Linear interpolation at `time` s (clamped to the ends); 0 / 6 m when empty.
+  double SpeedAt(double time) const;
+  double DAt(double time) const;
+};
+// The ego's speed and d of one recording (time from the consumed counts of the replies).
+EgoProfile RecordingEgoProfile(const Recording& recording);
+
 struct TrafficRunOptions {
   Scenario scenario;            // its timing is forced to the random (latency) mode
-  std::string planner = "baseline";  // drives the ego ("search" is ~50x slower)
+  std::string planner = "baseline";  // drives the ego when `ego_profiles` is empty
   double minutes = 30;          // simulated minutes in total
-  double episode_seconds = 120; // each episode starts like the recordings, from the start pose
+  double episode_seconds = 120; // planner episodes: each starts like the recordings, from the
+                                // start pose
+  // Non-empty: a scripted ego replays the recordings instead of a planner. Episode i replays
+  // ego_profiles[i % n] from the start pose for that profile's duration: its speed as a cap
+  // (lower behind a slower car in its lane, a time-gap law) and its lane (changing only when
+  // the target lane is free beside it). Episodes are added until `minutes` are covered.
+  std::vector<EgoProfile> ego_profiles;
   std::uint64_t first_seed = 1;
   int jobs = 1;                 // threads; results do not depend on it
 };
-// Drives the scenario with the named planner (config from plan::PlannerConfig::LoadDefault or
-// `planner_config_path` when not empty) and collects the statistics from the telemetry of
-// every exchange. Fails on a bad scenario, planner or configuration.
+// Number of episodes SimulateTraffic runs for `options` (>= 1).
+int TrafficEpisodes(const TrafficRunOptions& options);
+// Drives the scenario with the replayed profiles or the named planner (config from
+// plan::PlannerConfig::LoadDefault or `planner_config_path` when not empty) and collects the
+// statistics from the telemetry of every exchange. Fails on a bad scenario, planner,
+// configuration or an empty / non-increasing profile.
 StatusOr<TrafficFigures> SimulateTraffic(std::shared_ptr<const World> world,
                                          const TrafficRunOptions& options,
                                          const std::string& planner_config_path);

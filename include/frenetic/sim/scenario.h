@@ -61,6 +61,9 @@ struct TrafficOptions {
   double drag = 0.0037;                // 1/m (a_drag = drag * v^2)
   double brake_decel = 9.0;            // m/s^2, full brake when following too close
   double brake_gap_min = 10, brake_gap_max = 20;  // m, clamp of the source's trigger gap
+  // s the "too close" test must hold (or fail) before a car starts (or stops) braking: Unity's
+  // reaction lag, which keeps the brake/throttle cycle of a queued car from dying out.
+  double brake_delay = 0;
   double follow_lateral = 2.0;         // m, |Δd| under which a car is "in front" (ray-cast)
   double wander_min = 0.3, wander_max = 0.5;  // m, lateral wander amplitude per car
   double wander_period_min = 8, wander_period_max = 20;  // s

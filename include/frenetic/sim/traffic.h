@@ -46,7 +46,8 @@ struct TrafficCar {
   double throttle_w = 0, throttle_p = 0;
   bool queued = false;        // waiting for a respawn
   bool spawn_quirk = false;   // report speed in the wrong unit until the next tick
-  bool blocked = false;       // was following too close in the last tick
+  bool blocked = false;       // braking for a leader (the "too close" test, after the delay)
+  double switch_wait = 0;     // s the test has disagreed with `blocked` (brake_delay)
   double hard_brake_left = 0;  // s of forced braking left (hard-brake option)
   double slow_left = 0;        // s of blockade left
   double slow_speed = 0;

@@ -1,4 +1,5 @@
 // frenetic: a cost-function trajectory planner for the Udacity Term 3 highway simulator.
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -7,6 +8,8 @@
 #include "apps/commands.h"
 
 int main(int argc, char** argv) {
+  // Logs go to stderr so that stdout carries only results (tables, --json, serve's port line).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("frenetic"));
   CLI::App app{
       "frenetic: highway trajectory planner for the Udacity Term 3 simulator, with a headless\n"
       "simulator to drive, test, tune and benchmark it."};
