@@ -19,7 +19,8 @@ while [ $# -gt 0 ]; do
 done
 SHARED_DIR="$(cd "$SHARED_DIR" 2>/dev/null && pwd || echo "$SHARED_DIR")"
 
-TEST_PACKAGES=(python3 python3-websockets clang libclang-rt-14-dev nodejs npm chromium)
+# node and npm: the machine's own, or Debian's via scripts/report-test-deps.sh when absent.
+TEST_PACKAGES=(python3 python3-websockets clang libclang-rt-14-dev chromium)
 ensure_packages "${BUILD_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
 bash "$FRENETIC_ROOT/scripts/report-test-deps.sh"
 configure_and_build -DFRENETIC_BUILD_TESTS=ON -DFRENETIC_SHARED_DIR="$SHARED_DIR"
