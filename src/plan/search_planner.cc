@@ -69,7 +69,7 @@ struct Settings {
   int lat_offsets;
   double lat_offset_step;
   double score_dt, score_horizon;
-  double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d;
+  double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
   bool refine;
   int refine_iterations;
   double refine_budget_ms;
@@ -112,6 +112,7 @@ struct Settings {
     car_width = c.value("check.car_width");
     margin_s = c.value("check.margin_s");
     margin_d = c.value("check.margin_d");
+    margin_behind = c.value("check.margin_behind");
     refine = c.int_value("refine.enabled") != 0;
     refine_iterations = c.int_value("refine.max_iterations");
     refine_budget_ms = c.value("refine.budget_ms");
@@ -306,7 +307,7 @@ class SearchPlanner : public Planner {
     start_ = start;
     t_keep_ = kept * kTickSeconds;
     time_since_change_ += elapsed;
-    if (have_prev_traj_) prev_elapsed_ = elapsed;
+    if (have_prev_traj_) prev_elapsed_ = prev_base_ + elapsed;
 
     // Prediction (relative to the start state's s; the observation is "now").
     predictor_->Observe(t.sensor_fusion, start.s);
@@ -344,6 +345,10 @@ class SearchPlanner : public Planner {
       reuse_end_speed_ = sum.winner_end_speed;
       reuse_duration_ = sum.winner_duration;
       EvaluateWinnerCosts();
+    } else if (over_budget && ContinuePrevious()) {
+      // Cut short (a loaded machine): last cycle's winner, still collision-free, is a better
+      // answer than braking, which invites the car behind into the ego's boot.
+      sum.winner_lane = prev_target_lane_;
     } else {
       BuildFallback();
       have_prev_traj_ = false;
@@ -811,16 +816,33 @@ class SearchPlanner : public Planner {
 
   // Oriented-box overlap with every relevant car over the check horizon (inflated boxes).
   bool Collides() const {
+    return CollidesAt([this](int i) {
+      return FrenetState{tk_s_[i], tk_sd_[i], 0.0, tk_d_[i], tk_dd_[i], 0.0};
+    });
+  }
+  // The same test evaluating the polynomials only at the collision steps: most rejected
+  // candidates fail here, so they never pay for the full tick sampling.
+  bool Collides(const FrenetTrajectory& tr) const {
+    return CollidesAt([&tr](int i) { return tr.At(i * kTickSeconds); });
+  }
+  template <typename StateAt>
+  bool CollidesAt(StateAt state_at) const {
     const int step = std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
     const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
     for (int i = step; i <= n_ticks_; i += step) {
       const double t = i * kTickSeconds;
-      const traj::OrientedBox ego{tk_s_[i], tk_d_[i],
-                                  std::atan2(tk_dd_[i], std::max(tk_sd_[i], 0.5)), hl, hw};
+      const FrenetState st = state_at(i);
+      const traj::OrientedBox ego{st.s, st.d, std::atan2(st.d_d, std::max(st.s_d, 0.5)), hl, hw};
       for (int c = 0; c < ctx_.num_cars; ++c) {
         const double cs = car_s0_[c] + car_v_[c] * (t + t_keep_);
-        if (std::abs(cs - ego.cx) > 12 || std::abs(car_d_[c] - ego.cy) > 5) continue;
-        const traj::OrientedBox car{cs, car_d_[c], 0.0, hl + cfg_.margin_s, hw + cfg_.margin_d};
+        // A car behind in another lane than the start's is one the ego would cut in front of:
+        // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
+        // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
+        const bool behind_other_lane =
+            cs < ego.cx && std::abs(car_d_[c] - start_.d) > 0.5 * cfg_.lane_width;
+        const double margin = behind_other_lane ? cfg_.margin_behind : cfg_.margin_s;
+        if (std::abs(cs - ego.cx) > 8 + margin || std::abs(car_d_[c] - ego.cy) > 5) continue;
+        const traj::OrientedBox car{cs, car_d_[c], 0.0, hl + margin, hw + cfg_.margin_d};
         if (traj::Overlap(ego, car)) return true;
       }
     }
@@ -840,15 +862,15 @@ class SearchPlanner : public Planner {
         return false;
       }
       const int c = order_[r];
-      FillTicks(Candidate(c));
       ++sum.candidates_checked;
-      // Cheapest first: the Frenet-only collision test skips the XY conversion for the many
-      // candidates that run into traffic.
-      if (Collides()) {
+      // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
+      // conversion for the many candidates that run into traffic.
+      if (Collides(Candidate(c))) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         Trace(r, false, static_cast<int>(Reject::kCollision));
         continue;
       }
+      FillTicks(Candidate(c));
       Reject why = Reject::kCount;
       if (Violation(&why) > 0) {
         ++sum.rejections[static_cast<int>(why)];
@@ -1019,6 +1041,7 @@ class SearchPlanner : public Planner {
     }
     prev_target_lane_ = lane;
     prev_traj_ = winner_;
+    prev_base_ = 0;
     have_prev_traj_ = true;
   }
 
@@ -1044,13 +1067,31 @@ class SearchPlanner : public Planner {
     result_.summary.winner_total_cost = total;
   }
 
+  // Samples last cycle's winner from the current start on into the tick buffers; false when
+  // there is none or it now collides. The XY limits were checked on it when it won.
+  bool ContinuePrevious() {
+    if (!have_prev_traj_) return false;
+    for (int i = 1; i <= n_ticks_; ++i) {
+      const FrenetState st = prev_traj_.At(prev_elapsed_ + i * kTickSeconds);
+      tk_s_[i] = st.s;
+      tk_sd_[i] = st.s_d;
+      tk_sdd_[i] = st.s_dd;
+      tk_d_[i] = st.d;
+      tk_dd_[i] = st.d_d;
+      tk_ddd_[i] = st.d_dd;
+    }
+    if (Collides()) return false;
+    prev_base_ = prev_elapsed_;  // the next cycle's elapsed time counts from this start
+    return true;
+  }
+
   // Keep-lane braking at a jerk-limited constant deceleration, integrated tick by tick; it
   // never exceeds the limits. The first braking level that clears the traffic wins, else the
   // hardest.
   void BuildFallback() {
     const double levels[3] = {cfg_.fallback_decel,
                               std::min(2 * cfg_.fallback_decel, 0.75 * cfg_.max_accel),
-                              0.85 * cfg_.max_accel};
+                              0.9 * cfg_.max_accel};
     const int lane = LaneOf(start_.d);
     Trajectory1d lat{traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, lane_center_[lane], 0,
                                         0, cfg_.fallback_lat_duration),
@@ -1165,7 +1206,8 @@ class SearchPlanner : public Planner {
   int hist_n_ = 0;
   bool have_prev_traj_ = false;
   FrenetTrajectory prev_traj_;
-  double prev_elapsed_ = 0;
+  double prev_elapsed_ = 0;  // s: the current start's time on prev_traj_
+  double prev_base_ = 0;     // s: the stored plan start's time on prev_traj_ (see ContinuePrevious)
   int prev_target_lane_ = -1, lane_before_change_ = -1;
   double time_since_change_ = 1e9;
   // Plan reuse between full searches (see CanReuse).

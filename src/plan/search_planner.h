@@ -3,6 +3,10 @@
 // velocity keeping, quintic following (constant time-gap law) and stopping, quintic lateral
 // moves to lane centres, every lon x lat pair scored by the weighted cost set, then checked
 // lazily in cost order on the XY path, refined with NLopt, with a keep-lane braking fallback.
+// Between searches (fewer than continuity.replan_min_ticks points driven and no material change
+// in traffic) Plan() re-sends the previous plan minus the consumed points: such a cycle reports
+// candidates_generated == 0 with status ok. Set continuity.replan_min_ticks to 1 to search on
+// every call (e.g. to benchmark the search itself).
 #pragma once
 
 #include <memory>

@@ -56,7 +56,12 @@ TEST(PlannerConfigTest, UnknownCostTermAndParameterAreErrors) {
 
 TEST(PlannerConfigTest, MissingWeightIsAnError) {
   std::string yaml = DefaultYaml();
-  yaml.replace(yaml.find("    weight: 6\n"), 14, "");  // efficiency loses its weight
+  // efficiency loses its weight line (whatever its value and comment).
+  const size_t term = yaml.find("  efficiency:\n");
+  ASSERT_NE(term, std::string::npos);
+  const size_t weight = yaml.find("    weight:", term);
+  ASSERT_NE(weight, std::string::npos);
+  yaml.erase(weight, yaml.find('\n', weight) + 1 - weight);
   auto c = PlannerConfig::Parse(yaml, "w.yaml");
   ASSERT_FALSE(c.ok());
   EXPECT_NE(c.message().find("efficiency"), std::string::npos) << c.message();
@@ -64,7 +69,14 @@ TEST(PlannerConfigTest, MissingWeightIsAnError) {
   // A term left out entirely is a missing weight too.
   std::string dropped = DefaultYaml();
   const size_t at = dropped.find("  consistency:\n");
-  dropped.erase(at, dropped.find("s_scale", at) + 20 - at);
+  ASSERT_NE(at, std::string::npos);
+  // The term's block: its header and every deeper-indented line after it.
+  size_t end = dropped.find('\n', at) + 1;
+  while (end < dropped.size() && dropped.compare(end, 4, "    ") == 0) {
+    end = dropped.find('\n', end);
+    end = end == std::string::npos ? dropped.size() : end + 1;
+  }
+  dropped.erase(at, end - at);
   auto d = PlannerConfig::Parse(dropped, "w.yaml");
   ASSERT_FALSE(d.ok());
   EXPECT_NE(d.message().find("consistency"), std::string::npos) << d.message();

@@ -8,6 +8,7 @@
 #include <limits>
 #include <new>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -366,6 +367,67 @@ TEST(SearchPlannerTest, NoAllocationAfterWarmUp) {
   EXPECT_EQ(total, 0);
 }
 
+// Lockstep exchanges (one point consumed each): the plan is re-sent minus the consumed points
+// until continuity.replan_min_ticks points were driven, and a car appearing nearby forces a
+// search at once.
+TEST(SearchPlannerTest, ReusesThePlanBetweenSearchesAndReplansOnANewCar) {
+  REQUIRE_MAP(line);
+  PlannerConfig config = Config();
+  const int min_ticks = config.int_value("continuity.replan_min_ticks");
+  ASSERT_GE(min_ticks, 2) << "the shipped configuration should reuse plans";
+  auto made = MakePlanner("search", config, line);
+  ASSERT_TRUE(made.ok()) << made.message();
+  Planner& planner = **made;
+  auto car_row = [&](int id, double s, double d, double v) {
+    const map::CartesianPose p = line->ToCartesian(s, d);
+    return SensorCar{id, p.x, p.y, v * std::cos(p.heading), v * std::sin(p.heading), s, d};
+  };
+  for (const bool new_car : {false, true}) {
+    planner.Reset();
+    const map::CartesianPose start = line->ToCartesian(800, 6.0);
+    Telemetry t;
+    t.x = start.x;
+    t.y = start.y;
+    t.yaw = start.heading;
+    t.speed = 20;
+    double car_s = 900;
+    t.sensor_fusion.push_back(car_row(1, car_s, 2.0, 18));
+    std::vector<double> last_x, last_y;
+    std::vector<int> generated;
+    for (int cycle = 0; cycle <= min_ticks; ++cycle) {
+      const PlanResult& r = planner.Plan(t);
+      ASSERT_GE(r.x.size(), static_cast<size_t>(kMinPathPoints));
+      generated.push_back(r.summary.candidates_generated);
+      if (r.summary.candidates_generated == 0) {
+        // A reused plan is exactly the previous one minus the consumed point.
+        ASSERT_EQ(r.x.size() + 1, last_x.size());
+        for (size_t i = 0; i < r.x.size(); ++i) {
+          EXPECT_EQ(r.x[i], last_x[i + 1]);
+          EXPECT_EQ(r.y[i], last_y[i + 1]);
+        }
+      }
+      last_x = r.x;
+      last_y = r.y;
+      // The simulator drives one point and reports the rest.
+      t.x = r.x[0];
+      t.y = r.y[0];
+      t.yaw = std::atan2(r.y[1] - r.y[0], r.x[1] - r.x[0]);
+      t.previous_path_x.assign(r.x.begin() + 1, r.x.end());
+      t.previous_path_y.assign(r.y.begin() + 1, r.y.end());
+      car_s += 18 * kTickSeconds;
+      t.sensor_fusion = {car_row(1, car_s, 2.0, 18)};
+      if (new_car && cycle == 0) t.sensor_fusion.push_back(car_row(2, 840, 6.0, 15));
+    }
+    EXPECT_GT(generated[0], 0);
+    if (new_car) {
+      EXPECT_GT(generated[1], 0) << "a car appeared 40 m ahead: the planner must search";
+    } else {
+      for (int i = 1; i < min_ticks; ++i) EXPECT_EQ(generated[i], 0) << "cycle " << i;
+      EXPECT_GT(generated[min_ticks], 0) << "replan_min_ticks points driven: search again";
+    }
+  }
+}
+
 // Corrupts a plausible telemetry in one of many ways.
 Telemetry Corrupt(Telemetry t, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0, 1);
@@ -417,8 +479,19 @@ class FuzzTest : public testing::TestWithParam<std::string> {};
 
 TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
   REQUIRE_MAP(line);
-  auto planner = Make(GetParam(), line);
-  ASSERT_NE(planner, nullptr);
+  // Robustness does not need the full lattice: a small grid and a short refinement keep the
+  // 10,000 cycles within a few seconds (the defaults are exercised by the scenario tests).
+  PlannerConfig config = Config();
+  for (const auto& [key, value] : {std::pair<const char*, double>{"grid.speeds", 8},
+                                   {"grid.durations", 4},
+                                   {"grid.follow_gaps", 1},
+                                   {"grid.lat_durations", 1},
+                                   {"refine.max_iterations", 4}}) {
+    ASSERT_TRUE(config.Set(key, value).ok()) << key;
+  }
+  auto made = MakePlanner(GetParam(), config, line);
+  ASSERT_TRUE(made.ok()) << made.message();
+  std::unique_ptr<Planner> planner = std::move(made).value();
   std::mt19937 rng(2024);
   Loop loop(line, planner.get(), 3000, 6.0, 18.0, 8);
   loop.cars.push_back({0, 3040, 6.0, 12.0});
