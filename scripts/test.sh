@@ -44,8 +44,8 @@ log "step 3/4: frame-parser fuzzer"
 bash "$FRENETIC_ROOT/scripts/fuzz.sh" "${FRENETIC_FUZZ_SECONDS:-60}"
 
 log "step 4/4: ctest under AddressSanitizer + UndefinedBehaviorSanitizer"
-FRENETIC_BUILD_DIR="$FRENETIC_ROOT/build-asan" configure_and_build_asan
+configure_and_build_asan
 (cd "$FRENETIC_ROOT/build-asan" &&
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --output-on-failure -j "$JOBS" --timeout 1800 -E "${FRENETIC_ASAN_EXCLUDE:-^$}")
+  ctest --output-on-failure -j "$JOBS" --timeout 1800 -E "^report_(cli|browser)$")
 log "all tests passed in $((SECONDS - start)) s"
