@@ -67,7 +67,14 @@ double Interpolate(const std::vector<double>& t, const std::vector<double>& v, d
 // last path and extends it to kPathPoints points each exchange.
 class ReplayEgo {
  public:
-  ReplayEgo(const World& world, const EgoProfile& profile) : world_(world), profile_(profile) {}
+  ReplayEgo(const World& world, const EgoProfile& profile) : world_(world), profile_(profile) {
+    // Distance the recorded ego had driven by each profile time (trapezoid rule).
+    distance_.resize(profile_.t.size(), 0.0);
+    for (std::size_t i = 1; i < distance_.size(); ++i) {
+      distance_[i] = distance_[i - 1] + 0.5 * (profile_.speed[i] + profile_.speed[i - 1]) *
+                                            (profile_.t[i] - profile_.t[i - 1]);
+    }
+  }
 
   void Plan(const plan::Telemetry& t, double time, std::vector<double>* x,
             std::vector<double>* y) {
@@ -77,6 +84,14 @@ class ReplayEgo {
     while (sent_.size() > left) sent_.pop_front();
     if (sent_.size() > kKeep) sent_.resize(kKeep);
     const map::FrenetPoint ego = line.ToFrenet(t.x, t.y);
+    if (has_last_) travelled_ += std::max(0.0, line.DiffS(ego.s, last_s_));
+    has_last_ = true;
+    last_s_ = ego.s;
+    // Distance lost behind slower cars: the recorded planner made it up (it passed or sped up
+    // afterwards), so the scripted ego may exceed the recorded speed, up to the recorded ego's
+    // top speed, until it is back on the recorded distance. Without this it falls behind for
+    // good and the traffic drifts ahead of it.
+    const double deficit = Interpolate(profile_.t, distance_, time, 0.0) - travelled_;
     State st = sent_.empty() ? State{ego.s, ego.d, t.speed} : sent_.back();
 
     // Leader: the nearest car ahead in the lane the ego is in (reported chord s, d, as a planner
@@ -114,6 +129,9 @@ class ReplayEgo {
     for (int k = 1; static_cast<int>(sent_.size()) < kPathPoints; ++k) {
       const double tau = tau0 + k * kTick;
       double v_cap = profile_.SpeedAt(time + tau);
+      if (deficit > 0) {
+        v_cap = std::max(v_cap, std::min(v_cap + kCatchUpGain * deficit, kCatchUpSpeed));
+      }
       if (std::isfinite(lead_gap)) {
         // Time-gap law on the leader predicted at constant speed.
         const double gap = lead_gap + lead_v * tau - travelled;
@@ -148,6 +166,11 @@ class ReplayEgo {
   static constexpr double kLateralSpeed = 2.0;     // m/s: a lane change in ~2 s
   static constexpr double kLaneLookahead = 0.5;    // s
   static constexpr double kChangeClearBehind = 15, kChangeClearAhead = 20;  // m
+  // Catch-up on lost distance: 1/s, and the recorded ego's top speed (49.4 mph), m/s.
+  static constexpr double kCatchUpGain = 0.2, kCatchUpSpeed = 22.0;
+  std::vector<double> distance_;  // recorded distance at profile_.t, m
+  double travelled_ = 0, last_s_ = 0;
+  bool has_last_ = false;
   const World& world_;
   const EgoProfile& profile_;
   std::deque<State> sent_;
@@ -325,6 +348,7 @@ std::vector<StatRow> CompareTraffic(const TrafficFigures& real, const TrafficFig
   const long es = static_cast<long>(sim.ego_speeds.size());
   add("ego speed median", "m/s", Percentile(real.ego_speeds, 0.5),
       Percentile(sim.ego_speeds, 0.5), er, es);
+  add("ego speed mean", "m/s", Mean(real.ego_speeds), Mean(sim.ego_speeds), er, es);
   add("ego speed p95", "m/s", Percentile(real.ego_speeds, 0.95),
       Percentile(sim.ego_speeds, 0.95), er, es);
   return rows;

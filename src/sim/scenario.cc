@@ -168,6 +168,7 @@ Status TrafficOptions::Validate() const {
   check(max_accel > 0, "max_accel must be > 0");
   check(throttle_gain > 0, "throttle_gain must be > 0");
   check(drag >= 0, "drag must be >= 0");
+  check(linear_drag >= 0, "linear_drag must be >= 0");
   check(brake_decel > 0, "brake_decel must be > 0");
   check(brake_gap_min >= 0 && brake_gap_max >= brake_gap_min,
         "brake_gap must satisfy 0 <= min <= max");
@@ -319,6 +320,7 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
     t.Read("max_accel", &o.max_accel);
     t.Read("throttle_gain", &o.throttle_gain);
     t.Read("drag", &o.drag);
+    t.Read("linear_drag", &o.linear_drag);
     t.Read("brake_decel", &o.brake_decel);
     t.ReadRange("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
     t.Read("brake_delay", &o.brake_delay);

@@ -359,7 +359,7 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
       const double throttle =
           std::clamp(o_.throttle_gain * (desired - c.v) * kMph, -1.0, 1.0) * wander;
       a = throttle >= 0 ? throttle * o_.max_accel : throttle * o_.brake_decel;
-      a -= o_.drag * c.v * c.v;
+      a -= o_.drag * c.v * c.v + o_.linear_drag * c.v;
     }
     accel_[i] = a;
   }

@@ -182,6 +182,52 @@ TEST(Traffic, BrakeDelaySustainsTheQueuedBrakeThrottleCycle) {
   EXPECT_LT(QueueBehindSlowEgo(world, 0.4).second, vmin2);
 }
 
+// Free cruise speed / top speed of one lone car after 60 s.
+double CruiseFraction(std::shared_ptr<const World> world, double top_mph, double drag,
+                      double linear_drag) {
+  TrafficOptions o;
+  o.cars = 1;
+  o.respawn_distance = 5000;
+  o.max_accel = 4.6;
+  o.drag = drag;
+  o.linear_drag = linear_drag;
+  Ghost ego{world.get(), 500, 10, 16};  // right lane, never in the car's way
+  Traffic traffic(world, o, 4.6, 2.4, 5, ego.View());
+  TrafficCar& car = traffic.mutable_cars()[0];
+  car.spawned = true;
+  car.lane = 0;
+  car.s = 600;
+  car.d = 2;
+  car.top_speed = top_mph / kMph;
+  car.v = car.top_speed;
+  traffic.Place(car);
+  double sum = 0;
+  int n = 0;
+  for (int tick = 0; tick < 3000; ++tick) {
+    ego.Step();
+    traffic.Tick(ego.View(), tick);
+    if (tick >= 1500) {
+      sum += traffic.cars()[0].v;
+      ++n;
+    }
+  }
+  return sum / n / car.top_speed;
+}
+
+TEST(Traffic, LinearDragCruisesAtTheRecordedFractionOfTopSpeed) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  // The recordings: free cruise is ~83% of the top speed for 40.6 and 59.1 mph cars alike.
+  const double slow = CruiseFraction(world, 40.6, 0, 0.079);
+  const double fast = CruiseFraction(world, 59.1, 0, 0.079);
+  EXPECT_NEAR(slow, 0.832, 0.015);
+  EXPECT_NEAR(fast, 0.832, 0.015);
+  EXPECT_LT(std::abs(slow - fast), 0.01);
+  // Quadratic drag cannot hold one fraction: slow cars cruise relatively faster.
+  const double q_slow = CruiseFraction(world, 40.6, 0.004, 0);
+  const double q_fast = CruiseFraction(world, 59.1, 0.004, 0);
+  EXPECT_GT(q_slow - q_fast, 0.03);
+}
+
 TEST(Traffic, SameSeedSameTrafficBitForBit) {
   FRENETIC_REQUIRE_UDACITY(world);
   auto run = [&](std::uint64_t seed) {

@@ -223,8 +223,9 @@ struct TrafficRunOptions {
                                 // start pose
   // Non-empty: a scripted ego replays the recordings instead of a planner. Episode i replays
   // ego_profiles[i % n] from the start pose for that profile's duration: its speed as a cap
-  // (lower behind a slower car in its lane, a time-gap law) and its lane (changing only when
-  // the target lane is free beside it). Episodes are added until `minutes` are covered.
+  // (lower behind a slower car in its lane, a time-gap law; above it, up to 22 m/s, while
+  // making up distance lost behind slower cars) and its lane (changing only when the target
+  // lane is free beside it). Episodes are added until `minutes` are covered.
   std::vector<EgoProfile> ego_profiles;
   std::uint64_t first_seed = 1;
   int jobs = 1;                 // threads; results do not depend on it

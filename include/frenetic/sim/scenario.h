@@ -43,7 +43,10 @@ struct StartPose {
 
 // The proportional throttle law (§8.3) with a quadratic drag term, which gives the steady-state
 // error that keeps cars several mph below their top speed:
-//   a = A_max * clamp(gain * (top_mph - v_mph), -1, 1) * wander - drag * v^2   (throttle)
+//   a = A_max * clamp(gain * (top_mph - v_mph), -1, 1) * wander - drag * v^2
+//       - linear_drag * v   (throttle)
+// Unity's Rigidbody.drag damps velocity linearly; with it alone the free cruise speed is a fixed
+// fraction of the top speed, as recorded.
 struct TrafficOptions {
   int cars = 12;                       // forward cars reported in sensor_fusion, ids 0..cars-1
   double respawn_distance = 200;       // m, Euclidean distance to the ego that queues a respawn
@@ -59,6 +62,7 @@ struct TrafficOptions {
   double max_accel = 4.0;              // m/s^2 at full throttle
   double throttle_gain = 0.04;         // 1/mph
   double drag = 0.0037;                // 1/m (a_drag = drag * v^2)
+  double linear_drag = 0;              // 1/s (a_drag = linear_drag * v), Unity Rigidbody.drag
   double brake_decel = 9.0;            // m/s^2, full brake when following too close
   double brake_gap_min = 10, brake_gap_max = 20;  // m, clamp of the source's trigger gap
   // s the "too close" test must hold (or fail) before a car starts (or stops) braking: Unity's
