@@ -400,9 +400,14 @@ ParsedFrame ParseFrame(std::string_view frame) {
 
 std::size_t FormatControl(std::span<const double> x, std::span<const double> y,
                           std::string* out) {
+  // A coordinate beyond float32 range is one the simulator's float.Parse cannot read (and one
+  // near DBL_MAX would round up to an overflowing literal at kControlDigits): cut there too.
+  const auto writable = [](double v) {
+    return std::isfinite(v) && std::fabs(v) <= std::numeric_limits<float>::max();
+  };
   std::size_t n = std::min(x.size(), y.size());
   for (std::size_t i = 0; i < n; ++i) {
-    if (!std::isfinite(x[i]) || !std::isfinite(y[i])) {
+    if (!writable(x[i]) || !writable(y[i])) {
       n = i;
       break;
     }

@@ -341,6 +341,24 @@ TEST(ProtocolTest, FormatControlCutsAtTheFirstNonFinitePointAndToTheShorterArray
   EXPECT_EQ(out, R"(42["control",{"next_x":[],"next_y":[]}])");
 }
 
+// Found by the fuzzer: -DBL_MAX written with 10 digits rounds to -1.797693135e+308, a literal
+// that overflows double and made the frame invalid JSON. Points beyond float32 range, which the
+// simulator cannot parse, are cut like non-finite ones.
+TEST(ProtocolTest, FormatControlCutsAtCoordinatesBeyondFloat32Range) {
+  std::string out;
+  const std::vector<double> x = {1, 2, -1.7976931348517495e+308};
+  const std::vector<double> y = {1, 2, 3};
+  EXPECT_EQ(FormatControl(x, y, &out), 2u);
+  EXPECT_EQ(out, R"(42["control",{"next_x":[1,2],"next_y":[1,2]}])");
+  const std::vector<double> y_big = {1, 3.5e38};
+  EXPECT_EQ(FormatControl(std::vector<double>{1, 2}, y_big, &out), 1u);
+  ParsedReply reply;
+  const std::vector<double> tiny = {1.259867397e-321, 3.4e38};
+  EXPECT_EQ(FormatControl(tiny, tiny, &out), 2u);
+  ParseReply(out, &reply);
+  EXPECT_EQ(reply.kind, ReplyKind::kControl) << reply.error;
+}
+
 TEST(ProtocolTest, ParseReplyReadsControlAndRejectsWhatTheSimulatorCannotUse) {
   ParsedReply r;
   std::string frame;

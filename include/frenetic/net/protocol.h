@@ -44,7 +44,8 @@ ParsedFrame ParseFrame(std::string_view frame);
 
 // Appends `42["control",{"next_x":[...],"next_y":[...]}]` to *out (cleared first). Only finite
 // numbers are written; both arrays always have the same length: min(x.size(), y.size()) points,
-// cut before the first point with a non-finite coordinate. Numbers are written with
+// cut before the first point with a non-finite coordinate or one beyond float32 range (which
+// the simulator cannot parse). Numbers are written with
 // kControlDigits significant digits (far below the float32 resolution the simulator parses to).
 // Returns the number of points written.
 inline constexpr int kControlDigits = 10;
