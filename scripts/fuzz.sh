@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang in build-fuzz and runs the wire-protocol fuzzer.
 #   scripts/fuzz.sh [SECONDS]     run for SECONDS (default 60); exit 0 when nothing was found
+#   FRENETIC_FUZZ_SEED=N          libFuzzer seed (default 1, so CI runs are repeatable)
 # Needs clang and libclang-rt-14-dev. Findings (crash-*, leak-*, timeout-*) land in build-fuzz/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -62,5 +63,5 @@ cat >"$DICT" <<'DICT_EOF'
 DICT_EOF
 
 cd "$BUILD"
-exec ./frame_parser_fuzz -max_total_time="$SECONDS_TO_RUN" -max_len=16384 -timeout=10 \
+exec ./frame_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 -timeout=10 \
   -rss_limit_mb=2048 -dict="$DICT" -print_final_stats=1 "$CORPUS" "$SEEDS"
