@@ -932,7 +932,9 @@ class SearchPlanner : public Planner {
   }
 
   // Weighted cost of a trajectory (samples it like the bundles).
-  double CostOf(const FrenetTrajectory& tr, const LonTraj& lbase, const LatTraj& dbase) {
+  // Samples `tr` on the scoring grid into the ref_* buffers and points a CostInput at them.
+  cost::CostInput SampleForCost(const FrenetTrajectory& tr, const LonTraj& lbase,
+                                const LatTraj& dbase) {
     for (int k = 0; k < n_samples_; ++k) {
       const FrenetState st = tr.At(k * cfg_.score_dt);
       ref_s_[k] = st.s;
@@ -957,7 +959,11 @@ class SearchPlanner : public Planner {
     in.end_d = ref_d_[n_samples_ - 1];
     in.target_lane = dbase.lane;
     in.kind = lbase.kind;
-    const double v = costs_->Evaluate(ctx_, in);
+    return in;
+  }
+
+  double CostOf(const FrenetTrajectory& tr, const LonTraj& lbase, const LatTraj& dbase) {
+    const double v = costs_->Evaluate(ctx_, SampleForCost(tr, lbase, dbase));
     return Finite(v) ? v : 1e300;
   }
 
@@ -1046,25 +1052,12 @@ class SearchPlanner : public Planner {
   }
 
   void EvaluateWinnerCosts() {
-    const double total = CostOf(winner_, lon_[winner_lon_], lat_[winner_lat_]);
-    cost::CostInput in;  // CostOf left the samples in ref_*: evaluate per term on them
-    in.s = ref_s_.data();
-    in.s_d = ref_sd_.data();
-    in.s_dd = ref_sdd_.data();
-    in.d = ref_d_.data();
-    in.d_d = ref_dd_.data();
-    in.d_dd = ref_ddd_.data();
-    in.lon_duration = winner_.lon.duration;
-    in.lat_duration = winner_.lat.duration;
-    in.lon_jerk_squared = winner_.lon.poly.JerkSquaredIntegral(winner_.lon.duration);
-    in.lat_jerk_squared = winner_.lat.poly.JerkSquaredIntegral(winner_.lat.duration);
-    in.end_speed = winner_.lon.poly.V(winner_.lon.duration);
-    in.end_d = ref_d_[n_samples_ - 1];
-    in.target_lane = lat_[winner_lat_].lane;
-    in.kind = lon_[winner_lon_].kind;
-    costs_->Evaluate(ctx_, in, per_term_.data());
+    const LonTraj& lbase = lon_[winner_lon_];
+    const LatTraj& dbase = lat_[winner_lat_];
+    const double total =
+        costs_->Evaluate(ctx_, SampleForCost(winner_, lbase, dbase), per_term_.data());
     for (int i = 0; i < costs_->size(); ++i) result_.summary.winner_costs[i].value = per_term_[i];
-    result_.summary.winner_total_cost = total;
+    result_.summary.winner_total_cost = Finite(total) ? total : 1e300;
   }
 
   // Samples last cycle's winner from the current start on into the tick buffers; false when
