@@ -330,28 +330,9 @@ INSTANTIATE_TEST_SUITE_P(Rules, WrongTrimming,
                                            WrongTrimEgo::Rule::kAlwaysDropClosest,
                                            WrongTrimEgo::Rule::kNoTrim));
 
-// The same stand-in with the right rule passes: the failures above come from the rule alone.
+// The simulator's own ego on the same messages passes: the failures above come from the rule alone.
 TEST_F(RealData, StandInEgoWithTheRightRulePasses) {
-  const EgoModelFactory factory = [](float x, float y, double yaw) -> std::unique_ptr<EgoModel> {
-    class Right final : public EgoModel {
-     public:
-      Right(float x, float y, double yaw) : car_(x, y, yaw) {}
-      void ApplyPath(std::span<const double> x, std::span<const double> y) override {
-        car_.ApplyPath(x, y);
-      }
-      void Tick() override { car_.Tick(); }
-      float x() const override { return car_.x(); }
-      float y() const override { return car_.y(); }
-      double yaw() const override { return car_.yaw(); }
-      float speed() const override { return car_.speed(); }
-      std::span<const float> path_x() const override { return car_.path_x(); }
-      std::span<const float> path_y() const override { return car_.path_y(); }
-
-     private:
-      EgoCar car_;
-    };
-    return std::make_unique<Right>(x, y, yaw);
-  };
+  const EgoModelFactory factory = SimulatorEgoModel();
   EXPECT_TRUE(CheckEgoMotion(Head(40), factory).ok());
 }
 
