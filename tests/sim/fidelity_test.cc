@@ -330,7 +330,8 @@ INSTANTIATE_TEST_SUITE_P(Rules, WrongTrimming,
                                            WrongTrimEgo::Rule::kAlwaysDropClosest,
                                            WrongTrimEgo::Rule::kNoTrim));
 
-// The simulator's own ego on the same messages passes: the failures above come from the rule alone.
+// The simulator's own ego on the same messages passes: the failures above come from the
+// rule alone.
 TEST_F(RealData, StandInEgoWithTheRightRulePasses) {
   const EgoModelFactory factory = SimulatorEgoModel();
   EXPECT_TRUE(CheckEgoMotion(Head(40), factory).ok());
