@@ -23,19 +23,35 @@ class BufferCost : public CostTerm {
     if (n == 0 || ctx.num_cars == 0) return 0.0;
     // Same lane: the centres are closer laterally than a car width plus a little.
     const double same_lane = ctx.car_width + 0.6;
+    double car_v_max = 0, max_speed = 0;
+    for (int c = 0; c < ctx.num_cars; ++c) car_v_max = std::max(car_v_max, ctx.car_v[c]);
+    for (int k = 0; k < n; ++k) max_speed = std::max(max_speed, in.s_d[k]);
+    max_speed = std::max(max_speed, car_v_max);
+    const double max_reach = ctx.car_length + min_gap_ + headway_ * max_speed;
+    if (!AnyCarNear(ctx, in, same_lane, max_reach)) return 0.0;
     double sum = 0;
     for (int k = 0; k < n; ++k) {
       double worst = 0;
-      for (int c = 0; c < ctx.num_cars; ++c) {
-        if (std::abs(ctx.car_d[c] - in.d[k]) > same_lane) continue;
+      // The desired gap depends on the follower: the ego for a car ahead, the car for one behind.
+      const double ego_speed = std::max(in.s_d[k], 0.0);
+      const double desired_ahead = min_gap_ + headway_ * ego_speed;
+      const double inv_ahead = 1.0 / desired_ahead;
+      // No car farther in s than a car length plus the largest desired gap can fall short.
+      const double reach = ctx.car_length + min_gap_ + headway_ * std::max(ego_speed, car_v_max);
+      ForEachCarNear(ctx, in, k, same_lane, reach, [&](int c) {
+        if (std::abs(ctx.car_d[c] - in.d[k]) > same_lane) return true;
         const double ds = ctx.car_s[c * n + k] - in.s[k];
-        const double follower_speed = ds >= 0 ? std::max(in.s_d[k], 0.0) : ctx.car_v[c];
-        const double desired = min_gap_ + headway_ * std::max(follower_speed, 0.0);
         const double gap = std::abs(ds) - ctx.car_length;
-        if (gap >= desired) continue;
-        const double shortfall = std::min((desired - gap) / desired, 3.0);
+        double ratio;  // gap / desired gap
+        if (ds >= 0) {
+          ratio = gap * inv_ahead;
+        } else {
+          ratio = gap / (min_gap_ + headway_ * std::max(ctx.car_v[c], 0.0));
+        }
+        const double shortfall = std::clamp(1.0 - ratio, 0.0, 3.0);
         worst = std::max(worst, shortfall * shortfall);
-      }
+        return true;
+      });
       sum += worst;
     }
     return sum / n;

@@ -25,18 +25,32 @@ class CollisionCost : public CostTerm {
     const double hl = 0.5 * ctx.car_length + margin_, hw = 0.5 * ctx.car_width + margin_;
     // Cheap reject first: no overlap is possible beyond the boxes' circumscribed reach.
     const double reach = 2.0 * std::hypot(hl, hw);
+    if (!AnyCarNear(ctx, in, hl + 2.0 * hw, reach)) return 0.0;
     double sum = 0;
     for (int k = 0; k < n; ++k) {
+      // Ego heading from the Frenet velocity (s' floored: no spin at rest). Its lateral
+      // half-extent plus the car's half-width is at most hl |sin| + 2 hw, and |sin| <= |d'|/s'.
+      const double vs = std::max(in.s_d[k], 0.5), vd = in.d_d[k];
+      const double lateral = hl * std::min(1.0, std::abs(vd) / vs) + 2.0 * hw;
+      double ch = 0, sh = 0;  // unit heading, computed for the first car within reach
       bool hit = false;
-      for (int c = 0; c < ctx.num_cars && !hit; ++c) {
-        const double ds = ctx.car_s[c * n + k] - in.s[k];
-        const double dd = ctx.car_d[c] - in.d[k];
-        if (std::abs(ds) > reach || std::abs(dd) > reach) continue;
-        const traj::OrientedBox ego{in.s[k], in.d[k], std::atan2(in.d_d[k], std::max(in.s_d[k], 0.5)),
-                                    hl, hw};
-        const traj::OrientedBox car{ctx.car_s[c * n + k], ctx.car_d[c], 0.0, hl, hw};
-        hit = traj::Overlap(ego, car);
-      }
+      ForEachCarNear(ctx, in, k, lateral, reach, [&](int c) {
+        const double ds = ctx.car_s[c * n + k] - in.s[k], dd = ctx.car_d[c] - in.d[k];
+        if (std::abs(ds) > reach || std::abs(dd) > reach) return true;
+        if (ch == 0) {
+          const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+          ch = vs * inv;
+          sh = vd * inv;
+        }
+        // The car's own axes first (two of the four separating axes, the ones that part most
+        // pairs); the full test only when both overlap.
+        const double ex = hl * ch + hw * std::abs(sh), ey = hl * std::abs(sh) + hw * ch;
+        if (std::abs(ds) > ex + hl || std::abs(dd) > ey + hw) return true;
+        const traj::OrientedBox ego{in.s[k], in.d[k], 0.0, hl, hw};
+        const traj::OrientedBox car{in.s[k] + ds, in.d[k] + dd, 0.0, hl, hw};
+        hit = traj::Overlap(ego, ch, sh, car, 1.0, 0.0);
+        return !hit;
+      });
       if (hit) sum += 1.0 / (1.0 + k * ctx.dt / time_scale_);
     }
     return sum / n;

@@ -11,16 +11,22 @@ constexpr int kBlock = 10;  // ticks per acceleration sample (0.2 s)
 constexpr int kJerkBlocks = 5;  // acceleration samples per jerk sample (1 s)
 
 // Menger curvature of three points as the simulator computes it: 2 sin(theta) / |p3 - p1|.
+// Squared lengths and one square root: the path coordinates are far from overflow, so
+// std::hypot's care (and cost) is not needed.
 double Menger(double x1, double y1, double x2, double y2, double x3, double y3) {
   const double ax = x2 - x1, ay = y2 - y1, bx = x3 - x2, by = y3 - y2;
-  const double la = std::hypot(ax, ay), lb = std::hypot(bx, by);
-  if (la == 0 || lb == 0) return 0.0;
+  const double la2 = ax * ax + ay * ay, lb2 = bx * bx + by * by;
+  if (la2 == 0 || lb2 == 0) return 0.0;
   const double cross = ax * by - ay * bx, dot = ax * bx + ay * by;
-  if (std::abs(cross) < 1e-12 * la * lb && dot < 0) return 1e6;  // reversal
-  const double chord = std::hypot(x3 - x1, y3 - y1);
-  if (chord == 0) return 1e6;
-  return 2.0 * std::abs(cross) / (la * lb) / chord;
+  const double lalb = std::sqrt(la2 * lb2);
+  if (std::abs(cross) < 1e-12 * lalb && dot < 0) return 1e6;  // reversal
+  const double cx = x3 - x1, cy = y3 - y1;
+  const double chord2 = cx * cx + cy * cy;
+  if (chord2 == 0) return 1e6;
+  return 2.0 * std::abs(cross) / (lalb * std::sqrt(chord2));
 }
+
+double Norm(double x, double y) { return std::sqrt(x * x + y * y); }
 
 }  // namespace
 
@@ -35,7 +41,7 @@ XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first)
   first = std::clamp(first, 1, n - 1);
   // v_[i]: speed at tick i (from i-1); kappa_[i]: Menger curvature of (i-1, i, i+1).
   v_[0] = 0;
-  for (int i = 1; i < n; ++i) v_[i] = std::hypot(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
+  for (int i = 1; i < n; ++i) v_[i] = Norm(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
   kappa_[0] = 0;
   kappa_[n - 1] = 0;
   for (int i = 1; i + 1 < n; ++i) {
@@ -58,7 +64,7 @@ XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first)
   for (int j = a0; j < n; ++j) {
     const double vm = vmean(j), vp = vmean(j - kBlock);
     const double at = (vm - vp) / (kBlock * kDt), an = vm * vm * kmean(j);
-    acc_[j] = std::hypot(at, an);
+    acc_[j] = Norm(at, an);
     if (j >= first) m.max_accel = std::max(m.max_accel, acc_[j]);
   }
   // Jerk from 1 s means of the acceleration samples, block-aligned with j.

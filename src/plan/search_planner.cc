@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 
 #include "frenetic/plan/feasibility.h"
 #include "frenetic/plan/predictor.h"
@@ -27,6 +28,13 @@ constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s
 // m: cars closer than this (map frame) decide whether the last plan may be reused. Farther cars
 // cannot reach the ego's path within the few ticks a reused plan covers before the next search.
 constexpr double kRelevantRange = 120.0;
+// m: reaches of the cost terms' broad-phase masks (cost::ForEachCarNear), tighter first.
+// Laterally: the buffer term's same-lane test; the collision term's boxes up to a ~20 degree
+// heading. Longitudinally: the collision term's boxes; the buffer term's desired gap up to
+// ~50 m. A term that needs more reach falls back to examining every car.
+constexpr double kNearLateral[2] = {3.2, 4.5};
+constexpr double kNearLongitudinal[2] = {8.0, 60.0};
+constexpr int kMaxCars = 64;  // one bit each in the broad-phase masks
 
 double MsSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -162,11 +170,14 @@ class SearchPlanner : public Planner {
     cand_lat_.reserve(max_lon * max_lat);
     cand_cost_.reserve(max_lon * max_lat);
     order_.reserve(max_lon * max_lat);
-    const int max_cars = 64;
-    car_s_.assign(max_cars * n_samples_, 0.0);
-    car_d_.assign(max_cars, 0.0);
-    car_v_.assign(max_cars, 0.0);
-    car_s0_.assign(max_cars, 0.0);
+    car_s_.assign(kMaxCars * n_samples_, 0.0);
+    car_d_.assign(kMaxCars, 0.0);
+    car_v_.assign(kMaxCars, 0.0);
+    car_s0_.assign(kMaxCars, 0.0);
+    lat_near_.assign(2 * max_lat * n_samples_, 0);
+    lon_near_.assign(2 * max_lon * n_samples_, 0);
+    ref_near_lat_.assign(2 * n_samples_, 0);
+    ref_near_lon_.assign(2 * n_samples_, 0);
     prev_s_.assign(n_samples_, 0.0);
     prev_d_.assign(n_samples_, 0.0);
     for (auto* v : {&ref_s_, &ref_sd_, &ref_sdd_, &ref_d_, &ref_dd_, &ref_ddd_}) {
@@ -557,7 +568,7 @@ class SearchPlanner : public Planner {
     // (the simulator's traffic brakes for the car ahead).
     const auto cars = predictor_->cars();
     int nc = 0;
-    for (int i = 0; i < static_cast<int>(cars.size()) && nc < 64; ++i) {
+    for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
       const TrackedCar& car = cars[i];
       if (car.s < -cfg_.car_length && std::abs(car.d - start_.d) < 0.5 * cfg_.lane_width) continue;
       car_d_[nc] = car.d;
@@ -569,6 +580,10 @@ class SearchPlanner : public Planner {
       ++nc;
     }
     c.num_cars = nc;
+    c.near_lateral[0] = kNearLateral[0];
+    c.near_lateral[1] = kNearLateral[1];
+    c.near_longitudinal[0] = kNearLongitudinal[0];
+    c.near_longitudinal[1] = kNearLongitudinal[1];
     c.car_s = car_s_.data();
     c.car_d = car_d_.data();
     c.car_v = car_v_.data();
@@ -587,6 +602,7 @@ class SearchPlanner : public Planner {
       lon_sd_[i * n_samples_ + k] = st.v;
       lon_sdd_[i * n_samples_ + k] = st.a;
     }
+    NearLon(lon_s_.data() + i * n_samples_, lon_near_.data() + 2 * i * n_samples_);
   }
 
   void AddLat(const LatTraj& l) {
@@ -599,6 +615,33 @@ class SearchPlanner : public Planner {
       lat_d_[i * n_samples_ + k] = st.p;
       lat_dd_[i * n_samples_ + k] = st.v;
       lat_ddd_[i * n_samples_ + k] = st.a;
+    }
+    NearLat(lat_d_.data() + i * n_samples_, lat_near_.data() + 2 * i * n_samples_);
+  }
+
+  // Broad phase of the cost terms (cost::CostInput::near_lat, near_lon): which cars are within
+  // each reach of d[k] (near[0..n) and near[n..2n)), and of s[k].
+  void NearLat(const double* d, std::uint64_t* near) const {
+    NearMasks(d, kNearLateral, near, [this](int c, int) { return car_d_[c]; });
+  }
+  void NearLon(const double* s, std::uint64_t* near) const {
+    NearMasks(s, kNearLongitudinal, near,
+              [this](int c, int k) { return car_s_[c * n_samples_ + k]; });
+  }
+  // Bit c of near[k] (of near[n + k]) when |car_at(c, k) - x[k]| < reach[0] (reach[1]).
+  // Car-major, so that the inner loop over samples vectorises.
+  template <typename CarAt>
+  void NearMasks(const double* x, const double reach[2], std::uint64_t* near,
+                 CarAt car_at) const {
+    const int n = n_samples_;
+    std::fill(near, near + 2 * n, 0);
+    for (int c = 0; c < ctx_.num_cars; ++c) {
+      const std::uint64_t bit = std::uint64_t{1} << c;
+      for (int k = 0; k < n; ++k) {
+        const double dist = std::abs(car_at(c, k) - x[k]);
+        near[k] |= dist < reach[0] ? bit : 0;
+        near[n + k] |= dist < reach[1] ? bit : 0;
+      }
     }
   }
 
@@ -730,6 +773,10 @@ class SearchPlanner : public Planner {
     in.end_d = lat_d_[oj + n_samples_ - 1];
     in.target_lane = lat_[j].lane;
     in.kind = lon_[i].kind;
+    in.near_lat[0] = lat_near_.data() + 2 * oj;
+    in.near_lat[1] = lat_near_.data() + 2 * oj + n_samples_;
+    in.near_lon[0] = lon_near_.data() + 2 * oi;
+    in.near_lon[1] = lon_near_.data() + 2 * oi + n_samples_;
     return in;
   }
 
@@ -832,7 +879,9 @@ class SearchPlanner : public Planner {
     for (int i = step; i <= n_ticks_; i += step) {
       const double t = i * kTickSeconds;
       const FrenetState st = state_at(i);
-      const traj::OrientedBox ego{st.s, st.d, std::atan2(st.d_d, std::max(st.s_d, 0.5)), hl, hw};
+      const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
+      const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+      const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
       for (int c = 0; c < ctx_.num_cars; ++c) {
         const double cs = car_s0_[c] + car_v_[c] * (t + t_keep_);
         // A car behind in another lane than the start's is one the ego would cut in front of:
@@ -843,7 +892,7 @@ class SearchPlanner : public Planner {
         const double margin = behind_other_lane ? cfg_.margin_behind : cfg_.margin_s;
         if (std::abs(cs - ego.cx) > 8 + margin || std::abs(car_d_[c] - ego.cy) > 5) continue;
         const traj::OrientedBox car{cs, car_d_[c], 0.0, hl + margin, hw + cfg_.margin_d};
-        if (traj::Overlap(ego, car)) return true;
+        if (traj::Overlap(ego, vs * inv, vd * inv, car, 1.0, 0.0)) return true;
       }
     }
     return false;
@@ -959,6 +1008,12 @@ class SearchPlanner : public Planner {
     in.end_d = ref_d_[n_samples_ - 1];
     in.target_lane = dbase.lane;
     in.kind = lbase.kind;
+    NearLat(ref_d_.data(), ref_near_lat_.data());
+    NearLon(ref_s_.data(), ref_near_lon_.data());
+    in.near_lat[0] = ref_near_lat_.data();
+    in.near_lat[1] = ref_near_lat_.data() + n_samples_;
+    in.near_lon[0] = ref_near_lon_.data();
+    in.near_lon[1] = ref_near_lon_.data() + n_samples_;
     return in;
   }
 
@@ -1179,6 +1234,8 @@ class SearchPlanner : public Planner {
   std::vector<int> cand_lon_, cand_lat_, order_;
   std::vector<double> cand_cost_;
   std::vector<double> car_s_, car_d_, car_v_, car_s0_;
+  // Broad-phase masks (cost::CostInput::near_lat, near_lon).
+  std::vector<std::uint64_t> lat_near_, lon_near_, ref_near_lat_, ref_near_lon_;
   std::vector<double> prev_s_, prev_d_;
   std::vector<double> ref_s_, ref_sd_, ref_sdd_, ref_d_, ref_dd_, ref_ddd_;
   std::vector<double> tk_s_, tk_sd_, tk_sdd_, tk_d_, tk_dd_, tk_ddd_;

@@ -13,8 +13,12 @@ double Radius(const OrientedBox& b, double c, double s, double ux, double uy) {
 }  // namespace
 
 bool Overlap(const OrientedBox& a, const OrientedBox& b) {
-  const double ca = std::cos(a.heading), sa = std::sin(a.heading);
-  const double cb = std::cos(b.heading), sb = std::sin(b.heading);
+  return Overlap(a, std::cos(a.heading), std::sin(a.heading), b, std::cos(b.heading),
+                 std::sin(b.heading));
+}
+
+bool Overlap(const OrientedBox& a, double ca, double sa, const OrientedBox& b, double cb,
+             double sb) {
   const double dx = b.cx - a.cx, dy = b.cy - a.cy;
   // The four candidate separating axes are the boxes' own edge normals.
   const double axes[4][2] = {{ca, sa}, {-sa, ca}, {cb, sb}, {-sb, cb}};

@@ -1,6 +1,7 @@
 // Every registered cost term through the same property checks, and the registry against
 // config/planner.yaml.
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <set>
 #include <string>
@@ -149,6 +150,42 @@ TEST_P(CostContractTest, FiniteNonNegativeAndDeterministic) {
     ASSERT_GE(a, 0.0) << "case " << i;
     ASSERT_EQ(a, b) << "case " << i;
   }
+}
+
+// The planner's broad-phase masks (CostInput::near_lat / near_lon) only speed a term up: with
+// masks of any reach built as documented, every term returns exactly what it returns without.
+TEST_P(CostContractTest, BroadPhaseMasksDoNotChangeTheValue) {
+  auto term = Make();
+  std::mt19937 rng(4321);
+  std::uniform_real_distribution<double> u(0, 1);
+  int with_cars = 0;
+  for (int i = 0; i < 2000; ++i) {
+    Fixture f = RandomFixture(rng);
+    const double plain = term->Evaluate(f.ctx, f.in);
+    // Reaches from tight to loose, so that terms sometimes use a mask and sometimes fall back.
+    const double lat[2] = {1 + 3 * u(rng), 4 + 4 * u(rng)};
+    const double lon[2] = {2 + 10 * u(rng), 12 + 60 * u(rng)};
+    std::vector<std::uint64_t> near_lat(2 * kN, 0), near_lon(2 * kN, 0);
+    for (int c = 0; c < f.ctx.num_cars; ++c) {
+      for (int k = 0; k < kN; ++k) {
+        const double dd = std::abs(f.car_d[c] - f.d[k]);
+        const double ds = std::abs(f.car_s[c * kN + k] - f.s[k]);
+        for (int m = 0; m < 2; ++m) {
+          if (dd < lat[m]) near_lat[m * kN + k] |= std::uint64_t{1} << c;
+          if (ds < lon[m]) near_lon[m * kN + k] |= std::uint64_t{1} << c;
+        }
+      }
+    }
+    for (int m = 0; m < 2; ++m) {
+      f.ctx.near_lateral[m] = lat[m];
+      f.ctx.near_longitudinal[m] = lon[m];
+      f.in.near_lat[m] = near_lat.data() + m * kN;
+      f.in.near_lon[m] = near_lon.data() + m * kN;
+    }
+    with_cars += f.ctx.num_cars > 0 && plain > 0;
+    ASSERT_EQ(term->Evaluate(f.ctx, f.in), plain) << "case " << i;
+  }
+  EXPECT_GT(with_cars, 0);
 }
 
 TEST_P(CostContractTest, NearZeroOnIdealLaneKeeping) {

@@ -5,6 +5,8 @@
 // FRENETIC_REGISTER_COST (cost_registry.h).
 #pragma once
 
+#include <bit>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -44,6 +46,9 @@ struct CostContext {
   const double* car_d = nullptr;
   const double* car_v = nullptr;
   double car_length = 4.8, car_width = 2.4;  // footprint of every car, ego included, m
+  // Reaches of the broad-phase masks in CostInput (m), tighter first: see ForEachCarNear.
+  double near_lateral[2] = {0, 0};
+  double near_longitudinal[2] = {0, 0};
 };
 
 enum class LonKind : int { kVelocityKeeping = 0, kFollowing = 1, kStopping = 2 };
@@ -63,7 +68,62 @@ struct CostInput {
   double end_d = 0;      // m
   int target_lane = 0;
   LonKind kind = LonKind::kVelocityKeeping;
+  // Optional broad phase (nullptr: none). Bit c of near_lat[m][k] is set for every car c < 64
+  // with |ctx.car_d[c] - d[k]| < ctx.near_lateral[m], bit c of near_lon[m][k] for every car with
+  // |ctx.car_s[c * n + k] - s[k]| < ctx.near_longitudinal[m]. Each depends on one motion only,
+  // so the planner computes them once per lateral or longitudinal trajectory, not per candidate.
+  const std::uint64_t* near_lat[2] = {nullptr, nullptr};
+  const std::uint64_t* near_lon[2] = {nullptr, nullptr};
 };
+
+namespace internal {
+// The tightest of two masks whose reach exceeds `reach`, or nullptr.
+inline const std::uint64_t* Mask(const std::uint64_t* const masks[2], const double reaches[2],
+                                 double reach) {
+  for (int i = 0; i < 2; ++i) {
+    if (masks[i] != nullptr && reach < reaches[i]) return masks[i];
+  }
+  return nullptr;
+}
+}  // namespace internal
+
+// Calls fn(c) for every car c that may lie within `lateral` metres in d and `longitudinal`
+// metres in s of the candidate at sample k, until fn returns false: the cars of the tightest
+// broad-phase masks that cover those reaches, else every car. A superset: terms still apply
+// their exact test. Cars are visited in index order either way.
+template <typename Fn>
+inline void ForEachCarNear(const CostContext& ctx, const CostInput& in, int k, double lateral,
+                           double longitudinal, Fn&& fn) {
+  const std::uint64_t* lat = internal::Mask(in.near_lat, ctx.near_lateral, lateral);
+  const std::uint64_t* lon = internal::Mask(in.near_lon, ctx.near_longitudinal, longitudinal);
+  if (lat == nullptr && lon == nullptr) {
+    for (int c = 0; c < ctx.num_cars; ++c) {
+      if (!fn(c)) return;
+    }
+    return;
+  }
+  std::uint64_t m = ~std::uint64_t{0};
+  if (lat != nullptr) m &= lat[k];
+  if (lon != nullptr) m &= lon[k];
+  for (; m != 0; m &= m - 1) {
+    if (!fn(std::countr_zero(m))) return;
+  }
+}
+
+// Whether ForEachCarNear could visit any car at any sample, for reaches that hold at every
+// sample: lets a term skip its per-sample work for candidates far from all traffic.
+inline bool AnyCarNear(const CostContext& ctx, const CostInput& in, double lateral,
+                       double longitudinal) {
+  if (ctx.num_cars == 0) return false;
+  const std::uint64_t* lat = internal::Mask(in.near_lat, ctx.near_lateral, lateral);
+  const std::uint64_t* lon = internal::Mask(in.near_lon, ctx.near_longitudinal, longitudinal);
+  if (lat == nullptr && lon == nullptr) return true;
+  std::uint64_t any = 0;
+  for (int k = 0; k < ctx.num_samples; ++k) {
+    any |= (lat != nullptr ? lat[k] : ~std::uint64_t{0}) & (lon != nullptr ? lon[k] : ~std::uint64_t{0});
+  }
+  return any != 0;
+}
 
 // A tunable parameter a term declares, with its default and a sensible range.
 struct CostParamSpec {

@@ -14,5 +14,9 @@ struct OrientedBox {
 
 // True when the boxes overlap (touching counts). Never fails; NaN input gives false.
 bool Overlap(const OrientedBox& a, const OrientedBox& b);
+// The same with each box's heading given as its unit direction (cos, sin): no trigonometry,
+// for hot loops that know the direction as a velocity vector. `heading` fields are ignored.
+bool Overlap(const OrientedBox& a, double cos_a, double sin_a, const OrientedBox& b,
+             double cos_b, double sin_b);
 
 }  // namespace frenetic::traj
