@@ -125,17 +125,24 @@ void Size(const GridShape& g, Bundles* b) {
 
 // Traffic for the cost context: `vehicles` cars over three lanes, -60 m ... +200 m around s0.
 struct Traffic {
-  std::vector<double> s, d, v;
+  std::vector<double> s, d, v;        // s per sample; d and v per car
+  std::vector<double> d_at, v_at;     // d and v per sample (the cost context's layout)
   void Make(int vehicles, double s0) {
     s.assign(vehicles * kSamples, 0.0);
     d.assign(vehicles, 0.0);
     v.assign(vehicles, 0.0);
+    d_at.assign(vehicles * kSamples, 0.0);
+    v_at.assign(vehicles * kSamples, 0.0);
     for (int c = 0; c < vehicles; ++c) {
       const double u = std::fmod(0.5 + c * 0.6180339887498949, 1.0);
       d[c] = 2.0 + 4.0 * (c % 3);
       v[c] = 15.0 + (c % 7);
       const double sc = s0 - 60.0 + 260.0 * u;
-      for (int k = 0; k < kSamples; ++k) s[c * kSamples + k] = sc + v[c] * k * kScoreDt;
+      for (int k = 0; k < kSamples; ++k) {
+        s[c * kSamples + k] = sc + v[c] * k * kScoreDt;
+        d_at[c * kSamples + k] = d[c];
+        v_at[c * kSamples + k] = v[c];
+      }
     }
   }
 };
@@ -156,8 +163,8 @@ cost::CostContext Context(const traj::FrenetState& s0, const Traffic& tr) {
   c.previous_target_lane = 1;
   c.num_cars = static_cast<int>(tr.d.size());
   c.car_s = tr.s.data();
-  c.car_d = tr.d.data();
-  c.car_v = tr.v.data();
+  c.car_d = tr.d_at.data();
+  c.car_v = tr.v_at.data();
   return c;
 }
 

@@ -23,10 +23,9 @@ class BufferCost : public CostTerm {
     if (n == 0 || ctx.num_cars == 0) return 0.0;
     // Same lane: the centres are closer laterally than a car width plus a little.
     const double same_lane = ctx.car_width + 0.6;
-    double car_v_max = 0, max_speed = 0;
-    for (int c = 0; c < ctx.num_cars; ++c) car_v_max = std::max(car_v_max, ctx.car_v[c]);
+    const double car_v_max = ctx.max_car_speed;
+    double max_speed = car_v_max;
     for (int k = 0; k < n; ++k) max_speed = std::max(max_speed, in.s_d[k]);
-    max_speed = std::max(max_speed, car_v_max);
     const double max_reach = ctx.car_length + min_gap_ + headway_ * max_speed;
     if (!AnyCarNear(ctx, in, same_lane, max_reach)) return 0.0;
     double sum = 0;
@@ -39,14 +38,14 @@ class BufferCost : public CostTerm {
       // No car farther in s than a car length plus the largest desired gap can fall short.
       const double reach = ctx.car_length + min_gap_ + headway_ * std::max(ego_speed, car_v_max);
       ForEachCarNear(ctx, in, k, same_lane, reach, [&](int c) {
-        if (std::abs(ctx.car_d[c] - in.d[k]) > same_lane) return true;
+        if (std::abs(ctx.car_d[c * n + k] - in.d[k]) > same_lane) return true;
         const double ds = ctx.car_s[c * n + k] - in.s[k];
         const double gap = std::abs(ds) - ctx.car_length;
         double ratio;  // gap / desired gap
         if (ds >= 0) {
           ratio = gap * inv_ahead;
         } else {
-          ratio = gap / (min_gap_ + headway_ * std::max(ctx.car_v[c], 0.0));
+          ratio = gap / (min_gap_ + headway_ * std::max(ctx.car_v[c * n + k], 0.0));
         }
         const double shortfall = std::clamp(1.0 - ratio, 0.0, 3.0);
         worst = std::max(worst, shortfall * shortfall);

@@ -35,7 +35,7 @@ class CollisionCost : public CostTerm {
       double ch = 0, sh = 0;  // unit heading, computed for the first car within reach
       bool hit = false;
       ForEachCarNear(ctx, in, k, lateral, reach, [&](int c) {
-        const double ds = ctx.car_s[c * n + k] - in.s[k], dd = ctx.car_d[c] - in.d[k];
+        const double ds = ctx.car_s[c * n + k] - in.s[k], dd = ctx.car_d[c * n + k] - in.d[k];
         if (std::abs(ds) > reach || std::abs(dd) > reach) return true;
         if (ch == 0) {
           const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);

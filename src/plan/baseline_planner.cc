@@ -94,7 +94,8 @@ class BaselinePlanner : public Planner {
     const double horizon = prev_size * kTickSeconds;
 
     // Gaps per lane at the end of the previous path: free room ahead and behind.
-    predictor_->Observe(t.sensor_fusion, end_s);
+    // The seeds' planner looks at speeds only (constant velocity): no elapsed time needed.
+    predictor_->Observe(t.sensor_fusion, end_s, 0.0);
     double ahead[8], behind[8], lead_speed[8];
     for (int l = 0; l < num_lanes_ && l < 8; ++l) {
       ahead[l] = behind[l] = 1e9;
@@ -104,8 +105,7 @@ class BaselinePlanner : public Planner {
     for (int i = 0; i < static_cast<int>(cars.size()); ++i) {
       const int l = static_cast<int>(std::floor(cars[i].d / lane_width_));
       if (l < 0 || l >= num_lanes_ || l >= 8) continue;
-      double s, d;
-      predictor_->Predict(i, horizon, &s, &d);  // s relative to end_s
+      const double s = predictor_->Predict(i, horizon).s;  // relative to end_s
       if (s >= 0 && s < ahead[l]) {
         ahead[l] = s;
         lead_speed[l] = cars[i].v_s;

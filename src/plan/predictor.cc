@@ -1,22 +1,29 @@
 #include "frenetic/plan/predictor.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace frenetic::plan {
 namespace {
 
 constexpr double kMphPerMps = 2.2369362920544;
+// m: a reading this far from where the previous one predicted it is another car (a respawn
+// teleports an id, udacity-sim.md §8.2): its acceleration is not estimated.
+constexpr double kRespawnJump = 15.0;
+// s: an older reading says little about the current acceleration (a queued car's brake/throttle
+// cycle is about a second long).
+constexpr double kMaxReadingAge = 0.5;
 
-class ConstantVelocityPredictor : public Predictor {
+class TrafficPredictor : public Predictor {
  public:
-  ConstantVelocityPredictor(std::shared_ptr<const map::ReferenceLine> line,
-                            const PredictorOptions& options)
-      : line_(std::move(line)), options_(options) {
+  TrafficPredictor(std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options,
+                   bool manoeuvres)
+      : line_(std::move(line)), options_(options), manoeuvres_(manoeuvres) {
     cars_.reserve(options_.max_cars);
     memory_.reserve(options_.max_cars);
   }
 
-  void Observe(std::span<const SensorCar> rows, double ego_s) override {
+  void Observe(std::span<const SensorCar> rows, double ego_s, double now) override {
     cars_.clear();
     if (!std::isfinite(ego_s)) return;
     for (const SensorCar& row : rows) {
@@ -34,18 +41,59 @@ class ConstantVelocityPredictor : public Predictor {
       const double rel = line_->DiffS(f.s, line_->WrapS(ego_s));
       if (std::abs(rel) > options_.range) continue;
       const double heading = line_->At(f.s).heading;
-      double v = row.vx * std::cos(heading) + row.vy * std::sin(heading);
-      v = Repair(row.id, v);
-      cars_.push_back({row.id, rel, f.d, v});
+      const double ch = std::cos(heading), sh = std::sin(heading);
+      TrackedCar car;
+      car.id = row.id;
+      car.s = rel;
+      car.d = f.d;
+      // Along the lane and across it (the right normal is (sin h, -cos h)).
+      double v = row.vx * ch + row.vy * sh;
+      double v_d = row.vx * sh - row.vy * ch;
+      Memory* m = Find(row.id);
+      if (IsSpawnGlitch(m, v)) {
+        // The spawn glitch reports the speed in mph as if it were m/s for one message: use the
+        // id's previous speed, or undo the unit slip.
+        v = m != nullptr ? m->v : std::min(v / kMphPerMps, options_.max_speed);
+        v_d = 0;
+      } else {
+        car.a_s = Acceleration(m, f.s, v, now);
+        Remember(m, row.id, f.s, v, now);
+      }
+      car.v_s = v;
+      car.v_d = v_d;
+      car.d_target = manoeuvres_ ? LateralTarget(car.d, v_d) : car.d;
+      if (!manoeuvres_) car.a_s = 0;
+      cars_.push_back(car);
     }
   }
 
   std::span<const TrackedCar> cars() const override { return cars_; }
 
-  void Predict(int i, double t, double* s, double* d) const override {
+  Prediction Predict(int i, double t) const override {
     const TrackedCar& c = cars_[i];
-    *s = c.s + c.v_s * t;
-    *d = c.d;
+    Prediction p;
+    p.s = c.s;
+    p.v = c.v_s;
+    if (c.a_s < -options_.brake_threshold) {
+      // Braking at a_s for tb, then at the reached speed (never backwards).
+      const double tb = std::clamp(std::min(options_.brake_horizon, c.v_s / -c.a_s), 0.0, t);
+      p.s += c.v_s * tb + 0.5 * c.a_s * tb * tb;
+      p.v = std::max(0.0, c.v_s + c.a_s * tb);
+      p.s += p.v * (t - tb);
+    } else {
+      p.s += c.v_s * t;
+    }
+    p.d = c.d;
+    if (c.d_target != c.d && c.v_d != 0) {
+      const double reach = (c.d_target - c.d) / c.v_d;  // s until the target lane's centre
+      if (t < reach) {
+        p.d = c.d + c.v_d * t;
+        p.v_d = c.v_d;
+      } else {
+        p.d = c.d_target;
+      }
+    }
+    return p;
   }
 
   void Reset() override {
@@ -54,32 +102,59 @@ class ConstantVelocityPredictor : public Predictor {
   }
 
  private:
-  // The spawn glitch reports the speed in mph as if it were m/s for one message: use the id's
-  // previous speed, or undo the unit slip, and remember good readings.
-  double Repair(int id, double v) {
-    Memory* m = nullptr;
-    for (Memory& e : memory_) {
-      if (e.id == id) m = &e;
-    }
-    const bool glitch_ratio = m != nullptr && m->v > 1.0 && v > options_.spike_ratio * m->v;
-    if (v > options_.max_speed || glitch_ratio) {
-      v = m != nullptr ? m->v : std::min(v / kMphPerMps, options_.max_speed);
-      return v;
-    }
-    if (m != nullptr) {
-      m->v = v;
-    } else if (static_cast<int>(memory_.size()) < options_.max_cars) {
-      memory_.push_back({id, v});
-    }
-    return v;
-  }
-
   struct Memory {
     int id;
+    double s;  // line s of the reading (wrapped)
     double v;
+    double time;  // s, `now` of the reading (NaN: unknown)
   };
+
+  Memory* Find(int id) {
+    for (Memory& e : memory_) {
+      if (e.id == id) return &e;
+    }
+    return nullptr;
+  }
+
+  bool IsSpawnGlitch(const Memory* m, double v) const {
+    const bool glitch_ratio = m != nullptr && m->v > 1.0 && v > options_.spike_ratio * m->v;
+    return v > options_.max_speed || glitch_ratio;
+  }
+
+  // Longitudinal acceleration from the id's previous reading, when that is recent, or 0.
+  double Acceleration(const Memory* m, double s, double v, double now) const {
+    if (m == nullptr) return 0.0;
+    const double dt = now - m->time;  // NaN when either time is unknown
+    if (!(dt > 0 && dt <= kMaxReadingAge)) return 0.0;
+    const double expected = m->s + 0.5 * (m->v + v) * dt;
+    if (std::abs(line_->DiffS(s, expected)) > kRespawnJump) return 0.0;
+    return (v - m->v) / dt;
+  }
+
+  void Remember(Memory* m, int id, double s, double v, double now) {
+    if (m == nullptr) {
+      if (static_cast<int>(memory_.size()) >= options_.max_cars) return;
+      memory_.push_back({id, s, v, now});
+      return;
+    }
+    *m = {id, s, v, now};
+  }
+
+  // The centre of the next lane in the direction of a lateral move faster than the threshold,
+  // or d itself (no move predicted, or a move away from that centre: wander).
+  double LateralTarget(double d, double v_d) const {
+    if (!(std::abs(v_d) > options_.lateral_threshold)) return d;
+    const double w = options_.lane_width;
+    const int last = std::max(options_.num_lanes, 1) - 1;
+    const double ahead = d + std::copysign(0.5 * w + 0.01, v_d);
+    const int lane = std::clamp(static_cast<int>(std::floor(ahead / w)), 0, last);
+    const double centre = (lane + 0.5) * w;
+    return (centre - d) * v_d > 0 ? centre : d;
+  }
+
   std::shared_ptr<const map::ReferenceLine> line_;
   PredictorOptions options_;
+  bool manoeuvres_;
   std::vector<TrackedCar> cars_;
   std::vector<Memory> memory_;
 };
@@ -88,7 +163,12 @@ class ConstantVelocityPredictor : public Predictor {
 
 std::unique_ptr<Predictor> MakeConstantVelocityPredictor(
     std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options) {
-  return std::make_unique<ConstantVelocityPredictor>(std::move(line), options);
+  return std::make_unique<TrafficPredictor>(std::move(line), options, false);
+}
+
+std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::ReferenceLine> line,
+                                                  const PredictorOptions& options) {
+  return std::make_unique<TrafficPredictor>(std::move(line), options, true);
 }
 
 }  // namespace frenetic::plan

@@ -47,8 +47,9 @@ struct LonTraj {
   Trajectory1d traj;
   cost::LonKind kind = cost::LonKind::kVelocityKeeping;
   int lane = -1;         // -1: usable in every lane; else only with this lane's lateral moves
-  double param = 0;      // end speed (velocity keeping), extra gap (following), distance (stop)
-  double lead_s = 0, lead_v = 0;  // following: the leader at the start instant
+  // End speed (velocity keeping), extra gap (following), distance (stop), deceleration (braking).
+  double param = 0;
+  int lead = -1;         // following: the leader's index in the predictor's cars of this cycle
   double jerk2 = 0;
 };
 
@@ -72,6 +73,8 @@ struct Settings {
   int follow_gaps;
   double follow_d0, follow_tau, follow_tau_step;
   bool stop;
+  int brake_decels, brake_targets;
+  double brake_min_decel, brake_max_decel;
   int lat_durations;
   double lat_min_duration, lat_max_duration;
   int lat_offsets;
@@ -107,6 +110,10 @@ struct Settings {
     follow_tau = c.value("grid.follow_tau");
     follow_tau_step = c.value("grid.follow_tau_step");
     stop = c.int_value("grid.stop") != 0;
+    brake_decels = c.int_value("grid.brake_decels");
+    brake_targets = c.int_value("grid.brake_targets");
+    brake_min_decel = c.value("grid.brake_min_decel");
+    brake_max_decel = c.value("grid.brake_max_decel");
     lat_durations = c.int_value("grid.lat_durations");
     lat_min_duration = c.value("grid.lat_min_duration");
     lat_max_duration = c.value("grid.lat_max_duration");
@@ -150,7 +157,14 @@ class SearchPlanner : public Planner {
     po.d_max = config.value("prediction.d_max");
     po.max_speed = config.value("prediction.max_speed");
     po.spike_ratio = config.value("prediction.spike_ratio");
-    predictor_ = MakeConstantVelocityPredictor(line_, po);
+    po.brake_threshold = config.value("prediction.brake_threshold");
+    po.brake_horizon = config.value("prediction.brake_horizon");
+    po.lateral_threshold = config.value("prediction.lateral_threshold");
+    po.lane_width = cfg_.lane_width;
+    po.num_lanes = cfg_.num_lanes;
+    predictor_ = config.int_value("prediction.manoeuvres") != 0
+                     ? MakeManoeuvrePredictor(line_, po)
+                     : MakeConstantVelocityPredictor(line_, po);
     for (int l = 0; l < cfg_.num_lanes; ++l) {
       lane_center_[l] = (l + 0.5) * cfg_.lane_width;
     }
@@ -160,8 +174,9 @@ class SearchPlanner : public Planner {
     n_ticks_ = static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds));
     n_ticks_ = std::max(n_ticks_, cfg_.output_points);
     const int max_lon = cfg_.speeds * cfg_.durations + cfg_.durations +
-                        cfg_.num_lanes * cfg_.follow_gaps * cfg_.durations + 8;
-    const int max_lat = cfg_.num_lanes * cfg_.lat_durations * cfg_.lat_offsets + 8;
+                        cfg_.num_lanes * cfg_.follow_gaps * cfg_.durations +
+                        cfg_.brake_decels * cfg_.brake_targets + 8;
+    const int max_lat = cfg_.num_lanes * (cfg_.lat_durations + 1) * cfg_.lat_offsets + 8;
     lon_.reserve(max_lon);
     lat_.reserve(max_lat);
     for (auto* v : {&lon_s_, &lon_sd_, &lon_sdd_}) v->assign(max_lon * n_samples_, 0.0);
@@ -170,10 +185,17 @@ class SearchPlanner : public Planner {
     cand_lat_.reserve(max_lon * max_lat);
     cand_cost_.reserve(max_lon * max_lat);
     order_.reserve(max_lon * max_lat);
-    car_s_.assign(kMaxCars * n_samples_, 0.0);
-    car_d_.assign(kMaxCars, 0.0);
-    car_v_.assign(kMaxCars, 0.0);
+    first_hit_.reserve(max_lon * max_lat);
+    for (auto* v : {&car_s_, &car_d_, &car_v_}) v->assign(kMaxCars * n_samples_, 0.0);
+    car_index_.assign(kMaxCars, 0);
     car_s0_.assign(kMaxCars, 0.0);
+    car_d0_.assign(kMaxCars, 0.0);
+    collision_step_ =
+        std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
+    n_steps_ = n_ticks_ / collision_step_;
+    for (auto* v : {&step_s_, &step_d_, &step_v_, &step_vd_}) {
+      v->assign(kMaxCars * (n_steps_ + 1), 0.0);
+    }
     lat_near_.assign(2 * max_lat * n_samples_, 0);
     lon_near_.assign(2 * max_lon * n_samples_, 0);
     ref_near_lat_.assign(2 * n_samples_, 0);
@@ -236,6 +258,7 @@ class SearchPlanner : public Planner {
     ticks_since_search_ = 0;
     can_reuse_ = false;
     snap_n_ = 0;
+    clock_ = NAN;
     predictor_->Reset();
   }
 
@@ -274,6 +297,9 @@ class SearchPlanner : public Planner {
       consumed = 1;
       synced = true;
     }
+    // Simulated time of this message: it dates the traffic readings for the predictor's
+    // acceleration estimates. Unknown after a resynchronisation.
+    clock_ = synced ? (std::isnan(clock_) ? 0.0 : clock_) + consumed * kTickSeconds : NAN;
     if (synced && ego_ok && CanReuse(t, consumed)) {
       ReusePlan(consumed);
       return result_;
@@ -321,11 +347,12 @@ class SearchPlanner : public Planner {
     if (have_prev_traj_) prev_elapsed_ = prev_base_ + elapsed;
 
     // Prediction (relative to the start state's s; the observation is "now").
-    predictor_->Observe(t.sensor_fusion, start.s);
+    predictor_->Observe(t.sensor_fusion, start.s, clock_);
     BuildContext();
     sum.ms_prepare = MsSince(t0_);
 
-    bool found = false;
+    bool found = false;       // a candidate passed every check
+    bool least_harm = false;  // none did: the least harmful feasible one was taken instead
     bool over_budget = false;
     if (!invalid || synced) {
       GenerateBundles();
@@ -337,6 +364,7 @@ class SearchPlanner : public Planner {
       sum.ms_score = MsSince(t0_) - t_score;
       const double t_check = MsSince(t0_);
       found = CheckLazily(&over_budget);
+      if (!found && !over_budget) least_harm = LeastHarm(&over_budget);
       sum.ms_check = MsSince(t0_) - t_check;
       if (found && cfg_.refine && opt_ != nullptr &&
           MsSince(t0_) + cfg_.refine_budget_ms < 0.8 * cfg_.budget_ms) {
@@ -346,7 +374,7 @@ class SearchPlanner : public Planner {
       }
     }
     const double t_out = MsSince(t0_);
-    if (found) {
+    if (found || least_harm) {
       FillTicks(winner_);
       sum.winner_lane = lat_[winner_lat_].lane;
       sum.winner_end_speed = winner_.lon.At(winner_.lon.duration).v;
@@ -565,21 +593,37 @@ class SearchPlanner : public Planner {
       c.previous_s = c.previous_d = nullptr;
     }
     // Traffic: relevant cars only. A car behind in the ego's own lane is its follower's problem
-    // (the simulator's traffic brakes for the car ahead).
+    // (the simulator's traffic brakes for the car ahead). Predictions are sampled once here: at
+    // the scoring samples and at the collision-check steps, t_keep_ after the observation.
     const auto cars = predictor_->cars();
     int nc = 0;
     for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
       const TrackedCar& car = cars[i];
       if (car.s < -cfg_.car_length && std::abs(car.d - start_.d) < 0.5 * cfg_.lane_width) continue;
-      car_d_[nc] = car.d;
-      car_v_[nc] = car.v_s;
-      car_s0_[nc] = start_.s + car.s;  // at the observation instant, in the start's s frame
+      car_index_[nc] = i;
+      const Predictor::Prediction at_start = predictor_->Predict(i, t_keep_);
+      car_s0_[nc] = start_.s + at_start.s;  // at the start instant, in the start's s frame
+      car_d0_[nc] = at_start.d;
       for (int k = 0; k < n_samples_; ++k) {
-        car_s_[nc * n_samples_ + k] = car_s0_[nc] + car.v_s * (k * cfg_.score_dt + t_keep_);
+        const Predictor::Prediction p = predictor_->Predict(i, t_keep_ + k * cfg_.score_dt);
+        car_s_[nc * n_samples_ + k] = start_.s + p.s;
+        car_d_[nc * n_samples_ + k] = p.d;
+        car_v_[nc * n_samples_ + k] = p.v;
+      }
+      const int row = nc * (n_steps_ + 1);
+      for (int j = 1; j <= n_steps_; ++j) {
+        const Predictor::Prediction p =
+            predictor_->Predict(i, t_keep_ + j * collision_step_ * kTickSeconds);
+        step_s_[row + j] = start_.s + p.s;
+        step_d_[row + j] = p.d;
+        step_v_[row + j] = p.v;
+        step_vd_[row + j] = p.v_d;
       }
       ++nc;
     }
     c.num_cars = nc;
+    c.max_car_speed = 0;
+    for (int i = 0; i < nc * n_samples_; ++i) c.max_car_speed = std::max(c.max_car_speed, car_v_[i]);
     c.near_lateral[0] = kNearLateral[0];
     c.near_lateral[1] = kNearLateral[1];
     c.near_longitudinal[0] = kNearLongitudinal[0];
@@ -622,7 +666,8 @@ class SearchPlanner : public Planner {
   // Broad phase of the cost terms (cost::CostInput::near_lat, near_lon): which cars are within
   // each reach of d[k] (near[0..n) and near[n..2n)), and of s[k].
   void NearLat(const double* d, std::uint64_t* near) const {
-    NearMasks(d, kNearLateral, near, [this](int c, int) { return car_d_[c]; });
+    NearMasks(d, kNearLateral, near,
+              [this](int c, int k) { return car_d_[c * n_samples_ + k]; });
   }
   void NearLon(const double* s, std::uint64_t* near) const {
     NearMasks(s, kNearLongitudinal, near,
@@ -645,14 +690,12 @@ class SearchPlanner : public Planner {
     }
   }
 
-  LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, double lead_s,
-                  double lead_v) const {
+  LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, int lead = -1) const {
     LonTraj l;
     l.kind = kind;
     l.lane = lane;
     l.param = param;
-    l.lead_s = lead_s;
-    l.lead_v = lead_v;
+    l.lead = lead;
     l.traj.duration = T;
     const FrenetState& s0 = start_;
     switch (kind) {
@@ -660,15 +703,26 @@ class SearchPlanner : public Planner {
         l.traj.poly = traj::SolveQuartic(s0.s, s0.s_d, s0.s_dd, std::max(param, 0.0), 0.0, T);
         break;
       case cost::LonKind::kFollowing: {
-        // Constant time-gap law: s_target = s_lead(T) - (D0 + tau v_lead), minus `param` more.
-        const double s_lead = lead_s + lead_v * (T + t_keep_);
-        const double target = s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_v) - param;
-        l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_v, 0.0, T);
+        // Constant time-gap law on the leader's predicted state at T:
+        // s_target = s_lead(T) - (D0 + tau v_lead(T)), minus `param` more.
+        const Predictor::Prediction lead_at = predictor_->Predict(lead, t_keep_ + T);
+        const double s_lead = start_.s + lead_at.s;
+        const double target =
+            s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param;
+        l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_at.v, 0.0, T);
         break;
       }
       case cost::LonKind::kStopping:
         l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, s0.s + std::max(param, 0.0), 0.0,
                                          0.0, T);
+        break;
+      case cost::LonKind::kBraking:
+        // Decelerate at `param` at once for T, then hold the speed reached (the trajectory's
+        // constant-velocity continuation): s0 + v0 t - param t^2 / 2.
+        l.traj.poly = {};
+        l.traj.poly.c[0] = s0.s;
+        l.traj.poly.c[1] = s0.s_d;
+        l.traj.poly.c[2] = -0.5 * param;
         break;
     }
     return l;
@@ -684,20 +738,35 @@ class SearchPlanner : public Planner {
     return l;
   }
 
-  // The nearest car ahead in `lane` at the start instant, or -1.
+  // The nearest car ahead in `lane` at the start instant (context index), or -1.
   int Leader(int lane) const {
     int best = -1;
     double best_s = 1e18;
     for (int c = 0; c < ctx_.num_cars; ++c) {
-      if (std::abs(car_d_[c] - lane_center_[lane]) > 0.6 * cfg_.lane_width) continue;
-      const double s_at_start = car_s0_[c] + car_v_[c] * t_keep_;
-      if (s_at_start <= start_.s) continue;
-      if (s_at_start < best_s) {
-        best_s = s_at_start;
+      if (std::abs(car_d0_[c] - lane_center_[lane]) > 0.6 * cfg_.lane_width) continue;
+      if (car_s0_[c] <= start_.s) continue;
+      if (car_s0_[c] < best_s) {
+        best_s = car_s0_[c];
         best = c;
       }
     }
     return best;
+  }
+
+  // Constant-deceleration braking, each level to a few lower speeds (fractions of the current
+  // one): the quick, strong braking a quintic cannot start with.
+  void AddBraking() {
+    const double v0 = std::max(start_.s_d, 0.0);
+    if (v0 < 1.0) return;
+    for (int bi = 0; bi < cfg_.brake_decels; ++bi) {
+      const double a =
+          Linspace(cfg_.brake_min_decel, cfg_.brake_max_decel, cfg_.brake_decels, bi);
+      for (int ti = 0; ti < cfg_.brake_targets; ++ti) {
+        // Target speeds from standstill up to (but not including) the current speed.
+        const double target = v0 * ti / cfg_.brake_targets;
+        AddLon(MakeLon(cost::LonKind::kBraking, -1, a, (v0 - target) / a));
+      }
+    }
   }
 
   void GenerateBundles() {
@@ -716,21 +785,20 @@ class SearchPlanner : public Planner {
         // Velocity keeping to end speeds from 0 to the fastest lane's limit.
         double vmax = 0;
         for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ctx_.lane_speed_limit[l]);
-        AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T,
-                       0, 0));
+        AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T));
       }
       if (cfg_.stop) {
-        AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start_.s_d * T, T, 0, 0));
+        AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start_.s_d * T, T));
       }
+      if (di == 0) AddBraking();
       for (int l = 0; l < cfg_.num_lanes; ++l) {
         if (!reachable[l]) continue;
         const int lead = Leader(l);
         if (lead < 0) continue;
         for (int g = 0; g < cfg_.follow_gaps; ++g) {
           // Longer time gaps are extra distance on top of the base law.
-          const double extra = g * cfg_.follow_tau_step * car_v_[lead];
-          LonTraj lt = MakeLon(cost::LonKind::kFollowing, l, extra, T, car_s0_[lead], car_v_[lead]);
-          AddLon(lt);
+          const double extra = g * cfg_.follow_tau_step * car_v_[lead * n_samples_];
+          AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, car_index_[lead]));
         }
       }
     }
@@ -742,6 +810,14 @@ class SearchPlanner : public Planner {
         for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
           const double off = (oi - cfg_.lat_offsets / 2) * cfg_.lat_offset_step;
           AddLat(MakeLat(l, off, T));
+        }
+      }
+      // The lateral move under way, to its planned end time: replanning with full durations
+      // every cycle would stretch a lane change indefinitely (more time astride the line).
+      if (have_prev_traj_ && l == prev_lat_lane_) {
+        const double remaining = prev_traj_.lat.duration - prev_elapsed_;
+        if (remaining > 0.3 && remaining < cfg_.lat_min_duration - 0.05) {
+          AddLat(MakeLat(l, prev_lat_offset_, remaining));
         }
       }
     }
@@ -863,39 +939,45 @@ class SearchPlanner : public Planner {
 
   // Oriented-box overlap with every relevant car over the check horizon (inflated boxes).
   bool Collides() const {
-    return CollidesAt([this](int i) {
+    return FirstCollision([this](int i) {
       return FrenetState{tk_s_[i], tk_sd_[i], 0.0, tk_d_[i], tk_dd_[i], 0.0};
-    });
+    }, 1.0) <= n_steps_;
   }
   // The same test evaluating the polynomials only at the collision steps: most rejected
   // candidates fail here, so they never pay for the full tick sampling.
   bool Collides(const FrenetTrajectory& tr) const {
-    return CollidesAt([&tr](int i) { return tr.At(i * kTickSeconds); });
+    return FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0) <= n_steps_;
   }
+  // The first collision step (1..n_steps_) of `state_at` (state at a tick index), or
+  // n_steps_ + 1 when none; the safety margins are scaled by margin_scale (0: bare boxes).
   template <typename StateAt>
-  bool CollidesAt(StateAt state_at) const {
-    const int step = std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
+  int FirstCollision(StateAt state_at, double margin_scale) const {
     const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
-    for (int i = step; i <= n_ticks_; i += step) {
-      const double t = i * kTickSeconds;
-      const FrenetState st = state_at(i);
+    for (int j = 1; j <= n_steps_; ++j) {
+      const FrenetState st = state_at(j * collision_step_);
       const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
       const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
       const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
       for (int c = 0; c < ctx_.num_cars; ++c) {
-        const double cs = car_s0_[c] + car_v_[c] * (t + t_keep_);
+        const int at = c * (n_steps_ + 1) + j;
+        const double cs = step_s_[at], cd = step_d_[at];
         // A car behind in another lane than the start's is one the ego would cut in front of:
         // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
         // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
         const bool behind_other_lane =
-            cs < ego.cx && std::abs(car_d_[c] - start_.d) > 0.5 * cfg_.lane_width;
-        const double margin = behind_other_lane ? cfg_.margin_behind : cfg_.margin_s;
-        if (std::abs(cs - ego.cx) > 8 + margin || std::abs(car_d_[c] - ego.cy) > 5) continue;
-        const traj::OrientedBox car{cs, car_d_[c], 0.0, hl + margin, hw + cfg_.margin_d};
-        if (traj::Overlap(ego, vs * inv, vd * inv, car, 1.0, 0.0)) return true;
+            cs < ego.cx && std::abs(car_d0_[c] - start_.d) > 0.5 * cfg_.lane_width;
+        const double margin =
+            margin_scale * (behind_other_lane ? cfg_.margin_behind : cfg_.margin_s);
+        if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
+        // The car's heading from its predicted velocity (a lane change turns it).
+        const double cv = std::max(step_v_[at], 0.5), cvd = step_vd_[at];
+        const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+        const traj::OrientedBox car{cs, cd, 0.0, hl + margin,
+                                    hw + margin_scale * cfg_.margin_d};
+        if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) return j;
       }
     }
-    return false;
+    return n_steps_ + 1;
   }
 
   FrenetTrajectory Candidate(int c) const {
@@ -927,17 +1009,53 @@ class SearchPlanner : public Planner {
         continue;
       }
       ++sum.candidates_feasible;
-      winner_index_ = c;
-      winner_ = Candidate(c);
-      winner_lon_ = cand_lon_[c];
-      winner_lat_ = cand_lat_[c];
-      winner_cost_ = cand_cost_[c];
+      TakeWinner(c);
       Trace(r, true, -1);
       for (int rr = r + 1; rr < n && trace_ != nullptr &&
                            static_cast<int>(trace_->candidates.size()) < trace_max_;
            ++rr) {
         Trace(rr, false, -1);
       }
+      return true;
+    }
+    return false;
+  }
+
+  void TakeWinner(int c) {
+    winner_index_ = c;
+    winner_ = Candidate(c);
+    winner_lon_ = cand_lon_[c];
+    winner_lat_ = cand_lat_[c];
+    winner_cost_ = cand_cost_[c];
+  }
+
+  // When no candidate is feasible and clear of traffic with the safety margins: the least
+  // harmful feasible one, judged on bare car boxes — collision-free if any is, else the one
+  // whose first contact comes latest (more time for the others to react, and for the next
+  // cycles to find a way out); cost breaks ties. False when none is even feasible.
+  bool LeastHarm(bool* over_budget) {
+    const int n = static_cast<int>(order_.size());
+    first_hit_.resize(n);
+    for (int r = 0; r < n; ++r) {
+      if ((r & 31) == 31 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+        *over_budget = true;
+        return false;
+      }
+      const int c = order_[r];
+      first_hit_[c] = FirstCollision([&](int i) { return Candidate(c).At(i * kTickSeconds); }, 0.0);
+    }
+    // Latest contact first; the scoring order (stable) breaks ties.
+    std::stable_sort(order_.begin(), order_.end(),
+                     [&](int a, int b) { return first_hit_[a] > first_hit_[b]; });
+    for (int r = 0; r < n; ++r) {
+      if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+        *over_budget = true;
+        return false;
+      }
+      const int c = order_[r];
+      FillTicks(Candidate(c));
+      if (Violation(nullptr) > 0) continue;
+      TakeWinner(c);
       return true;
     }
     return false;
@@ -975,7 +1093,7 @@ class SearchPlanner : public Planner {
   FrenetTrajectory FromParams(const double* x) const {
     const LonTraj& base = lon_[winner_lon_];
     const LatTraj& lbase = lat_[winner_lat_];
-    LonTraj l = MakeLon(base.kind, base.lane, x[0], x[1], base.lead_s, base.lead_v);
+    LonTraj l = MakeLon(base.kind, base.lane, x[0], x[1], base.lead);
     LatTraj d = MakeLat(lbase.lane, x[3], x[2]);
     return {l.traj, d.traj};
   }
@@ -1049,6 +1167,8 @@ class SearchPlanner : public Planner {
     PlanSummary& sum = result_.summary;
     const LonTraj& lb = lon_[winner_lon_];
     const LatTraj& db = lat_[winner_lat_];
+    // Braking is the emergency family: it is sent as sampled, at once.
+    if (lb.kind == cost::LonKind::kBraking) return;
     double x[4] = {lb.param, lb.traj.duration, db.traj.duration, db.offset};
     double lo[4], hi[4];
     switch (lb.kind) {
@@ -1064,6 +1184,8 @@ class SearchPlanner : public Planner {
         lo[0] = 0;
         hi[0] = std::max(1.0, start_.s_d * cfg_.max_duration);
         break;
+      case cost::LonKind::kBraking:
+        return;
     }
     lo[1] = cfg_.min_duration;
     hi[1] = cfg_.max_duration;
@@ -1101,6 +1223,8 @@ class SearchPlanner : public Planner {
       time_since_change_ = 0;
     }
     prev_target_lane_ = lane;
+    prev_lat_lane_ = lat_[winner_lat_].lane;
+    prev_lat_offset_ = winner_.lat.poly.P(winner_.lat.duration) - lane_center_[prev_lat_lane_];
     prev_traj_ = winner_;
     prev_base_ = 0;
     have_prev_traj_ = true;
@@ -1232,8 +1356,16 @@ class SearchPlanner : public Planner {
   std::vector<LatTraj> lat_;
   std::vector<double> lon_s_, lon_sd_, lon_sdd_, lat_d_, lat_dd_, lat_ddd_;
   std::vector<int> cand_lon_, cand_lat_, order_;
+  std::vector<int> first_hit_;  // per candidate: first collision step on bare boxes (LeastHarm)
   std::vector<double> cand_cost_;
-  std::vector<double> car_s_, car_d_, car_v_, car_s0_;
+  // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples
+  // ([c * n_samples_ + k]), where it is at the start instant, its predictor index, and its
+  // predicted s, d, speed and lateral speed at the collision-check steps ([c * (n_steps_ + 1) +
+  // j], t_keep_ + j * collision_step_ ticks).
+  std::vector<double> car_s_, car_d_, car_v_, car_s0_, car_d0_;
+  std::vector<int> car_index_;
+  int collision_step_ = 5, n_steps_ = 0;
+  std::vector<double> step_s_, step_d_, step_v_, step_vd_;
   // Broad-phase masks (cost::CostInput::near_lat, near_lon).
   std::vector<std::uint64_t> lat_near_, lon_near_, ref_near_lat_, ref_near_lon_;
   std::vector<double> prev_s_, prev_d_;
@@ -1259,6 +1391,8 @@ class SearchPlanner : public Planner {
   double prev_elapsed_ = 0;  // s: the current start's time on prev_traj_
   double prev_base_ = 0;     // s: the stored plan start's time on prev_traj_ (see ContinuePrevious)
   int prev_target_lane_ = -1, lane_before_change_ = -1;
+  int prev_lat_lane_ = -1;       // lane and end offset (m) of the previous winner's lateral move
+  double prev_lat_offset_ = 0;
   double time_since_change_ = 1e9;
   // Plan reuse between full searches (see CanReuse).
   struct SnapCar {
@@ -1271,6 +1405,7 @@ class SearchPlanner : public Planner {
   double snap_ego_x_ = 0, snap_ego_y_ = 0;
   int ticks_since_search_ = 0;
   bool can_reuse_ = false;
+  double clock_ = NAN;  // s, simulated time of the current message (NaN: unknown)
   int reuse_lane_ = -1;
   double reuse_end_speed_ = 0, reuse_duration_ = 0;
 

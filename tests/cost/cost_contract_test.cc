@@ -28,7 +28,7 @@ struct Fixture {
     in.s = s.data(); in.s_d = s_d.data(); in.s_dd = s_dd.data();
     in.d = d.data(); in.d_d = d_d.data(); in.d_dd = d_dd.data();
     ctx.car_s = car_s.data(); ctx.car_d = car_d.data(); ctx.car_v = car_v.data();
-    ctx.num_cars = static_cast<int>(car_d.size());
+    ctx.num_cars = static_cast<int>(car_d.size()) / kN;
     ctx.previous_s = prev_s.empty() ? nullptr : prev_s.data();
     ctx.previous_d = prev_d.empty() ? nullptr : prev_d.data();
   }
@@ -92,10 +92,15 @@ Fixture RandomFixture(std::mt19937& rng) {
   }
   const int cars = static_cast<int>(u(rng) * 12);
   for (int c = 0; c < cars; ++c) {
-    const double s0 = -50 + 150 * u(rng), vc = 25 * u(rng);
-    for (int k = 0; k < kN; ++k) f.car_s.push_back(s0 + vc * k * 0.25);
-    f.car_d.push_back(12 * u(rng));
-    f.car_v.push_back(vc);
+    // Constant speed or braking; staying in lane or moving across.
+    const double s0 = -50 + 150 * u(rng), v0 = 25 * u(rng), a = u(rng) < 0.3 ? -8 * u(rng) : 0;
+    const double d0 = 12 * u(rng), vd = u(rng) < 0.3 ? -3 + 6 * u(rng) : 0;
+    for (int k = 0; k < kN; ++k) {
+      const double t = k * 0.25, tb = a < 0 ? std::min(t, v0 / -a) : t;
+      f.car_s.push_back(s0 + v0 * tb + 0.5 * a * tb * tb + (v0 + a * tb) * (t - tb));
+      f.car_v.push_back(v0 + a * tb);
+      f.car_d.push_back(d0 + vd * t);
+    }
   }
   if (u(rng) < 0.5) {
     for (int k = 0; k < kN; ++k) {
@@ -168,7 +173,7 @@ TEST_P(CostContractTest, BroadPhaseMasksDoNotChangeTheValue) {
     std::vector<std::uint64_t> near_lat(2 * kN, 0), near_lon(2 * kN, 0);
     for (int c = 0; c < f.ctx.num_cars; ++c) {
       for (int k = 0; k < kN; ++k) {
-        const double dd = std::abs(f.car_d[c] - f.d[k]);
+        const double dd = std::abs(f.car_d[c * kN + k] - f.d[k]);
         const double ds = std::abs(f.car_s[c * kN + k] - f.s[k]);
         for (int m = 0; m < 2; ++m) {
           if (dd < lat[m]) near_lat[m * kN + k] |= std::uint64_t{1} << c;
@@ -258,16 +263,22 @@ TEST(CostBehaviourTest, TermsRankTheObviousChoices) {
   (*buffer)->Configure(b_def);
   Fixture f = IdealLaneKeeping();
   // A stopped car 30 m ahead in the ego's lane: the lane-keeping candidate runs into it.
-  for (int k = 0; k < kN; ++k) f.car_s.push_back(130);
-  f.car_d.push_back(6);
-  f.car_v.push_back(0);
+  for (int k = 0; k < kN; ++k) {
+    f.car_s.push_back(130);
+    f.car_d.push_back(6);
+    f.car_v.push_back(0);
+  }
   f.Wire();
   EXPECT_GT((*collision)->Evaluate(f.ctx, f.in), 0.02);
   EXPECT_GT((*buffer)->Evaluate(f.ctx, f.in), 0.1);
   // The same car in the next lane is harmless.
-  f.car_d[0] = 10;
+  for (double& d : f.car_d) d = 10;
   EXPECT_EQ((*collision)->Evaluate(f.ctx, f.in), 0.0);
   EXPECT_EQ((*buffer)->Evaluate(f.ctx, f.in), 0.0);
+  // ...unless it is predicted to move into the ego's lane: from 10 to 6 over the first second.
+  for (int k = 0; k < kN; ++k) f.car_d[k] = std::max(6.0, 10 - 4 * k * 0.25);
+  EXPECT_GT((*collision)->Evaluate(f.ctx, f.in), 0.02);
+  EXPECT_GT((*buffer)->Evaluate(f.ctx, f.in), 0.1);
 }
 
 }  // namespace

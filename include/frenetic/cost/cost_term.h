@@ -7,6 +7,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,20 +39,25 @@ struct CostContext {
   // Last cycle's chosen trajectory at the same sample times (nullptr when there is none).
   const double* previous_s = nullptr;
   const double* previous_d = nullptr;
-  // Predicted traffic: car c at sample k is at (car_s[c * n + k], car_d[c]) moving at car_v[c]
-  // along the lane. Cars the planner deems irrelevant (far, or behind in the ego's own lane) are
-  // already left out.
+  // Predicted traffic: car c at sample k is at (car_s[c * n + k], car_d[c * n + k]) moving at
+  // car_v[c * n + k] along the lane. Cars the planner deems irrelevant (far, or behind in the
+  // ego's own lane) are already left out.
   int num_cars = 0;
   const double* car_s = nullptr;
   const double* car_d = nullptr;
   const double* car_v = nullptr;
+  // An upper bound of every car_v value (m/s; infinity when unknown): bounds broad-phase reaches.
+  double max_car_speed = std::numeric_limits<double>::infinity();
   double car_length = 4.8, car_width = 2.4;  // footprint of every car, ego included, m
   // Reaches of the broad-phase masks in CostInput (m), tighter first: see ForEachCarNear.
   double near_lateral[2] = {0, 0};
   double near_longitudinal[2] = {0, 0};
 };
 
-enum class LonKind : int { kVelocityKeeping = 0, kFollowing = 1, kStopping = 2 };
+// Longitudinal families: quartic velocity keeping, quintic following (time-gap law) and
+// stopping, and constant-deceleration braking to a lower speed (the strongest, fastest braking
+// the lattice can express; Apollo's backup profiles).
+enum class LonKind : int { kVelocityKeeping = 0, kFollowing = 1, kStopping = 2, kBraking = 3 };
 
 // One candidate, as sampled for scoring (struct of arrays, ctx.num_samples long).
 struct CostInput {
@@ -69,7 +75,7 @@ struct CostInput {
   int target_lane = 0;
   LonKind kind = LonKind::kVelocityKeeping;
   // Optional broad phase (nullptr: none). Bit c of near_lat[m][k] is set for every car c < 64
-  // with |ctx.car_d[c] - d[k]| < ctx.near_lateral[m], bit c of near_lon[m][k] for every car with
+  // with |ctx.car_d[c * n + k] - d[k]| < ctx.near_lateral[m], bit c of near_lon[m][k] for every car with
   // |ctx.car_s[c * n + k] - s[k]| < ctx.near_longitudinal[m]. Each depends on one motion only,
   // so the planner computes them once per lateral or longitudinal trajectory, not per candidate.
   const std::uint64_t* near_lat[2] = {nullptr, nullptr};

@@ -1,8 +1,10 @@
 // Prediction of the surrounding traffic from sensor_fusion rows. Rows are converted to Frenet on
 // the smooth reference line (from x, y: this also repairs the simulator's s = d = 0 glitch at the
 // seam), rows off the carriageway (parked cars) are dropped, and the one-message speed spike of a
-// just-spawned car is repaired. The default predictor keeps each car at constant speed along its
-// lane; the interface leaves room for better ones.
+// just-spawned car is repaired. Two predictors: constant velocity along the lane, and the default
+// manoeuvre-aware one, which also extrapolates a car that is braking (its deceleration, from its
+// previous reading) and a car that is moving across lanes (its lateral velocity, from vx, vy),
+// the two moves of the simulator's traffic that end in collisions (udacity-sim.md §8.3, §8.5).
 #pragma once
 
 #include <memory>
@@ -20,6 +22,9 @@ namespace frenetic::plan {
 struct TrackedCar {
   int id = 0;
   double s = 0, d = 0, v_s = 0;
+  double a_s = 0;       // m/s^2 along the lane, from the previous reading (0 when unknown)
+  double v_d = 0;       // m/s across the lane, right positive
+  double d_target = 0;  // m: where a lateral move is predicted to end (= d when none)
 };
 
 struct PredictorOptions {
@@ -28,22 +33,39 @@ struct PredictorOptions {
   double max_speed = 30;     // m/s: faster readings are the spawn glitch
   double spike_ratio = 1.8;  // a reading this much above the id's last one is the spawn glitch
   int max_cars = 64;         // rows beyond this are ignored (keeps Observe allocation-free)
+  // Manoeuvre-aware predictor only.
+  double brake_threshold = 2.0;  // m/s^2: a car decelerating harder is predicted to keep braking
+  double brake_horizon = 2.0;    // s: for at most this long (then constant speed, never < 0)
+  double lateral_threshold = 0.5;  // m/s: a car moving across faster is changing lanes
+  double lane_width = 4.0;       // m, lanes [0, w), [w, 2w), ...; a lane change ends at a centre
+  int num_lanes = 3;
 };
 
 class Predictor {
  public:
   virtual ~Predictor() = default;
   // Replaces the tracked set with the valid rows of `rows`, relative to the ego's line
-  // coordinate `ego_s` (wrapped or not). Never fails: invalid rows are skipped.
-  virtual void Observe(std::span<const SensorCar> rows, double ego_s) = 0;
+  // coordinate `ego_s` (wrapped or not). `now` is the simulated time of the readings (s, any
+  // origin, increasing between calls; NaN when unknown, e.g. after a resynchronisation): it
+  // dates the readings from which later calls estimate accelerations. Never fails: invalid rows
+  // are skipped.
+  virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now) = 0;
   virtual std::span<const TrackedCar> cars() const = 0;
-  // Predicted (s, d) of car i, t seconds after the observation.
-  virtual void Predict(int i, double t, double* s, double* d) const = 0;
+  // Predicted state of car i, t >= 0 seconds after the observation: s and d (m), speed along
+  // the lane v (m/s) and lateral velocity v_d (m/s).
+  struct Prediction {
+    double s = 0, d = 0, v = 0, v_d = 0;
+  };
+  virtual Prediction Predict(int i, double t) const = 0;
   virtual void Reset() = 0;
 };
 
 // Constant speed along the lane, constant d.
 std::unique_ptr<Predictor> MakeConstantVelocityPredictor(
     std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options);
+// Constant velocity, except a braking car keeps braking for up to brake_horizon and a car moving
+// across lanes keeps its lateral velocity until it reaches the next lane centre.
+std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::ReferenceLine> line,
+                                                  const PredictorOptions& options);
 
 }  // namespace frenetic::plan
