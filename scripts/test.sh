@@ -31,10 +31,13 @@ log "step 1/4: ctest suite"
 
 log "step 2/4: fidelity against the real simulator recordings"
 if [ -d "$SHARED_DIR/realdata/telemetry" ] && [ -f "$SHARED_DIR/data/highway_map.csv" ]; then
-  # Traffic statistics are printed by `frenetic fidelity --checks traffic`; they are not yet all
-  # within their bands (see README), so CI gates on the exact checks.
+  # The exact checks gate CI. The traffic statistics (seeded, ~5 s, the same for any --jobs) are
+  # printed too but do not gate yet: two rows are still out of band (see README).
   "$BUILD_DIR/frenetic" fidelity --recordings "$SHARED_DIR/realdata/telemetry" --checks protocol,frenet,ego \
     --map "$SHARED_DIR/data/highway_map.csv"
+  "$BUILD_DIR/frenetic" fidelity --recordings "$SHARED_DIR/realdata/telemetry" --checks traffic \
+    --map "$SHARED_DIR/data/highway_map.csv" --jobs "$JOBS" ||
+    log "traffic statistics: rows out of band (reported, not gating; see README)"
 else
   log "skipped: no $SHARED_DIR/realdata/telemetry"
 fi

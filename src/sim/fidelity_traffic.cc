@@ -160,7 +160,7 @@ class ReplayEgo {
   static constexpr std::size_t kKeep = 5;
   static constexpr double kTick = 0.02;
   static constexpr double kCarLength = 4.6;
-  static constexpr double kMaxAccel = 3.5, kMaxDecel = 6.0;  // m/s^2; the recorded ego
+  static constexpr double kMaxAccel = 5.0, kMaxDecel = 6.0;  // m/s^2; the recorded ego
                                                             // reached 49 mph in ~7 s
   static constexpr double kStandstill = 8.0, kTimeGap = 1.2, kGapGain = 0.5;  // m, s, 1/s
   static constexpr double kLateralSpeed = 2.0;     // m/s: a lane change in ~2 s

@@ -156,7 +156,7 @@ Status TrafficOptions::Validate() const {
   check(batch_min >= 1 && batch_max >= batch_min, "batch must satisfy 1 <= min <= max");
   check(period_min_frames >= 1 && period_max_frames >= period_min_frames,
         "period_frames must satisfy 1 <= min <= max");
-  check(frame_ticks >= 1, "frame_ticks must be >= 1");
+  check(frame_rate >= 1 && frame_rate <= 1000, "frame_rate must be in [1, 1000] Hz");
   check(spawn_retries >= 1, "spawn_retries must be >= 1");
   check(spawn_clearance >= 0, "spawn_clearance must be >= 0");
   check(behind_offset_min <= behind_offset_max, "behind_offsets must satisfy min <= max");
@@ -173,6 +173,7 @@ Status TrafficOptions::Validate() const {
   check(brake_gap_min >= 0 && brake_gap_max >= brake_gap_min,
         "brake_gap must satisfy 0 <= min <= max");
   check(brake_delay >= 0 && brake_delay <= 2, "brake_delay must be in [0, 2] s");
+  check(brake_release_delay <= 2, "brake_release_delay must be <= 2 s (negative: brake_delay)");
   check(follow_lateral > 0, "follow_lateral must be > 0");
   check(wander_min >= 0 && wander_max >= wander_min && wander_max <= 2,
         "wander must satisfy 0 <= min <= max <= 2");
@@ -227,8 +228,57 @@ Status Scenario::Validate() const {
   return Status::Ok();
 }
 
-StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view source_view) {
-  const std::string source(source_view);
+namespace {
+
+// Files being loaded, outermost first (canonical paths), to report a `base` cycle.
+using BaseChain = std::vector<std::string>;
+
+bool IsScenarioName(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+  });
+}
+
+std::string CanonicalPath(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+  return ec ? path : p.string();
+}
+
+StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, BaseChain* chain);
+
+// Reads and parses a scenario file; `chain` holds the files that named it as their base.
+StatusOr<Scenario> LoadFile(const std::string& path, BaseChain* chain) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open scenario file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return Parse(ss.str(), path, chain);
+}
+
+// The scenario named by `base` in the file `source`: a bundled name or a path relative to the
+// file's directory. A file already in `chain` is a cycle.
+StatusOr<Scenario> LoadBase(const std::string& base, const std::string& source, BaseChain* chain) {
+  std::string path = base;
+  if (IsScenarioName(base)) {
+    path = ScenarioDir() + "/" + base + ".yaml";
+  } else if (std::filesystem::path(base).is_relative()) {
+    path = (std::filesystem::path(source).parent_path() / base).string();
+  }
+  const std::string canonical = CanonicalPath(path);
+  if (std::find(chain->begin(), chain->end(), canonical) != chain->end()) {
+    std::string cycle;
+    for (const auto& f : *chain) cycle += f + " -> ";
+    return Status::Error(source + ": 'base' cycle: " + cycle + canonical);
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return Status::Error(source + ": 'base' scenario '" + base + "' not found (" + path + ")");
+  }
+  return LoadFile(path, chain);
+}
+
+StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, BaseChain* chain) {
   YAML::Node root;
   try {
     root = YAML::Load(std::string(yaml_text));
@@ -237,9 +287,24 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
                          ": " + e.msg);
   }
   Scenario sc;
-  sc.source = source;
   Status st;
   MapReader r(root, "", source, &st);
+  // `base: NAME or FILE` loads that scenario first; this file's keys then override its values
+  // (key by key, maps merged); name, description and source are this file's.
+  if (r.Has("base")) {
+    std::string base;
+    r.Read("base", &base);
+    if (!st.ok()) return st;
+    chain->push_back(CanonicalPath(source));
+    auto loaded = LoadBase(base, source, chain);
+    chain->pop_back();
+    if (!loaded.ok()) return loaded.status();
+    sc = std::move(*loaded);
+    sc.description.clear();
+  } else {
+    r.MarkKnown("base");
+  }
+  sc.source = source;
   r.Read("name", &sc.name);
   r.Read("description", &sc.description);
   r.Read("seed", &sc.seed);
@@ -256,6 +321,7 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
       r.MarkKnown("start");
       std::string v = node.as<std::string>();
       if (v != "auto") r.Fail("start", "must be 'auto' or a map with x, y or s, lane/d");
+      sc.start = StartPose();
     } else {
       MapReader start = r.Sub("start");
       StartPose& p = sc.start;
@@ -310,7 +376,7 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
     t.Read("respawn_distance", &o.respawn_distance);
     t.ReadRange("batch", &o.batch_min, &o.batch_max);
     t.ReadRange("period_frames", &o.period_min_frames, &o.period_max_frames);
-    t.Read("frame_ticks", &o.frame_ticks);
+    t.Read("frame_rate", &o.frame_rate);
     t.Read("spawn_retries", &o.spawn_retries);
     t.Read("spawn_clearance", &o.spawn_clearance);
     t.ReadRange("behind_offsets", &o.behind_offset_min, &o.behind_offset_max);
@@ -324,6 +390,8 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
     t.Read("brake_decel", &o.brake_decel);
     t.ReadRange("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
     t.Read("brake_delay", &o.brake_delay);
+    t.Read("brake_release_delay", &o.brake_release_delay);
+    t.Read("brake_to_leader_mph", &o.brake_to_leader_mph);
     t.Read("follow_lateral", &o.follow_lateral);
     t.ReadRange("wander", &o.wander_min, &o.wander_max);
     t.ReadRange("wander_period", &o.wander_period_min, &o.wander_period_max);
@@ -383,6 +451,13 @@ StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view so
   return sc;
 }
 
+}  // namespace
+
+StatusOr<Scenario> ParseScenario(std::string_view yaml_text, std::string_view source_view) {
+  BaseChain chain;
+  return Parse(yaml_text, std::string(source_view), &chain);
+}
+
 std::string ScenarioDir() { return std::string(FRENETIC_SOURCE_DIR) + "/config/scenarios"; }
 
 std::vector<std::string> ScenarioNames() {
@@ -396,24 +471,16 @@ std::vector<std::string> ScenarioNames() {
 }
 
 StatusOr<Scenario> LoadScenario(const std::string& name_or_path) {
-  const bool is_name =
-      !name_or_path.empty() &&
-      std::all_of(name_or_path.begin(), name_or_path.end(), [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
-      });
+  const bool is_name = IsScenarioName(name_or_path);
   const std::string path = is_name ? ScenarioDir() + "/" + name_or_path + ".yaml" : name_or_path;
-  std::ifstream in(path);
-  if (!in) {
-    if (is_name) {
-      std::string known;
-      for (const auto& n : ScenarioNames()) known += (known.empty() ? "" : ", ") + n;
-      return Status::Error("unknown scenario '" + name_or_path + "' (known: " + known + ")");
-    }
-    return Status::Error(path + ": cannot open scenario file");
+  std::error_code ec;
+  if (is_name && !std::filesystem::is_regular_file(path, ec)) {
+    std::string known;
+    for (const auto& n : ScenarioNames()) known += (known.empty() ? "" : ", ") + n;
+    return Status::Error("unknown scenario '" + name_or_path + "' (known: " + known + ")");
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  auto sc = ParseScenario(ss.str(), path);
+  BaseChain chain;
+  auto sc = LoadFile(path, &chain);
   if (sc.ok() && is_name && sc->name.empty()) sc->name = name_or_path;
   return sc;
 }

@@ -156,8 +156,10 @@ void Simulator::Tick() {
   sample.collision_with = traffic_->Collides(box);
   ++ticks_;
   monitor_.Update(sample, time());
-  if (++frame_tick_ >= scenario_.traffic.frame_ticks) {
-    frame_tick_ = 0;
+  // Rendered frames in this tick (none, one or several, at the scenario's frame rate).
+  frame_phase_ += scenario_.traffic.frame_rate * kTick;
+  while (frame_phase_ >= 1.0 - 1e-9) {
+    frame_phase_ -= 1.0;
     traffic_->Frame(view_);
   }
   UpdateMetrics();

@@ -167,7 +167,9 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
     car.hard_brake_left = 0;
     car.slow_left = 0;
     car.blocked = false;
+    car.too_close = false;
     car.switch_wait = 0;
+    car.leader_v = 0;
     InitWander(car);
     car.d = LaneCentre(lane) + Wander(car, time_);
     car.d_rate = 0;
@@ -185,7 +187,9 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
 
 void Traffic::Frame(const EgoView& ego) {
   if (--countdown_ > 0) return;
-  countdown_ = UniformInt(o_.period_min_frames, o_.period_max_frames);
+  // The source draws count_max and counts frames up to it after the run's frame, so the next
+  // run is count_max + 1 frames later.
+  countdown_ = UniformInt(o_.period_min_frames, o_.period_max_frames) + 1;
   for (TrafficCar& c : cars_) {
     if (c.queued) continue;
     if (std::hypot(c.x - ego.x, c.y - ego.y) > o_.respawn_distance) {
@@ -335,13 +339,17 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
     const double closing = c.v - leader_v;
     if (closing > 0) h = std::max(h, closing * closing / (2 * o_.brake_decel) + 1.0);
     const bool too_close = gap < h;
+    c.too_close = too_close;
+    if (too_close) c.leader_v = leader_v;
     if (too_close == c.blocked) {
       c.switch_wait = 0;
     } else {
       // Unity reacts a little late both ways; the lag keeps a queued car's brake/throttle cycle
       // going at the amplitude the recordings show instead of decaying to tick-long pulses.
       c.switch_wait += kDt;
-      if (c.switch_wait >= o_.brake_delay - 1e-9) {
+      const double delay = too_close || o_.brake_release_delay < 0 ? o_.brake_delay
+                                                                   : o_.brake_release_delay;
+      if (c.switch_wait >= delay - 1e-9) {
         c.blocked = too_close;
         c.switch_wait = 0;
       }
@@ -351,13 +359,19 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
     double a;
     if (c.hard_brake_left > 0) {
       a = -o_.hard_brake_decel;
-    } else if (c.blocked) {
+    } else if (c.blocked && !o_.brake_to_leader_mph) {
       a = -o_.brake_decel;
+    } else if (c.blocked && c.v * kMph > c.leader_v) {
+      // §8.3: the desired speed is the leader's m/s number read as mph, with a brake gain of 1
+      // per mph: full brake more than 1 mph above it (brake_decel is the recorded total).
+      a = -o_.brake_decel * std::min(c.v * kMph - c.leader_v, 1.0);
     } else {
       const double wander =
           1.0 - o_.throttle_wander * (0.5 + 0.5 * std::sin(c.throttle_w * time_ + c.throttle_p));
+      // Free: toward the top speed. Blocked below the wrong-unit target: gently up to it.
+      const double target_mph = c.blocked ? c.leader_v : desired * kMph;
       const double throttle =
-          std::clamp(o_.throttle_gain * (desired - c.v) * kMph, -1.0, 1.0) * wander;
+          std::clamp(o_.throttle_gain * (target_mph - c.v * kMph), -1.0, 1.0) * wander;
       a = throttle >= 0 ? throttle * o_.max_accel : throttle * o_.brake_decel;
       a -= o_.drag * c.v * c.v + o_.linear_drag * c.v;
     }
@@ -410,7 +424,9 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
   // Lane changes by the §8.5 rule, evaluated on the new state.
   if (o_.lane_changes) {
     for (TrafficCar& c : cars_) {
-      if (c.spawned && c.blocked && !c.changing && c.slow_left <= 0 && c.hard_brake_left <= 0) {
+      // The source evaluates the rule in the same branch as the ray-cast test, not after the
+      // reaction lag.
+      if (c.spawned && c.too_close && !c.changing && c.slow_left <= 0 && c.hard_brake_left <= 0) {
         LaneChangeRule(c, ego, tick);
       }
     }

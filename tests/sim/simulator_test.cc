@@ -152,5 +152,29 @@ TEST(Simulator, StartPoseOptions) {
   EXPECT_FALSE(Simulator::Create(world, sc, 1).ok());
 }
 
+TEST(Simulator, RespawnSchedulerRunsAtTheFrameRate) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  // The scheduler runs on rendered frames, every 21-60 of them: at 12.5 frames per second only
+  // the scene-load batch (1-3 cars) is out after 1.6 s; at 50 more batches have followed.
+  auto spawned_after = [&](double frame_rate, int ticks) {
+    Scenario sc = Default();
+    sc.traffic.frame_rate = frame_rate;
+    auto sim = Simulator::Create(world, sc, 4);
+    EXPECT_TRUE(sim.ok()) << sim.message();
+    (*sim)->Advance(ticks);
+    int n = 0;
+    for (const TrafficCar& c : (*sim)->traffic().cars()) n += c.spawned ? 1 : 0;
+    return n;
+  };
+  const int slow = spawned_after(12.5, 80);
+  const int fast = spawned_after(50, 80);
+  EXPECT_LE(slow, 3);
+  EXPECT_GT(fast, slow);
+  // 50 Hz is one frame per tick; a first frame-rate check in Validate.
+  Scenario bad = Default();
+  bad.traffic.frame_rate = 0;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 }  // namespace
 }  // namespace frenetic::sim

@@ -52,7 +52,10 @@ struct TrafficOptions {
   double respawn_distance = 200;       // m, Euclidean distance to the ego that queues a respawn
   int batch_min = 1, batch_max = 3;    // cars respawned per scheduler run
   int period_min_frames = 20, period_max_frames = 59;  // frames between scheduler runs
-  int frame_ticks = 1;                 // physics ticks per rendered frame (1 = 50 fps)
+  // Rendered frames per simulated second: the respawn scheduler runs on frames (§2, §8.2).
+  // 50 is one frame per physics tick; the recordings' spawn batches came every 1.06 s on
+  // average, i.e. about 38 frames per second with the 21-60 frame period.
+  double frame_rate = 50;              // Hz
   int spawn_retries = 500;             // placement attempts per car
   double spawn_clearance = 6;          // m, no other car may be closer to a spawn point
   int behind_offset_min = -3, behind_offset_max = -2;  // waypoint index offsets from the ego
@@ -68,6 +71,13 @@ struct TrafficOptions {
   // s the "too close" test must hold (or fail) before a car starts (or stops) braking: Unity's
   // reaction lag, which keeps the brake/throttle cycle of a queued car from dying out.
   double brake_delay = 0;
+  // s the test must fail before a braking car lets go; negative: brake_delay (symmetric lag).
+  double brake_release_delay = -1;
+  // The source's units mix while too close (§8.3, scene BrakeCondition NeverBrake): the desired
+  // speed becomes the leader's speed in m/s taken as mph, so the car brakes (proportionally
+  // within 1 mph) only down to leader_mps / 2.237 m/s and, once slower, throttles gently back up
+  // to it until the gap opens. Off: it brakes at brake_decel for as long as it is too close.
+  bool brake_to_leader_mph = true;
   double follow_lateral = 2.0;         // m, |Δd| under which a car is "in front" (ray-cast)
   double wander_min = 0.3, wander_max = 0.5;  // m, lateral wander amplitude per car
   double wander_period_min = 8, wander_period_max = 20;  // s

@@ -78,7 +78,7 @@ class Simulator {
   std::unique_ptr<Traffic> traffic_;
   IncidentMonitor monitor_;
   std::int64_t ticks_ = 0;
-  int frame_tick_ = 0;
+  double frame_phase_ = 0;  // fraction of a rendered frame elapsed
   EgoView view_;
   double chord_s_ = 0, chord_d_ = 0;
   LeaderGap leader_;

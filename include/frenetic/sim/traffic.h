@@ -47,7 +47,9 @@ struct TrafficCar {
   bool queued = false;        // waiting for a respawn
   bool spawn_quirk = false;   // report speed in the wrong unit until the next tick
   bool blocked = false;       // braking for a leader (the "too close" test, after the delay)
+  bool too_close = false;     // the "too close" test itself, this tick (§8.5 evaluates on it)
   double switch_wait = 0;     // s the test has disagreed with `blocked` (brake_delay)
+  double leader_v = 0;        // m/s, speed of the leader when last seen too close
   double hard_brake_left = 0;  // s of forced braking left (hard-brake option)
   double slow_left = 0;        // s of blockade left
   double slow_speed = 0;
