@@ -31,6 +31,7 @@
 #include <string>
 
 #include "frenetic/check.h"
+#include "frenetic/map/chord_frenet.h"
 
 namespace frenetic::map {
 namespace {
@@ -38,6 +39,9 @@ namespace {
 constexpr int kDegree = 5;
 constexpr int kOrder = kDegree + 1;  // control points per span
 constexpr double kPi = std::numbers::pi;
+// m: the chord offset is stored at d = 0 and d = kChordD1 (it is nearly linear in d: over
+// d in [0, 12] the Udacity map's offsets bend by < 1 cm).
+constexpr double kChordD1 = 12.0;
 // Scales smoothness_weight = 1 to a useful balance between the data term (m^2 at ~180
 // waypoints) and the integral of |r_sss|^2 (~1e-4 1/m^2 squared over ~7 km).
 constexpr double kSmoothnessScale = 1e6;
@@ -205,6 +209,8 @@ struct ReferenceLine::Impl {
   // Struct-of-arrays copies with n + 1 entries (entry n repeats sample 0 at s = length, heading
   // unwrapped), so segment i always interpolates between entries i and i + 1.
   std::vector<double> x, y, th, tx, ty, k, dk;
+  // Chord offset (ChordOffset) at each sample for d = 0 and d = kChordD1; linear in d between.
+  std::vector<double> chord0, chord1;
   double max_waypoint_distance = 0;
   double max_map_s_difference = 0;
 
@@ -647,6 +653,18 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
   }
   line->impl_->max_waypoint_distance = max_dist;
   line->impl_->max_map_s_difference = max_ds;
+  // The simulator's reading of d at every sample (float32 chords, as it computes them).
+  const ChordFrenet chords(track);
+  Impl& m = *line->impl_;
+  m.chord0.resize(n);
+  m.chord1.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double si = i * m.step;
+    const CartesianPose p0 = line->ToCartesian(si, 0.0), p1 = line->ToCartesian(si, kChordD1);
+    const double c0 = chords.Convert(p0.x, p0.y).d, c1 = chords.Convert(p1.x, p1.y).d;
+    m.chord0[i] = std::isfinite(c0) ? c0 : 0.0;
+    m.chord1[i] = std::isfinite(c1) ? c1 - kChordD1 : 0.0;
+  }
   return std::shared_ptr<const ReferenceLine>(std::move(line));
 }
 
@@ -724,6 +742,31 @@ FrenetPoint ReferenceLine::ToFrenet(double x, double y, double s_hint) const {
   constexpr double kTrustedOffset = 40.0;
   if (std::abs(f.d) > kTrustedOffset) return ToFrenet(x, y);
   return f;
+}
+
+ReferenceLine::OffsetRange ReferenceLine::ChordOffset(double s_from, double s_to,
+                                                     double d) const {
+  const Impl& m = *impl_;
+  OffsetRange r;
+  if (m.chord0.empty() || !std::isfinite(s_from) || !std::isfinite(s_to) || !std::isfinite(d)) {
+    return r;
+  }
+  // Every sample from the one at or before s_from to the one at or after s_to.
+  const double lo = WrapS(s_from) * m.inv_step;
+  const int first = static_cast<int>(lo);
+  const int count = std::min(m.n, static_cast<int>(std::ceil(
+                                      lo + std::max(0.0, s_to - s_from) * m.inv_step)) -
+                                      first + 1);
+  const double w = d / kChordD1;
+  r.lo = std::numeric_limits<double>::infinity();
+  r.hi = -r.lo;
+  for (int j = 0; j < count; ++j) {
+    const int i = (first + j) % m.n;
+    const double off = m.chord0[i] + (m.chord1[i] - m.chord0[i]) * w;
+    r.lo = std::min(r.lo, off);
+    r.hi = std::max(r.hi, off);
+  }
+  return r;
 }
 
 RefSample ReferenceLine::At(double s) const {

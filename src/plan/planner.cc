@@ -22,6 +22,7 @@ const char* ToString(Reject reason) {
     case Reject::kJerk: return "jerk";
     case Reject::kOffRoad: return "off_road";
     case Reject::kCollision: return "collision";
+    case Reject::kLaneLine: return "lane_line";
     case Reject::kCount: break;
   }
   return "unknown";

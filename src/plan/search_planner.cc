@@ -1,6 +1,8 @@
 // The `search` planner. Werling, Ziegler, Kammel, Thrun, "Optimal Trajectory Generation for
 // Dynamic Street Scenarios in a Frenet Frame", ICRA 2010: 1-D longitudinal and lateral bundles,
 // every pair scored, lazy hard checks in cost order, a backup that always exists.
+#include "plan/search_planner.h"
+
 #include <nlopt.h>
 
 #include <algorithm>
@@ -12,7 +14,6 @@
 #include "frenetic/plan/predictor.h"
 #include "frenetic/traj/box.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_planner.h"
 
 namespace frenetic::plan {
 namespace {
@@ -34,7 +35,13 @@ constexpr double kRelevantRange = 120.0;
 // ~50 m. A term that needs more reach falls back to examining every car.
 constexpr double kNearLateral[2] = {3.2, 4.5};
 constexpr double kNearLongitudinal[2] = {8.0, 60.0};
-constexpr int kMaxCars = 64;  // one bit each in the broad-phase masks
+constexpr int kMaxCars = 64;
+// The simulator times a car whose d is within 0.8 m of a lane line and flags it after 150 ticks
+// (udacity-sim.md §7.4). Lane centres keep a little more room; the hard check allows a little
+// less time.
+constexpr double kStraddle = 0.8;       // m
+constexpr double kLaneLineBand = 0.9;   // m
+constexpr int kMaxStraddleTicks = 135;  // one bit each in the broad-phase masks
 
 double MsSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -46,10 +53,10 @@ bool Finite(double v) { return std::isfinite(v); }
 struct LonTraj {
   Trajectory1d traj;
   cost::LonKind kind = cost::LonKind::kVelocityKeeping;
-  int lane = -1;         // -1: usable in every lane; else only with this lane's lateral moves
+  int lane = -1;  // -1: usable in every lane; else only with this lane's lateral moves
   // End speed (velocity keeping), extra gap (following), distance (stop), deceleration (braking).
   double param = 0;
-  int lead = -1;         // following: the leader's index in the predictor's cars of this cycle
+  int lead = -1;  // following: the leader's index in the predictor's cars of this cycle
   double jerk2 = 0;
 };
 
@@ -166,9 +173,12 @@ class SearchPlanner : public Planner {
                      ? MakeManoeuvrePredictor(line_, po)
                      : MakeConstantVelocityPredictor(line_, po);
     for (int l = 0; l < cfg_.num_lanes; ++l) {
-      lane_center_[l] = (l + 0.5) * cfg_.lane_width;
+      lane_nominal_[l] = lane_center_[l] = (l + 0.5) * cfg_.lane_width;
     }
-    if (cfg_.num_lanes > 1) lane_center_[cfg_.num_lanes - 1] -= cfg_.outer_inset;
+    if (cfg_.num_lanes > 1) {
+      lane_nominal_[cfg_.num_lanes - 1] -= cfg_.outer_inset;
+      lane_center_[cfg_.num_lanes - 1] -= cfg_.outer_inset;
+    }
 
     n_samples_ = static_cast<int>(std::floor(cfg_.score_horizon / cfg_.score_dt + 1e-9)) + 1;
     n_ticks_ = static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds));
@@ -190,8 +200,7 @@ class SearchPlanner : public Planner {
     car_index_.assign(kMaxCars, 0);
     car_s0_.assign(kMaxCars, 0.0);
     car_d0_.assign(kMaxCars, 0.0);
-    collision_step_ =
-        std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
+    collision_step_ = std::max(1, static_cast<int>(std::lround(cfg_.collision_dt / kTickSeconds)));
     n_steps_ = n_ticks_ / collision_step_;
     for (auto* v : {&step_s_, &step_d_, &step_v_, &step_vd_}) {
       v->assign(kMaxCars * (n_steps_ + 1), 0.0);
@@ -211,8 +220,8 @@ class SearchPlanner : public Planner {
     const int path_cap = kHistory + cfg_.output_points + n_ticks_ + 8;
     chk_x_.assign(path_cap, 0.0);
     chk_y_.assign(path_cap, 0.0);
-    for (auto* v : {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_,
-                    &plan_y_}) {
+    for (auto* v :
+         {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_, &plan_y_}) {
       v->assign(cfg_.output_points + 1, 0.0);
     }
     hist_x_.assign(kHistory, 0.0);
@@ -272,8 +281,7 @@ class SearchPlanner : public Planner {
     if (trace_ != nullptr) trace_->candidates.clear();
 
     const bool ego_ok = Finite(t.x) && Finite(t.y) && Finite(t.yaw) && Finite(t.speed) &&
-                        std::abs(t.x) < 1e6 && std::abs(t.y) < 1e6 && t.speed > -1 &&
-                        t.speed < 100;
+                        std::abs(t.x) < 1e6 && std::abs(t.y) < 1e6 && t.speed > -1 && t.speed < 100;
     bool prev_ok = t.previous_path_x.size() == t.previous_path_y.size();
     for (size_t i = 0; prev_ok && i < t.previous_path_x.size(); ++i) {
       prev_ok = Finite(t.previous_path_x[i]) && Finite(t.previous_path_y[i]);
@@ -312,15 +320,21 @@ class SearchPlanner : public Planner {
       // The driven points feed the jerk windows of the XY check.
       PushHistory(consumed);
       // Move the kept points to the front (destination before source: a forward copy is safe).
-      for (auto* v : {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_,
-                      &plan_y_}) {
+      for (auto* v :
+           {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_, &plan_y_}) {
         std::copy(v->begin() + consumed, v->begin() + consumed + kept, v->begin());
       }
       const int k = kept - 1;
       start = {plan_s_[k], plan_sd_[k], plan_sdd_[k], plan_d_[k], plan_dd_[k], plan_ddd_[k]};
+      straddle_at_start_ = straddle_ticks_;
+      for (int i = 0; i < kept; ++i) {
+        straddle_at_start_ =
+            Straddles(plan_s_[i], plan_s_[i], plan_d_[i], plan_d_[i]) ? straddle_at_start_ + 1 : 0;
+      }
       elapsed = (consumed + kept - plan_start_index_ - 1) * kTickSeconds;
     } else {
       hist_n_ = 0;
+      straddle_ticks_ = straddle_at_start_ = 0;
       have_prev_traj_ = false;
       if (ego_ok) {
         const map::FrenetPoint f = line_->ToFrenet(t.x, t.y, have_plan_ ? plan_s_[0] : t.s);
@@ -494,8 +508,8 @@ class SearchPlanner : public Planner {
     PlanSummary& sum = result_.summary;
     PushHistory(consumed);
     const int n = plan_n_ - consumed;
-    for (auto* v : {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_,
-                    &plan_y_}) {
+    for (auto* v :
+         {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_, &plan_y_}) {
       std::copy(v->begin() + consumed, v->begin() + plan_n_, v->begin());
     }
     plan_n_ = n;
@@ -519,6 +533,9 @@ class SearchPlanner : public Planner {
   void PushHistory(int consumed) {
     // Keep the last kHistory driven points, oldest first.
     for (int i = 0; i < consumed; ++i) {
+      straddle_ticks_ = Straddles(plan_s_[i], plan_s_[i], plan_d_[i], plan_d_[i])
+                            ? straddle_ticks_ + 1
+                            : 0;
       if (hist_n_ == kHistory) {
         std::copy(hist_x_.begin() + 1, hist_x_.end(), hist_x_.begin());
         std::copy(hist_y_.begin() + 1, hist_y_.end(), hist_y_.begin());
@@ -528,6 +545,20 @@ class SearchPlanner : public Planner {
       hist_y_[hist_n_] = plan_y_[i];
       ++hist_n_;
     }
+  }
+
+  // Whether the simulator may read d within kStraddle of a lane line for a point with s in
+  // [s0, s1] and d in [d0, d1] (it reads d from chords: ReferenceLine::ChordOffset).
+  bool Straddles(double s0, double s1, double d0, double d1) const {
+    const map::ReferenceLine::OffsetRange r = line_->ChordOffset(s0, s1, 0.5 * (d0 + d1));
+    return StraddlesRead(d0 + r.lo, d1 + r.hi);
+  }
+  bool StraddlesRead(double lo, double hi) const {
+    for (int l = 1; l < cfg_.num_lanes; ++l) {
+      const double line = l * cfg_.lane_width;
+      if (hi > line - kStraddle && lo < line + kStraddle) return true;
+    }
+    return false;
   }
 
   // Keeps s in [0, L): shifts everything stored by whole loops (wrap is free for the line).
@@ -547,6 +578,23 @@ class SearchPlanner : public Planner {
     return best;
   }
 
+  // The lanes' centres for this cycle: the nominal ones, moved just enough that the simulator,
+  // which measures d from the chords between waypoints (up to ~1.3 m outward mid-segment on
+  // left bends, udacity-sim.md §5.3 and §9.3), reads the ego inside its lane over the next
+  // stretch: clear of the lane lines' +-0.8 m bands (the 3 s timer) and of the road edges.
+  void LaneCentres() {
+    const double ahead = std::max(start_.s_d, 10.0) * cfg_.score_horizon + 20.0;
+    const int last = cfg_.num_lanes - 1;
+    for (int l = 0; l <= last; ++l) {
+      const map::ReferenceLine::OffsetRange r =
+          line_->ChordOffset(start_.s - 10.0, start_.s + ahead, lane_nominal_[l]);
+      const double lo_read = l == 0 ? cfg_.d_min : l * cfg_.lane_width + kLaneLineBand;
+      const double hi_read = l == last ? cfg_.d_max : (l + 1) * cfg_.lane_width - kLaneLineBand;
+      const double lo = lo_read - r.lo, hi = hi_read - r.hi;
+      lane_center_[l] = lo <= hi ? std::clamp(lane_nominal_[l], lo, hi) : 0.5 * (lo + hi);
+    }
+  }
+
   void BuildContext() {
     cost::CostContext& c = ctx_;
     c.num_samples = n_samples_;
@@ -562,6 +610,7 @@ class SearchPlanner : public Planner {
     c.previous_target_lane = prev_target_lane_;
     c.time_since_lane_change = time_since_change_;
     c.lane_before_change = lane_before_change_;
+    LaneCentres();
     // Lane speed limits: the XY speed of an offset curve is s' (1 + kappa d) with d to the right
     // and kappa positive to the left, so the outer lane of a left bend is faster in XY.
     const double reach = cfg_.max_speed * cfg_.score_horizon + 20;
@@ -623,7 +672,8 @@ class SearchPlanner : public Planner {
     }
     c.num_cars = nc;
     c.max_car_speed = 0;
-    for (int i = 0; i < nc * n_samples_; ++i) c.max_car_speed = std::max(c.max_car_speed, car_v_[i]);
+    for (int i = 0; i < nc * n_samples_; ++i)
+      c.max_car_speed = std::max(c.max_car_speed, car_v_[i]);
     c.near_lateral[0] = kNearLateral[0];
     c.near_lateral[1] = kNearLateral[1];
     c.near_longitudinal[0] = kNearLongitudinal[0];
@@ -666,8 +716,7 @@ class SearchPlanner : public Planner {
   // Broad phase of the cost terms (cost::CostInput::near_lat, near_lon): which cars are within
   // each reach of d[k] (near[0..n) and near[n..2n)), and of s[k].
   void NearLat(const double* d, std::uint64_t* near) const {
-    NearMasks(d, kNearLateral, near,
-              [this](int c, int k) { return car_d_[c * n_samples_ + k]; });
+    NearMasks(d, kNearLateral, near, [this](int c, int k) { return car_d_[c * n_samples_ + k]; });
   }
   void NearLon(const double* s, std::uint64_t* near) const {
     NearMasks(s, kNearLongitudinal, near,
@@ -676,8 +725,7 @@ class SearchPlanner : public Planner {
   // Bit c of near[k] (of near[n + k]) when |car_at(c, k) - x[k]| < reach[0] (reach[1]).
   // Car-major, so that the inner loop over samples vectorises.
   template <typename CarAt>
-  void NearMasks(const double* x, const double reach[2], std::uint64_t* near,
-                 CarAt car_at) const {
+  void NearMasks(const double* x, const double reach[2], std::uint64_t* near, CarAt car_at) const {
     const int n = n_samples_;
     std::fill(near, near + 2 * n, 0);
     for (int c = 0; c < ctx_.num_cars; ++c) {
@@ -707,14 +755,13 @@ class SearchPlanner : public Planner {
         // s_target = s_lead(T) - (D0 + tau v_lead(T)), minus `param` more.
         const Predictor::Prediction lead_at = predictor_->Predict(lead, t_keep_ + T);
         const double s_lead = start_.s + lead_at.s;
-        const double target =
-            s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param;
+        const double target = s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param;
         l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_at.v, 0.0, T);
         break;
       }
       case cost::LonKind::kStopping:
-        l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, s0.s + std::max(param, 0.0), 0.0,
-                                         0.0, T);
+        l.traj.poly =
+            traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, s0.s + std::max(param, 0.0), 0.0, 0.0, T);
         break;
       case cost::LonKind::kBraking:
         // Decelerate at `param` at once for T, then hold the speed reached (the trajectory's
@@ -733,7 +780,8 @@ class SearchPlanner : public Planner {
     l.lane = lane;
     l.offset = offset;
     l.traj.duration = T;
-    const double target = std::clamp(lane_center_[lane] + offset, cfg_.d_min, cfg_.d_max);
+    const double target =
+        std::clamp(lane_center_[lane] + offset, 0.0, cfg_.num_lanes * cfg_.lane_width);
     l.traj.poly = traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, target, 0.0, 0.0, T);
     return l;
   }
@@ -759,8 +807,7 @@ class SearchPlanner : public Planner {
     const double v0 = std::max(start_.s_d, 0.0);
     if (v0 < 1.0) return;
     for (int bi = 0; bi < cfg_.brake_decels; ++bi) {
-      const double a =
-          Linspace(cfg_.brake_min_decel, cfg_.brake_max_decel, cfg_.brake_decels, bi);
+      const double a = Linspace(cfg_.brake_min_decel, cfg_.brake_max_decel, cfg_.brake_decels, bi);
       for (int ti = 0; ti < cfg_.brake_targets; ++ti) {
         // Target speeds from standstill up to (but not including) the current speed.
         const double target = v0 * ti / cfg_.brake_targets;
@@ -907,7 +954,8 @@ class SearchPlanner : public Planner {
   }
 
   // The worst normalised excess over all limits (<= 0: feasible), and the first reason.
-  double Violation(Reject* reason) {
+  // lane_line: include the lane-line timer (LeastHarm may drop it: a collision is worse).
+  double Violation(Reject* reason, bool lane_line = true) {
     double worst = -1e9;
     Reject why = Reject::kCount;
     auto take = [&](double v, Reject r) {
@@ -916,15 +964,32 @@ class SearchPlanner : public Planner {
         why = r;
       }
     };
+    // d as the simulator reads it (from chords), bounded every 5 ticks over the s swept since
+    // the previous check point.
+    // The lane-line timer runs on, from the start state's count, while the read d may be astride
+    // a line; a trajectory still astride at its end would stay there.
     double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
-    for (int i = 1; i <= n_ticks_; ++i) {
-      dmin = std::min(dmin, tk_d_[i]);
-      dmax = std::max(dmax, tk_d_[i]);
-      sdmin = std::min(sdmin, tk_sd_[i]);
+    int straddle = straddle_at_start_, worst_straddle = straddle;
+    for (int i = 1; i <= n_ticks_; ++i) sdmin = std::min(sdmin, tk_sd_[i]);
+    for (int prev = 1, i = std::min(5, n_ticks_); n_ticks_ >= 1;
+         prev = i, i = std::min(i + 5, n_ticks_)) {
+      const double d_lo = std::min(tk_d_[prev], tk_d_[i]), d_hi = std::max(tk_d_[prev], tk_d_[i]);
+      const map::ReferenceLine::OffsetRange r = line_->ChordOffset(
+          std::min(tk_s_[prev], tk_s_[i]), std::max(tk_s_[prev], tk_s_[i]), 0.5 * (d_lo + d_hi));
+      dmin = std::min(dmin, d_lo + r.lo);
+      dmax = std::max(dmax, d_hi + r.hi);
+      straddle = StraddlesRead(d_lo + r.lo, d_hi + r.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+      worst_straddle = std::max(worst_straddle, straddle);
+      if (i == n_ticks_) break;
     }
+    if (straddle > 0) worst_straddle = 1 << 20;
     take(std::max(cfg_.d_min - dmin, dmax - cfg_.d_max) / cfg_.lane_width, Reject::kOffRoad);
+    if (lane_line) {
+      take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
+           Reject::kLaneLine);
+    }
     take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
-    if (worst > 0) {  // already infeasible: skip the XY conversion
+    if (worst > 0) {                      // already infeasible: skip the XY conversion
       if (reason != nullptr) *reason = why;
       return worst;
     }
@@ -939,9 +1004,11 @@ class SearchPlanner : public Planner {
 
   // Oriented-box overlap with every relevant car over the check horizon (inflated boxes).
   bool Collides() const {
-    return FirstCollision([this](int i) {
-      return FrenetState{tk_s_[i], tk_sd_[i], 0.0, tk_d_[i], tk_dd_[i], 0.0};
-    }, 1.0) <= n_steps_;
+    return FirstCollision(
+               [this](int i) {
+                 return FrenetState{tk_s_[i], tk_sd_[i], 0.0, tk_d_[i], tk_dd_[i], 0.0};
+               },
+               1.0) <= n_steps_;
   }
   // The same test evaluating the polynomials only at the collision steps: most rejected
   // candidates fail here, so they never pay for the full tick sampling.
@@ -972,8 +1039,7 @@ class SearchPlanner : public Planner {
         // The car's heading from its predicted velocity (a lane change turns it).
         const double cv = std::max(step_v_[at], 0.5), cvd = step_vd_[at];
         const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
-        const traj::OrientedBox car{cs, cd, 0.0, hl + margin,
-                                    hw + margin_scale * cfg_.margin_d};
+        const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
         if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) return j;
       }
     }
@@ -1011,8 +1077,8 @@ class SearchPlanner : public Planner {
       ++sum.candidates_feasible;
       TakeWinner(c);
       Trace(r, true, -1);
-      for (int rr = r + 1; rr < n && trace_ != nullptr &&
-                           static_cast<int>(trace_->candidates.size()) < trace_max_;
+      for (int rr = r + 1;
+           rr < n && trace_ != nullptr && static_cast<int>(trace_->candidates.size()) < trace_max_;
            ++rr) {
         Trace(rr, false, -1);
       }
@@ -1047,16 +1113,19 @@ class SearchPlanner : public Planner {
     // Latest contact first; the scoring order (stable) breaks ties.
     std::stable_sort(order_.begin(), order_.end(),
                      [&](int a, int b) { return first_hit_[a] > first_hit_[b]; });
-    for (int r = 0; r < n; ++r) {
-      if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
-        *over_budget = true;
-        return false;
+    // Feasible first; then ignoring the lane-line timer (an incident, but not a crash).
+    for (const bool lane_line : {true, false}) {
+      for (int r = 0; r < n; ++r) {
+        if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+          *over_budget = true;
+          return false;
+        }
+        const int c = order_[r];
+        FillTicks(Candidate(c));
+        if (Violation(nullptr, lane_line) > 0) continue;
+        TakeWinner(c);
+        return true;
       }
-      const int c = order_[r];
-      FillTicks(Candidate(c));
-      if (Violation(nullptr) > 0) continue;
-      TakeWinner(c);
-      return true;
     }
     return false;
   }
@@ -1265,8 +1334,8 @@ class SearchPlanner : public Planner {
                               std::min(2 * cfg_.fallback_decel, 0.75 * cfg_.max_accel),
                               0.9 * cfg_.max_accel};
     const int lane = LaneOf(start_.d);
-    Trajectory1d lat{traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, lane_center_[lane], 0,
-                                        0, cfg_.fallback_lat_duration),
+    Trajectory1d lat{traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, lane_center_[lane], 0, 0,
+                                        cfg_.fallback_lat_duration),
                      cfg_.fallback_lat_duration};
     for (int level = 0; level < 3; ++level) {
       const double decel = levels[level];
@@ -1341,7 +1410,8 @@ class SearchPlanner : public Planner {
   bool constraints_ok_ = false;
   int refine_evals_ = 0;
 
-  double lane_center_[cost::kMaxLanes] = {};
+  double lane_nominal_[cost::kMaxLanes] = {};  // configured lane centres, m
+  double lane_center_[cost::kMaxLanes] = {};   // this cycle's (LaneCentres), m
   int n_samples_ = 0, n_ticks_ = 0;
   Clock::time_point t0_;
   CycleTrace* trace_ = nullptr;
@@ -1382,16 +1452,18 @@ class SearchPlanner : public Planner {
   bool have_plan_ = false;
   int plan_n_ = 0;
   int plan_start_index_ = 0;  // index of the start state of the stored plan's new part
-  std::vector<double> plan_s_, plan_sd_, plan_sdd_, plan_d_, plan_dd_, plan_ddd_, plan_x_,
-      plan_y_;
+  std::vector<double> plan_s_, plan_sd_, plan_sdd_, plan_d_, plan_dd_, plan_ddd_, plan_x_, plan_y_;
   std::vector<double> hist_x_, hist_y_;
   int hist_n_ = 0;
+  // Consecutive ticks the simulator may have read the ego astride a lane line: up to the last
+  // driven point, and up to this cycle's start state (kept points included).
+  int straddle_ticks_ = 0, straddle_at_start_ = 0;
   bool have_prev_traj_ = false;
   FrenetTrajectory prev_traj_;
   double prev_elapsed_ = 0;  // s: the current start's time on prev_traj_
   double prev_base_ = 0;     // s: the stored plan start's time on prev_traj_ (see ContinuePrevious)
   int prev_target_lane_ = -1, lane_before_change_ = -1;
-  int prev_lat_lane_ = -1;       // lane and end offset (m) of the previous winner's lateral move
+  int prev_lat_lane_ = -1;  // lane and end offset (m) of the previous winner's lateral move
   double prev_lat_offset_ = 0;
   double time_since_change_ = 1e9;
   // Plan reuse between full searches (see CanReuse).

@@ -20,9 +20,6 @@ const char* StatusName(plan::PlanStatus s) {
   return "?";
 }
 
-constexpr const char* kRejectNames[] = {"speed", "acceleration", "jerk", "off_road", "collision"};
-static_assert(std::size(kRejectNames) == static_cast<std::size_t>(plan::Reject::kCount));
-
 nlohmann::json Finite(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
@@ -143,15 +140,15 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
                                  std::size_t first_incident, int l_old, int l_new) {
   const plan::PlanSummary& s = result.summary;
   nlohmann::json rejections = nlohmann::json::object();
-  for (std::size_t k = 0; k < std::size(kRejectNames); ++k) {
-    rejections[kRejectNames[k]] = s.rejections[k];
+  for (int k = 0; k < static_cast<int>(plan::Reject::kCount); ++k) {
+    rejections[plan::ToString(static_cast<plan::Reject>(k))] = s.rejections[k];
   }
   nlohmann::json candidates = nlohmann::json::array();
   if (trace != nullptr) {
     for (const plan::CandidateTrace& c : trace->candidates) {
       nlohmann::json reject = nullptr;
-      if (c.reject >= 0 && c.reject < static_cast<int>(std::size(kRejectNames))) {
-        reject = kRejectNames[c.reject];
+      if (c.reject >= 0 && c.reject < static_cast<int>(plan::Reject::kCount)) {
+        reject = plan::ToString(static_cast<plan::Reject>(c.reject));
       }
       candidates.push_back({{"lane", c.lane},
                             {"end_speed", Finite(c.end_speed)},

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 
 namespace frenetic::map {
@@ -104,6 +105,33 @@ TEST_F(ChordFrenetUdacity, SignAndSeam) {
   const FrenetPoint seam = frenet.Convert(px, py);
   EXPECT_NEAR(seam.s, 6945.554 - 0.1 * 31.405, 0.01);
   EXPECT_NEAR(seam.d, 0.0, 0.01);
+}
+
+// ReferenceLine::ChordOffset bounds what the simulator reads for points of the smooth line, and
+// it is large where the spec says (§5.3: up to ~1.4 m mid-segment on the left bends, outward).
+TEST_F(ChordFrenetUdacity, ReferenceLineChordOffsetBoundsTheSimulatorsReading) {
+  auto line = ReferenceLine::Fit(track_);
+  ASSERT_TRUE(line.ok()) << line.message();
+  const ChordFrenet frenet(track_);
+  double widest = 0, widest_s = 0;
+  for (double s = 0.25; s < (*line)->length(); s += 3.1) {
+    for (double d : {2.0, 6.0, 9.8}) {
+      const CartesianPose p = (*line)->ToCartesian(s, d);
+      const double reading = frenet.Convert(p.x, p.y).d - d;
+      const ReferenceLine::OffsetRange r = (*line)->ChordOffset(s, s, d);
+      ASSERT_LE(r.lo - 0.02, reading) << "s " << s << " d " << d;
+      ASSERT_GE(r.hi + 0.02, reading) << "s " << s << " d " << d;
+      if (r.hi > widest) {
+        widest = r.hi;
+        widest_s = s;
+      }
+    }
+  }
+  EXPECT_GT(widest, 1.1);  // a right-lane car at d = 9.8 reads > 10.9 there
+  EXPECT_NEAR(widest_s, 5100, 120);  // segment 144 -> 145, s 5072-5135
+  // A window covers its points.
+  const auto window = (*line)->ChordOffset(4900, 5200, 9.8);
+  EXPECT_GE(window.hi, widest - 1e-9);
 }
 
 TEST(ChordFrenetTest, SquareLoopByHand) {

@@ -70,6 +70,16 @@ class ReferenceLine {
   // s = 0; the sample at length() is samples()[0].
   const std::vector<RefSample>& samples() const;
 
+  // The simulator measures every d from the chords between waypoints (udacity-sim.md §5.3), not
+  // from this line: a point at (s, d) of the line reads d + offset, where the offset is the
+  // chord's distance from the line (up to ~1.3 m outward mid-segment on the Udacity map's left
+  // bends). Bounds of that offset for points at d with s in [s_from, s_to] (unwrapped,
+  // s_to >= s_from; at most one loop), conservative where the simulator switches chords.
+  struct OffsetRange {
+    double lo = 0, hi = 0;  // m
+  };
+  OffsetRange ChordOffset(double s_from, double s_to, double d) const;
+
   // Diagnostics of the fit.
   double max_waypoint_distance() const;  // largest distance from a waypoint to the line, m
   double max_map_s_difference() const;   // largest |s_line − s_map| at the waypoints, m

@@ -27,9 +27,10 @@ enum class PlanStatus : std::uint8_t {
 };
 const char* ToString(PlanStatus status);
 
-// Why a candidate was rejected (hard filters, counted per reason).
+// Why a candidate was rejected (hard filters, counted per reason). kLaneLine: it would keep the
+// ego astride a lane line past the simulator's 3 s timer.
 enum class Reject : std::uint8_t {
-  kSpeed, kAcceleration, kJerk, kOffRoad, kCollision, kCount
+  kSpeed, kAcceleration, kJerk, kOffRoad, kCollision, kLaneLine, kCount
 };
 const char* ToString(Reject reason);
 
