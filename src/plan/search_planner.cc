@@ -88,6 +88,7 @@ struct Settings {
   double lat_offset_step;
   double score_dt, score_horizon;
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
+  double headway_min;
   bool refine;
   int refine_iterations;
   double refine_budget_ms;
@@ -135,6 +136,7 @@ struct Settings {
     margin_s = c.value("check.margin_s");
     margin_d = c.value("check.margin_d");
     margin_behind = c.value("check.margin_behind");
+    headway_min = c.value("check.headway_min");
     refine = c.int_value("refine.enabled") != 0;
     refine_iterations = c.int_value("refine.max_iterations");
     refine_budget_ms = c.value("refine.budget_ms");
@@ -196,6 +198,8 @@ class SearchPlanner : public Planner {
     cand_cost_.reserve(max_lon * max_lat);
     order_.reserve(max_lon * max_lat);
     first_hit_.reserve(max_lon * max_lat);
+    clearance_.reserve(max_lon * max_lat);
+    rank_.reserve(max_lon * max_lat);
     for (auto* v : {&car_s_, &car_d_, &car_v_}) v->assign(kMaxCars * n_samples_, 0.0);
     car_index_.assign(kMaxCars, 0);
     car_s0_.assign(kMaxCars, 0.0);
@@ -1031,10 +1035,13 @@ class SearchPlanner : public Planner {
         // A car behind in another lane than the start's is one the ego would cut in front of:
         // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
         // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
+        // A car ahead needs room to brake behind it: headway_min at the ego's speed.
         const bool behind_other_lane =
             cs < ego.cx && std::abs(car_d0_[c] - start_.d) > 0.5 * cfg_.lane_width;
         const double margin =
-            margin_scale * (behind_other_lane ? cfg_.margin_behind : cfg_.margin_s);
+            margin_scale * (cs >= ego.cx ? std::max(cfg_.margin_s, cfg_.headway_min * st.s_d)
+                                         : behind_other_lane ? cfg_.margin_behind
+                                                             : cfg_.margin_s);
         if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
         // The car's heading from its predicted velocity (a lane change turns it).
         const double cv = std::max(step_v_[at], 0.5), cvd = step_vd_[at];
@@ -1044,6 +1051,23 @@ class SearchPlanner : public Planner {
       }
     }
     return n_steps_ + 1;
+  }
+
+  // The smallest separation (m) of the bare boxes from any car over the check horizon, in the
+  // Frenet frame with the boxes aligned to the lane: max(|ds| - length, |dd| - width), < 0 on
+  // overlap. Ranks the least harmful trajectories.
+  double Clearance(const FrenetTrajectory& tr) const {
+    double worst = 1e9;
+    for (int j = 1; j <= n_steps_; ++j) {
+      const FrenetState st = tr.At(j * collision_step_ * kTickSeconds);
+      for (int c = 0; c < ctx_.num_cars; ++c) {
+        const int at = c * (n_steps_ + 1) + j;
+        const double sep = std::max(std::abs(step_s_[at] - st.s) - cfg_.car_length,
+                                    std::abs(step_d_[at] - st.d) - cfg_.car_width);
+        worst = std::min(worst, sep);
+      }
+    }
+    return worst;
   }
 
   FrenetTrajectory Candidate(int c) const {
@@ -1096,23 +1120,33 @@ class SearchPlanner : public Planner {
   }
 
   // When no candidate is feasible and clear of traffic with the safety margins: the least
-  // harmful feasible one, judged on bare car boxes — collision-free if any is, else the one
-  // whose first contact comes latest (more time for the others to react, and for the next
-  // cycles to find a way out); cost breaks ties. False when none is even feasible.
+  // harmful feasible one, judged on bare car boxes — among the collision-free ones the one that
+  // keeps farthest from every car, else the one whose first contact comes latest (more time for
+  // the others to react, and for the next cycles to find a way out). False when none is even
+  // feasible.
   bool LeastHarm(bool* over_budget) {
     const int n = static_cast<int>(order_.size());
     first_hit_.resize(n);
+    clearance_.resize(n);
+    rank_.resize(n);
     for (int r = 0; r < n; ++r) {
       if ((r & 31) == 31 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
       }
       const int c = order_[r];
-      first_hit_[c] = FirstCollision([&](int i) { return Candidate(c).At(i * kTickSeconds); }, 0.0);
+      rank_[c] = r;
+      const FrenetTrajectory tr = Candidate(c);
+      first_hit_[c] = FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0);
+      clearance_[c] = first_hit_[c] > n_steps_ ? Clearance(tr) : 0.0;
     }
-    // Latest contact first; the scoring order (stable) breaks ties.
-    std::stable_sort(order_.begin(), order_.end(),
-                     [&](int a, int b) { return first_hit_[a] > first_hit_[b]; });
+    // Latest contact first, then most room; the scoring order breaks ties (a strict total order:
+    // std::stable_sort would allocate).
+    std::sort(order_.begin(), order_.end(), [&](int a, int b) {
+      if (first_hit_[a] != first_hit_[b]) return first_hit_[a] > first_hit_[b];
+      if (clearance_[a] != clearance_[b]) return clearance_[a] > clearance_[b];
+      return rank_[a] < rank_[b];
+    });
     // Feasible first; then ignoring the lane-line timer (an incident, but not a crash).
     for (const bool lane_line : {true, false}) {
       for (int r = 0; r < n; ++r) {
@@ -1426,7 +1460,9 @@ class SearchPlanner : public Planner {
   std::vector<LatTraj> lat_;
   std::vector<double> lon_s_, lon_sd_, lon_sdd_, lat_d_, lat_dd_, lat_ddd_;
   std::vector<int> cand_lon_, cand_lat_, order_;
-  std::vector<int> first_hit_;  // per candidate: first collision step on bare boxes (LeastHarm)
+  // Per candidate (LeastHarm): first collision step and clearance on bare boxes.
+  std::vector<int> first_hit_, rank_;
+  std::vector<double> clearance_;
   std::vector<double> cand_cost_;
   // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples
   // ([c * n_samples_ + k]), where it is at the start instant, its predictor index, and its
