@@ -191,6 +191,7 @@ Status TrafficOptions::Validate() const {
   check(cut_in_min_gap >= 0 && cut_in_max_gap >= cut_in_min_gap,
         "cut_in.gap must satisfy 0 <= min <= max");
   check(cut_in_duration > 0, "cut_in.duration must be > 0");
+  check(cut_in_max_closing >= 0, "cut_in.max_closing must be >= 0");
   check(hard_brake_rate >= 0, "hard_brake.rate must be >= 0");
   check(hard_brake_decel > 0, "hard_brake.decel must be > 0");
   check(hard_brake_duration > 0, "hard_brake.duration must be > 0");
@@ -413,6 +414,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
       c.Read("rate", &o.cut_in_rate);
       c.ReadRange("gap", &o.cut_in_min_gap, &o.cut_in_max_gap);
       c.Read("duration", &o.cut_in_duration);
+      c.Read("max_closing", &o.cut_in_max_closing);
       c.Finish();
     }
     {

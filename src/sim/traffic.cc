@@ -287,6 +287,9 @@ void Traffic::HarderEvents(const EgoView& ego, std::int64_t tick) {
     double best_gap = std::numeric_limits<double>::infinity();
     for (TrafficCar& c : cars_) {
       if (!c.spawned || c.changing || std::abs(c.lane - ego_lane) != 1) continue;
+      if (c.v * kMph <= o_.lane_change_min_mph || c.v < ego.speed - o_.cut_in_max_closing) {
+        continue;
+      }
       const double gap = line.DiffS(c.s, ego.s) - car_length_;
       if (gap >= o_.cut_in_min_gap && gap <= o_.cut_in_max_gap && gap < best_gap) {
         best_gap = gap;

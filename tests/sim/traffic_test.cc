@@ -216,6 +216,47 @@ double LowestSpeedBehindSlowLeader(std::shared_ptr<const World> world, bool to_l
   return v_min;
 }
 
+// Cut-ins (cut-in scenario): a car in the next lane 6-15 m ahead of the ego pulls in front of
+// it, unless it is much slower than the ego or below the §8.5 lane-change speed. Returns the
+// number of cut-ins over 10 s with the car at `car_speed` and the ego at 20 m/s.
+int CutInsWithCarAt(std::shared_ptr<const World> world, double car_speed) {
+  TrafficOptions o;
+  o.cars = 1;
+  o.lane_changes = false;
+  o.respawn_distance = 5000;
+  o.cut_in_rate = 50;  // as soon as allowed
+  o.cut_in_min_gap = 6;
+  o.cut_in_max_gap = 15;
+  o.cut_in_max_closing = 5;
+  o.event_cooldown = 0.5;
+  Ghost ego{world.get(), 1000, 6, 20};
+  Traffic traffic(world, o, 4.6, 2.4, 5, ego.View());
+  TrafficCar& c = traffic.mutable_cars()[0];
+  int cut_ins = 0;
+  for (int tick = 0; tick < 500; ++tick) {
+    // Keep the car in lane 0, 10 m ahead of the ego at a fixed speed.
+    c.spawned = true;
+    c.changing = false;
+    c.lane = 0;
+    c.d = 2;
+    c.s = world->line->WrapS(ego.s + 10 + 4.6);
+    c.v = c.top_speed = car_speed;
+    c.wander_amp = 0;
+    traffic.Place(c);
+    traffic.Tick(ego.View(), tick);
+    cut_ins = traffic.stats().cut_ins;
+    ego.Step();
+  }
+  return cut_ins;
+}
+
+TEST(Traffic, OnlyCarsNearTheEgosSpeedCutIn) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  EXPECT_GT(CutInsWithCarAt(world, 18.0), 0);  // 2 m/s slower: cuts in
+  EXPECT_EQ(CutInsWithCarAt(world, 12.0), 0);  // 8 m/s slower: would be unavoidable
+  EXPECT_EQ(CutInsWithCarAt(world, 5.0), 0);   // below 15 mph, even for a slow ego
+}
+
 TEST(Traffic, TooCloseCarBrakesToItsLeadersSpeedReadAsMph) {
   FRENETIC_REQUIRE_UDACITY(world);
   // §8.3: the desired speed is the leader's 13.1 m/s taken as 13.1 mph = 5.86 m/s; the recorded

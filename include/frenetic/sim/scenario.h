@@ -97,6 +97,10 @@ struct TrafficOptions {
   double cut_in_rate = 0;              // 1/s, chance rate that an adjacent car cuts in
   double cut_in_min_gap = 6, cut_in_max_gap = 20;  // m, bumper gap ahead of the ego
   double cut_in_duration = 1.5;        // s, its lateral manoeuvre
+  // m/s: a car slower than the ego by more than this does not cut in (nor does one below the
+  // §8.5 lane-change speed): a slow car pulling in a few metres ahead of a fast one makes a
+  // crash no driver could avoid, which measures nothing.
+  double cut_in_max_closing = 5;
   double hard_brake_rate = 0;          // 1/s, chance rate that the ego's leader brakes hard
   double hard_brake_decel = 8;         // m/s^2
   double hard_brake_duration = 1.5;    // s
