@@ -62,6 +62,7 @@ constexpr Default kDefaults[] = {
     {"check.margin_d", 0.3, 0, 2, false},
     {"check.margin_behind", 8, 0, 30, false},
     {"check.headway_min", 0.5, 0, 2, false},
+    {"check.behind_time", 1.0, 0, 4, false},
     {"prediction.range", 200, 50, 400, false},
     {"prediction.d_min", -1, -5, 0, false},
     {"prediction.d_max", 13, 12, 20, false},

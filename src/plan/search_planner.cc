@@ -36,6 +36,9 @@ constexpr double kRelevantRange = 120.0;
 constexpr double kNearLateral[2] = {3.2, 4.5};
 constexpr double kNearLongitudinal[2] = {8.0, 60.0};
 constexpr int kMaxCars = 64;
+// m: a car behind within this lateral offset is following the ego (the simulator's traffic sees
+// a leader within 2 m and brakes for it).
+constexpr double kFollowerLateral = 1.0;
 // The simulator times a car whose d is within 0.8 m of a lane line and flags it after 150 ticks
 // (udacity-sim.md §7.4). Lane centres keep a little more room; the hard check allows a little
 // less time.
@@ -88,7 +91,7 @@ struct Settings {
   double lat_offset_step;
   double score_dt, score_horizon;
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
-  double headway_min;
+  double headway_min, behind_time;
   bool refine;
   int refine_iterations;
   double refine_budget_ms;
@@ -137,6 +140,7 @@ struct Settings {
     margin_d = c.value("check.margin_d");
     margin_behind = c.value("check.margin_behind");
     headway_min = c.value("check.headway_min");
+    behind_time = c.value("check.behind_time");
     refine = c.int_value("refine.enabled") != 0;
     refine_iterations = c.int_value("refine.max_iterations");
     refine_budget_ms = c.value("refine.budget_ms");
@@ -537,9 +541,8 @@ class SearchPlanner : public Planner {
   void PushHistory(int consumed) {
     // Keep the last kHistory driven points, oldest first.
     for (int i = 0; i < consumed; ++i) {
-      straddle_ticks_ = Straddles(plan_s_[i], plan_s_[i], plan_d_[i], plan_d_[i])
-                            ? straddle_ticks_ + 1
-                            : 0;
+      straddle_ticks_ =
+          Straddles(plan_s_[i], plan_s_[i], plan_d_[i], plan_d_[i]) ? straddle_ticks_ + 1 : 0;
       if (hist_n_ == kHistory) {
         std::copy(hist_x_.begin() + 1, hist_x_.end(), hist_x_.begin());
         std::copy(hist_y_.begin() + 1, hist_y_.end(), hist_y_.begin());
@@ -645,14 +648,16 @@ class SearchPlanner : public Planner {
     } else {
       c.previous_s = c.previous_d = nullptr;
     }
-    // Traffic: relevant cars only. A car behind in the ego's own lane is its follower's problem
-    // (the simulator's traffic brakes for the car ahead). Predictions are sampled once here: at
-    // the scoring samples and at the collision-check steps, t_keep_ after the observation.
+    // Traffic: relevant cars only. A car right behind the ego in its lane is its follower's
+    // problem (the simulator's traffic brakes for the car ahead) — but only once the ego is
+    // squarely in front of it: mid lane change the car may not have seen the ego yet.
+    // Predictions are sampled once here: at the scoring samples and at the collision-check
+    // steps, t_keep_ after the observation.
     const auto cars = predictor_->cars();
     int nc = 0;
     for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
       const TrackedCar& car = cars[i];
-      if (car.s < -cfg_.car_length && std::abs(car.d - start_.d) < 0.5 * cfg_.lane_width) continue;
+      if (car.s < -cfg_.car_length && std::abs(car.d - start_.d) < kFollowerLateral) continue;
       car_index_[nc] = i;
       const Predictor::Prediction at_start = predictor_->Predict(i, t_keep_);
       car_s0_[nc] = start_.s + at_start.s;  // at the start instant, in the start's s frame
@@ -1020,9 +1025,12 @@ class SearchPlanner : public Planner {
     return FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0) <= n_steps_;
   }
   // The first collision step (1..n_steps_) of `state_at` (state at a tick index), or
-  // n_steps_ + 1 when none; the safety margins are scaled by margin_scale (0: bare boxes).
+  // n_steps_ + 1 when none. The safety margins are scaled by margin_scale (0: bare boxes),
+  // except the room kept for a car behind in another lane, scaled by behind_scale: that car
+  // does not see the ego until it is in front of it (the simulator's traffic only brakes for a
+  // car within 2 m laterally), so moving into its way is never safe.
   template <typename StateAt>
-  int FirstCollision(StateAt state_at, double margin_scale) const {
+  int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0) const {
     const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
     for (int j = 1; j <= n_steps_; ++j) {
       const FrenetState st = state_at(j * collision_step_);
@@ -1038,10 +1046,12 @@ class SearchPlanner : public Planner {
         // A car ahead needs room to brake behind it: headway_min at the ego's speed.
         const bool behind_other_lane =
             cs < ego.cx && std::abs(car_d0_[c] - start_.d) > 0.5 * cfg_.lane_width;
+        // A car behind in another lane needs room to react and brake when it closes in.
+        const double closing = std::max(0.0, step_v_[at] - st.s_d);
         const double margin =
-            margin_scale * (cs >= ego.cx ? std::max(cfg_.margin_s, cfg_.headway_min * st.s_d)
-                                         : behind_other_lane ? cfg_.margin_behind
-                                                             : cfg_.margin_s);
+            cs >= ego.cx        ? margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * st.s_d)
+            : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
+                                : margin_scale * cfg_.margin_s;
         if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
         // The car's heading from its predicted velocity (a lane change turns it).
         const double cv = std::max(step_v_[at], 0.5), cvd = step_vd_[at];
@@ -1120,10 +1130,10 @@ class SearchPlanner : public Planner {
   }
 
   // When no candidate is feasible and clear of traffic with the safety margins: the least
-  // harmful feasible one, judged on bare car boxes — among the collision-free ones the one that
-  // keeps farthest from every car, else the one whose first contact comes latest (more time for
-  // the others to react, and for the next cycles to find a way out). False when none is even
-  // feasible.
+  // harmful feasible one, judged on bare car boxes (but still never cutting in front of a car
+  // behind in another lane) — among the collision-free ones the one that keeps farthest from
+  // every car, else the one whose first contact comes latest (more time for the others to react,
+  // and for the next cycles to find a way out). False when none is even feasible.
   bool LeastHarm(bool* over_budget) {
     const int n = static_cast<int>(order_.size());
     first_hit_.resize(n);
@@ -1137,7 +1147,7 @@ class SearchPlanner : public Planner {
       const int c = order_[r];
       rank_[c] = r;
       const FrenetTrajectory tr = Candidate(c);
-      first_hit_[c] = FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0);
+      first_hit_[c] = FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0, 1.0);
       clearance_[c] = first_hit_[c] > n_steps_ ? Clearance(tr) : 0.0;
     }
     // Latest contact first, then most room; the scoring order breaks ties (a strict total order:
