@@ -36,6 +36,7 @@ struct DriveArgs {
   int jobs = 0;
   bool progress = false;
   bool no_timing = false;
+  bool real_time_deadlines = false;
   std::string connect;
   bool realtime = false;
 };
@@ -80,6 +81,9 @@ int Drive(const DriveArgs& a) {
       a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
   auto config = plan::PlannerConfig::Load(config_path);
   if (!config.ok()) return Fail(config.message());
+  // Latency is counted in ticks here, so wall-clock deadlines would only make a seed's result
+  // depend on the machine's load.
+  if (!a.real_time_deadlines) config->PinDeadlines();
   auto shared_config = std::make_shared<const plan::PlannerConfig>(std::move(config).value());
   std::shared_ptr<const map::ReferenceLine> line = (*world)->line;
   const std::string planner_name = a.planner;
@@ -180,6 +184,11 @@ void RegisterDrive(CLI::App& app) {
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,
                 "Show the live progress line on stderr even when it is not a terminal");
+  sub->add_flag("--real-time-deadlines", args->real_time_deadlines,
+                "Apply the planner's wall-clock deadlines (budget_ms, refine.budget_ms) as "
+                "configured. Default: off - the headless simulator counts latency in ticks, so "
+                "the deadlines are pinned at their maxima and every run of a seed gives the "
+                "same drive whatever the machine's load (planning times are still measured)");
   sub->add_flag("--no-timing", args->no_timing,
                 "Report and record planning times as 0, so the same seed gives byte-identical "
                 "records");

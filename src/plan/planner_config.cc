@@ -111,6 +111,14 @@ PlannerConfig PlannerConfig::Defaults() {
   return c;
 }
 
+void PlannerConfig::PinDeadlines() {
+  for (const char* key : {"budget_ms", "refine.budget_ms"}) {
+    Param* p = Find(key);
+    FRENETIC_CHECK(p != nullptr);
+    p->value = p->hi;
+  }
+}
+
 PlannerConfig::Param* PlannerConfig::Find(std::string_view key) {
   for (Param& p : params_) {
     if (p.key == key) return &p;

@@ -1312,6 +1312,11 @@ class SearchPlanner : public Planner {
     sum.refine_cost_after = before;
     nlopt_set_lower_bounds(opt_, lo);
     nlopt_set_upper_bounds(opt_, hi);
+    // The first steps: a tenth of each range. Explicit, or NLopt would keep the step it derived
+    // from the first refinement ever run (state carried across cycles and episodes).
+    double step[4];
+    for (int i = 0; i < 4; ++i) step[i] = std::max(1e-3, 0.1 * (hi[i] - lo[i]));
+    nlopt_set_initial_step(opt_, step);
     const double remaining = 0.8 * cfg_.budget_ms - MsSince(t0_);
     nlopt_set_maxtime(opt_, std::max(1e-3, std::min(cfg_.refine_budget_ms, remaining)) * 1e-3);
     refine_evals_ = 0;

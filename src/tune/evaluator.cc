@@ -107,18 +107,15 @@ struct Evaluator::Impl {
       if (Status s = config.Set(suite.params[i].key, values[i]); !s.ok()) return s;
     }
     if (pin) {
-      // Deadlines are wall-clock: at their maxima the search is never cut short, and the
-      // refinement (bounded by a wall-clock NLopt maxtime) is off, so an episode does not
-      // depend on load (rank and thread counts included).
-      for (const auto& p : config.Params()) {
-        if (p.key != "budget_ms" && p.key != "refine.budget_ms" && p.key != "refine.enabled") {
-          continue;
+      // Deadlines are wall-clock: at their maxima the search is never cut short and the
+      // refinement runs its iterations, so an episode does not depend on load (rank and thread
+      // counts included). A tuned budget keeps its tuned value.
+      config.PinDeadlines();
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::string& key = suite.params[i].key;
+        if (key == "budget_ms" || key == "refine.budget_ms") {
+          if (Status s = config.Set(key, values[i]); !s.ok()) return s;
         }
-        const bool tuned = std::any_of(suite.params.begin(), suite.params.end(),
-                                       [&](const TunedParam& t) { return t.key == p.key; });
-        if (tuned) continue;
-        const double pinned = p.key == "refine.enabled" ? p.lo : p.hi;
-        if (Status s = config.Set(p.key, pinned); !s.ok()) return s;
       }
     }
     return config;

@@ -36,6 +36,11 @@ class PlannerConfig {
   std::vector<Param> Params() const;
   std::string ToYaml() const;  // round-trips through Parse
   double budget_ms() const;    // per-cycle deadline (config key budget_ms)
+  // Sets the wall-clock budgets (budget_ms, refine.budget_ms) to their maxima, so that on any
+  // sane machine no deadline cuts a cycle short: the planner's answers then depend on its
+  // inputs only (refinement stays on, bounded by refine.max_iterations). For headless drives,
+  // tuning and fidelity runs, whose latency is counted in ticks, not measured.
+  void PinDeadlines();
 
   // The value of a declared key; aborts on an undeclared one (a program error).
   double value(std::string_view key) const;

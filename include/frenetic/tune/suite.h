@@ -68,10 +68,10 @@ struct Suite {
   ObjectiveWeights objective;
   SearchOptions search;
   // Make every episode independent of wall-clock time while evaluating: the planner's deadlines
-  // (budget_ms, refine.budget_ms) go to their maxima and the time-limited refinement is off
-  // (refine.enabled 0), unless the suite tunes those keys. Then an evaluation does not depend on
-  // machine load, threads or ranks, and a resumed run retraces the logged one. The tuned config
-  // keeps the start config's values of these keys.
+  // (budget_ms, refine.budget_ms) go to their maxima (PlannerConfig::PinDeadlines), unless the
+  // suite tunes those keys; the refinement runs its iteration budget. Then an evaluation does
+  // not depend on machine load, threads or ranks, and a resumed run retraces the logged one.
+  // The tuned config keeps the start config's values of these keys.
   bool deterministic = true;
 };
 
