@@ -13,6 +13,8 @@ constexpr double kRespawnJump = 15.0;
 // s: an older reading says little about the current acceleration (a queued car's brake/throttle
 // cycle is about a second long).
 constexpr double kMaxReadingAge = 0.5;
+// m/s^2: no car of the simulator speeds up faster (traffic tops out near 5).
+constexpr double kMaxCarAccel = 8.0;
 
 class TrafficPredictor : public Predictor {
  public:
@@ -50,11 +52,11 @@ class TrafficPredictor : public Predictor {
       double v = row.vx * ch + row.vy * sh;
       double v_d = row.vx * sh - row.vy * ch;
       Memory* m = Find(row.id);
-      if (IsSpawnGlitch(m, v)) {
-        // The spawn glitch reports the speed in mph as if it were m/s for one message: use the
-        // id's previous speed, or undo the unit slip.
-        v = m != nullptr ? m->v : std::min(v / kMphPerMps, options_.max_speed);
-        v_d = 0;
+      if (IsSpawnGlitch(m, f.s, v, now)) {
+        // The spawn glitch reports the speed in mph as if it were m/s for one message: undo
+        // the unit slip.
+        v = std::min(v / kMphPerMps, options_.max_speed);
+        v_d /= kMphPerMps;
       } else {
         car.a_s = Acceleration(m, f.s, v, now);
         Remember(m, row.id, f.s, v, now);
@@ -116,9 +118,16 @@ class TrafficPredictor : public Predictor {
     return nullptr;
   }
 
-  bool IsSpawnGlitch(const Memory* m, double v) const {
-    const bool glitch_ratio = m != nullptr && m->v > 1.0 && v > options_.spike_ratio * m->v;
-    return v > options_.max_speed || glitch_ratio;
+  // The spawn glitch: a speed above any car's, or a jump from a recent reading of the same car
+  // that no car could accelerate through. An old reading, or one from before a respawn (the id
+  // teleported), says nothing about the current speed, so it never makes a reading a glitch.
+  bool IsSpawnGlitch(const Memory* m, double s, double v, double now) const {
+    if (v > options_.max_speed) return true;
+    if (m == nullptr || !(m->v > 1.0)) return false;
+    const double dt = now - m->time;
+    if (!(dt > 0 && dt <= kMaxReadingAge)) return false;
+    if (std::abs(line_->DiffS(s, m->s + m->v * dt)) > kRespawnJump) return false;
+    return v > options_.spike_ratio * m->v && v - m->v > kMaxCarAccel * dt + 2.0;
   }
 
   // Longitudinal acceleration from the id's previous reading, when that is recent, or 0.

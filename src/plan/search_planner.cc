@@ -39,6 +39,8 @@ constexpr int kMaxCars = 64;
 // m: a car behind within this lateral offset is following the ego (the simulator's traffic sees
 // a leader within 2 m and brakes for it).
 constexpr double kFollowerLateral = 1.0;
+// m along s: a car in another lane this close is alongside (a lane change must yield to it).
+constexpr double kAlongside = 20.0;
 // The simulator times a car whose d is within 0.8 m of a lane line and flags it after 150 ticks
 // (udacity-sim.md §7.4). Lane centres keep a little more room; the hard check allows a little
 // less time.
@@ -89,6 +91,8 @@ struct Settings {
   double lat_min_duration, lat_max_duration;
   int lat_offsets;
   double lat_offset_step;
+  int lat_delays;
+  double lat_delay_step;
   double score_dt, score_horizon;
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
   double headway_min, behind_time;
@@ -130,6 +134,8 @@ struct Settings {
     lat_max_duration = c.value("grid.lat_max_duration");
     lat_offsets = c.int_value("grid.lat_offsets");
     lat_offset_step = c.value("grid.lat_offset_step");
+    lat_delays = c.int_value("grid.lat_delays");
+    lat_delay_step = c.value("grid.lat_delay_step");
     score_dt = c.value("score.dt");
     score_horizon = c.value("score.horizon");
     check_horizon = c.value("check.horizon");
@@ -190,9 +196,10 @@ class SearchPlanner : public Planner {
     n_ticks_ = static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds));
     n_ticks_ = std::max(n_ticks_, cfg_.output_points);
     const int max_lon = cfg_.speeds * cfg_.durations + cfg_.durations +
-                        cfg_.num_lanes * cfg_.follow_gaps * cfg_.durations +
+                        2 * cfg_.num_lanes * cfg_.follow_gaps * cfg_.durations +
                         cfg_.brake_decels * cfg_.brake_targets + 8;
-    const int max_lat = cfg_.num_lanes * (cfg_.lat_durations + 1) * cfg_.lat_offsets + 8;
+    const int max_lat =
+        cfg_.num_lanes * (cfg_.lat_durations + 1 + cfg_.lat_delays) * cfg_.lat_offsets + 8;
     lon_.reserve(max_lon);
     lat_.reserve(max_lat);
     for (auto* v : {&lon_s_, &lon_sd_, &lon_sdd_}) v->assign(max_lon * n_samples_, 0.0);
@@ -784,14 +791,18 @@ class SearchPlanner : public Planner {
     return l;
   }
 
-  LatTraj MakeLat(int lane, double offset, double T) const {
+  LatTraj MakeLat(int lane, double offset, double T, double delay = 0) const {
     LatTraj l;
     l.lane = lane;
     l.offset = offset;
     l.traj.duration = T;
+    l.traj.delay = delay;
     const double target =
         std::clamp(lane_center_[lane] + offset, 0.0, cfg_.num_lanes * cfg_.lane_width);
-    l.traj.poly = traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, target, 0.0, 0.0, T);
+    // A delayed move holds still first (only offered when the ego is nearly at rest laterally).
+    l.traj.poly = delay > 0
+                      ? traj::SolveQuintic(start_.d, 0.0, 0.0, target, 0.0, 0.0, T)
+                      : traj::SolveQuintic(start_.d, start_.d_d, start_.d_dd, target, 0.0, 0.0, T);
     return l;
   }
 
@@ -825,6 +836,22 @@ class SearchPlanner : public Planner {
     }
   }
 
+  // The car in `lane` nearest to the ego along s within kAlongside at the start instant (context
+  // index), or -1: the one a lane change into that lane must pass behind or in front of.
+  int Alongside(int lane) const {
+    int best = -1;
+    double best_ds = kAlongside;
+    for (int c = 0; c < ctx_.num_cars; ++c) {
+      if (std::abs(car_d0_[c] - lane_center_[lane]) > 0.6 * cfg_.lane_width) continue;
+      const double ds = std::abs(car_s0_[c] - start_.s);
+      if (ds < best_ds) {
+        best_ds = ds;
+        best = c;
+      }
+    }
+    return best;
+  }
+
   void GenerateBundles() {
     lon_.clear();
     lat_.clear();
@@ -833,7 +860,7 @@ class SearchPlanner : public Planner {
     // Lanes within reach: the current one and its neighbours.
     bool reachable[cost::kMaxLanes] = {};
     for (int l = 0; l < cfg_.num_lanes; ++l) {
-      reachable[l] = std::abs(lane_center_[l] - start_.d) <= 1.5 * cfg_.lane_width;
+      reachable[l] = std::abs(lane_center_[l] - start_.d) <= 2.5 * cfg_.lane_width;
     }
     for (int di = 0; di < cfg_.durations; ++di) {
       const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
@@ -849,18 +876,28 @@ class SearchPlanner : public Planner {
       if (di == 0) AddBraking();
       for (int l = 0; l < cfg_.num_lanes; ++l) {
         if (!reachable[l]) continue;
-        const int lead = Leader(l);
-        if (lead < 0) continue;
-        for (int g = 0; g < cfg_.follow_gaps; ++g) {
-          // Longer time gaps are extra distance on top of the base law.
-          const double extra = g * cfg_.follow_tau_step * car_v_[lead * n_samples_];
-          AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, car_index_[lead]));
+        // Follow the lane's leader, and yield to (drop behind) the car alongside, which the
+        // delayed lane changes below need to pass behind it (Apollo's yield samples).
+        const int targets[2] = {Leader(l), Alongside(l)};
+        for (int k = 0; k < 2; ++k) {
+          const int lead = targets[k];
+          if (lead < 0 || (k == 1 && lead == targets[0])) continue;
+          for (int g = 0; g < cfg_.follow_gaps; ++g) {
+            // Longer time gaps are extra distance on top of the base law.
+            const double extra = g * cfg_.follow_tau_step * car_v_[lead * n_samples_];
+            AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, car_index_[lead]));
+          }
         }
       }
     }
+    // Laterally at rest (keeping a lane): one duration stands for all for the own lane (they
+    // coincide), and lane changes may also wait before they start.
+    const bool at_rest = std::abs(start_.d_d) < 0.2 && std::abs(start_.d_dd) < 0.5;
     for (int l = 0; l < cfg_.num_lanes; ++l) {
       if (!reachable[l]) continue;
-      for (int ti = 0; ti < cfg_.lat_durations; ++ti) {
+      const bool own = std::abs(lane_center_[l] - start_.d) < 0.5 * cfg_.lane_width;
+      const bool centred = own && at_rest && std::abs(lane_center_[l] - start_.d) < 0.1;
+      for (int ti = 0; ti < (centred ? 1 : cfg_.lat_durations); ++ti) {
         const double T =
             Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, cfg_.lat_durations, ti);
         for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
@@ -868,11 +905,21 @@ class SearchPlanner : public Planner {
           AddLat(MakeLat(l, off, T));
         }
       }
+      if (!own && at_rest) {
+        const double T = Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, 3, 1);
+        for (int k = 1; k <= cfg_.lat_delays; ++k)
+          AddLat(MakeLat(l, 0.0, T, k * cfg_.lat_delay_step));
+      }
       // The lateral move under way, to its planned end time: replanning with full durations
-      // every cycle would stretch a lane change indefinitely (more time astride the line).
+      // every cycle would stretch a lane change indefinitely (more time astride the line), and
+      // a waiting one would never start.
       if (have_prev_traj_ && l == prev_lat_lane_) {
-        const double remaining = prev_traj_.lat.duration - prev_elapsed_;
-        if (remaining > 0.3 && remaining < cfg_.lat_min_duration - 0.05) {
+        const traj::Trajectory1d& prev = prev_traj_.lat;
+        const double wait = prev.delay - prev_elapsed_;
+        const double remaining = prev.end_time() - prev_elapsed_;
+        if (wait > 0.05) {
+          AddLat(MakeLat(l, prev_lat_offset_, prev.duration, wait));
+        } else if (remaining > 0.3 && remaining < cfg_.lat_min_duration - 0.05) {
           AddLat(MakeLat(l, prev_lat_offset_, remaining));
         }
       }
@@ -1030,7 +1077,8 @@ class SearchPlanner : public Planner {
   // does not see the ego until it is in front of it (the simulator's traffic only brakes for a
   // car within 2 m laterally), so moving into its way is never safe.
   template <typename StateAt>
-  int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0) const {
+  int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
+                     int* car_hit = nullptr) const {
     const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
     for (int j = 1; j <= n_steps_; ++j) {
       const FrenetState st = state_at(j * collision_step_);
@@ -1048,8 +1096,14 @@ class SearchPlanner : public Planner {
             cs < ego.cx && std::abs(car_d0_[c] - start_.d) > 0.5 * cfg_.lane_width;
         // A car behind in another lane needs room to react and brake when it closes in.
         const double closing = std::max(0.0, step_v_[at] - st.s_d);
+        // The headway to a car ahead is kept in full while the ego is in its lane and tapers
+        // to margin_s as the ego moves out of it (pulling out from behind a car is how a
+        // lane change starts).
+        const double inside = std::clamp(
+            (cfg_.car_width - std::abs(cd - st.d)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
         const double margin =
-            cs >= ego.cx        ? margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * st.s_d)
+            cs >= ego.cx
+                ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * st.s_d)
             : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                                 : margin_scale * cfg_.margin_s;
         if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
@@ -1057,7 +1111,10 @@ class SearchPlanner : public Planner {
         const double cv = std::max(step_v_[at], 0.5), cvd = step_vd_[at];
         const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
         const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
-        if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) return j;
+        if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) {
+          if (car_hit != nullptr) *car_hit = c;
+          return j;
+        }
       }
     }
     return n_steps_ + 1;
@@ -1096,9 +1153,14 @@ class SearchPlanner : public Planner {
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
       // conversion for the many candidates that run into traffic.
-      if (Collides(Candidate(c))) {
+      const FrenetTrajectory tr = Candidate(c);
+      int hit_car = -1;
+      const int hit =
+          FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0, 1.0, &hit_car);
+      if (hit <= n_steps_) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
-        Trace(r, false, static_cast<int>(Reject::kCollision));
+        Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
+              hit * collision_step_ * kTickSeconds);
         continue;
       }
       FillTicks(Candidate(c));
@@ -1174,7 +1236,8 @@ class SearchPlanner : public Planner {
     return false;
   }
 
-  void Trace(int rank, bool winner, int reject) {
+  // car: context index of the car a collision rejection is against (-1: none), at time t.
+  void Trace(int rank, bool winner, int reject, int car = -1, double t = 0) {
     if (trace_ == nullptr || static_cast<int>(trace_->candidates.size()) >= trace_max_) return;
     const int c = order_[rank];
     CandidateTrace ct;
@@ -1186,6 +1249,10 @@ class SearchPlanner : public Planner {
     ct.checked = winner || reject >= 0;
     ct.winner = winner;
     ct.reject = reject;
+    if (car >= 0) {
+      ct.reject_car = predictor_->cars()[car_index_[car]].id;
+      ct.reject_time = t;
+    }
     const FrenetTrajectory tr = Candidate(c);
     for (double tt = 0; tt <= cfg_.score_horizon + 1e-9; tt += 0.25) {
       const FrenetState st = tr.At(tt);
@@ -1342,7 +1409,7 @@ class SearchPlanner : public Planner {
     }
     prev_target_lane_ = lane;
     prev_lat_lane_ = lat_[winner_lat_].lane;
-    prev_lat_offset_ = winner_.lat.poly.P(winner_.lat.duration) - lane_center_[prev_lat_lane_];
+    prev_lat_offset_ = winner_.lat.At(winner_.lat.end_time()).p - lane_center_[prev_lat_lane_];
     prev_traj_ = winner_;
     prev_base_ = 0;
     have_prev_traj_ = true;

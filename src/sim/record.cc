@@ -157,6 +157,9 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
                             {"checked", c.checked},
                             {"winner", c.winner},
                             {"reject", reject},
+                            {"reject_car", c.reject_car >= 0 ? nlohmann::json(c.reject_car)
+                                                             : nlohmann::json(nullptr)},
+                            {"reject_t", Finite(c.reject_time)},
                             {"x", c.x},
                             {"y", c.y},
                             {"costs", Costs(c.costs)}});

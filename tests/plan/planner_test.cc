@@ -544,7 +544,7 @@ TEST(PredictorTest, RepairsGlitchesAndDropsParkedCars) {
   EXPECT_NEAR(pred->cars()[0].s, 50, 0.1);
   EXPECT_NEAR(pred->cars()[0].d, 6, 0.05);
   EXPECT_NEAR(pred->cars()[0].v_s, 17.6, 0.05);
-  // The spawn spike: 2.24x for one message -> the previous speed.
+  // The spawn spike: 2.24x for one message -> the unit slip undone.
   rows[0].vx *= 2.237;
   rows[0].vy *= 2.237;
   pred->Observe(rows, 150, 0.06);
@@ -554,6 +554,51 @@ TEST(PredictorTest, RepairsGlitchesAndDropsParkedCars) {
   rows[0].id = 7;
   pred->Observe(rows, 150, 0.06);
   EXPECT_NEAR(pred->cars()[0].v_s, 17.6 * 2.237 / 2.2369, 0.1);
+  // A car last seen slow long ago and fast now is fast (a stale reading proves no glitch), and
+  // its lateral motion is kept.
+  const map::CartesianPose b = line->ToCartesian(210, 6);
+  const double h = b.heading;
+  std::vector<SensorCar> slow = {{3, b.x, b.y, 4.7 * std::cos(h), 4.7 * std::sin(h), 0, 0}};
+  pred->Observe(slow, 150, 1.0);
+  // 17.6 along the lane, 2.5 m/s to the left (the right normal is (sin h, -cos h)).
+  std::vector<SensorCar> fast = {{3, b.x, b.y, 17.6 * std::cos(h) - 2.5 * std::sin(h),
+                                  17.6 * std::sin(h) + 2.5 * std::cos(h), 0, 0}};
+  pred->Observe(fast, 150, 20.0);
+  ASSERT_EQ(pred->cars().size(), 1u);
+  EXPECT_NEAR(pred->cars()[0].v_s, 17.6, 0.05);
+  EXPECT_NEAR(pred->cars()[0].v_d, -2.5, 0.05);
+}
+
+// The manoeuvre-aware predictor: a braking car keeps braking (for brake_horizon), a car moving
+// across lanes reaches the next lane's centre and stops there.
+TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
+  REQUIRE_MAP(line);
+  PredictorOptions o;
+  auto pred = MakeManoeuvrePredictor(line, o);
+  const map::CartesianPose p = line->ToCartesian(300, 9.0);
+  const double h = p.heading;
+  auto row = [&](double v, double v_d) {
+    return std::vector<SensorCar>{{1, p.x, p.y, v * std::cos(h) + v_d * std::sin(h),
+                                   v * std::sin(h) - v_d * std::cos(h), 0, 0}};
+  };
+  pred->Observe(row(20.0, 0.0), 280, 0.0);
+  pred->Observe(row(19.4, -2.0), 280, 0.1);  // -6 m/s^2, moving left at 2 m/s
+  ASSERT_EQ(pred->cars().size(), 1u);
+  EXPECT_NEAR(pred->cars()[0].a_s, -6.0, 0.05);
+  EXPECT_NEAR(pred->cars()[0].d_target, 6.0, 1e-9);  // the middle lane's centre
+  const Predictor::Prediction at1 = pred->Predict(0, 1.0), at3 = pred->Predict(0, 3.0);
+  EXPECT_NEAR(at1.v, 13.4, 0.1);
+  EXPECT_NEAR(at1.d, 7.0, 0.05);
+  EXPECT_NEAR(at1.v_d, -2.0, 1e-9);
+  EXPECT_NEAR(at3.d, 6.0, 1e-9);  // arrived, and stays
+  EXPECT_EQ(at3.v_d, 0.0);
+  EXPECT_NEAR(at3.v, 19.4 - 6.0 * 2.0, 0.1);  // braked for brake_horizon (2 s), then holds
+  // The constant-velocity predictor ignores both.
+  auto cv = MakeConstantVelocityPredictor(line, o);
+  cv->Observe(row(20.0, 0.0), 280, 0.0);
+  cv->Observe(row(19.4, -2.0), 280, 0.1);
+  EXPECT_NEAR(cv->Predict(0, 3.0).v, 19.4, 0.05);
+  EXPECT_NEAR(cv->Predict(0, 3.0).d, 9.0, 0.05);
 }
 
 TEST(FeasibilityTest, SlidingCheckBoundsTheSimulatorsMeasureAndSeesKinks) {

@@ -93,6 +93,15 @@ TEST(TrajectoryTest, ContinuesAtConstantVelocityAfterItsEnd) {
   FrenetTrajectory ft{t, Trajectory1d{SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0}};
   EXPECT_NEAR(ft.At(2.5).d, 2, 1e-9);
   EXPECT_TRUE(ft.At(1.0).IsFinite());
+  // A delayed lane change holds its start for the delay, then follows the quintic, shifted.
+  Trajectory1d wait{SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5};
+  EXPECT_EQ(wait.end_time(), 3.5);
+  EXPECT_EQ(wait.At(0.0).p, 6);
+  EXPECT_EQ(wait.At(1.4).p, 6);
+  EXPECT_EQ(wait.At(1.4).v, 0);
+  EXPECT_NEAR(wait.At(1.5 + 1.2).p, ft.lat.At(1.2).p, 1e-12);
+  EXPECT_NEAR(wait.At(1.5 + 1.2).v, ft.lat.At(1.2).v, 1e-12);
+  EXPECT_NEAR(wait.At(10).p, 2, 1e-9);
 }
 
 TEST(BoxTest, OverlapSeparatingAxis) {

@@ -78,6 +78,8 @@ struct CandidateTrace {
   bool checked = false;       // went through the feasibility / collision check
   bool winner = false;
   int reject = -1;            // static_cast<int>(Reject) when checked and rejected, else -1
+  int reject_car = -1;        // collision rejections: the other car's sensor_fusion id...
+  double reject_time = 0;     // ...and when the (margin-inflated) boxes would first meet, s
   std::vector<double> x, y;   // the candidate's path in the map frame, coarsely sampled (~0.25 s)
   std::vector<CostTermValue> costs;  // per term, config order
 };

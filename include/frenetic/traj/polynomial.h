@@ -37,12 +37,16 @@ Polynomial5 SolveQuartic(double x0, double v0, double a0, double v1, double a1, 
 
 // A polynomial valid on [0, duration], continued at constant velocity (zero acceleration) after
 // its end: the lattice's trajectories all end with zero acceleration, so the continuation is C1
-// and, for those, C2.
+// and, for those, C2. With a delay the motion holds still at the polynomial's start for that long
+// and follows it after (a lane change that waits): for polynomials that start at rest, this is C2.
 struct Trajectory1d {
   Polynomial5 poly;
-  double duration = 0;  // s
-
+  double duration = 0;  // s, of the polynomial
+  double delay = 0;     // s before the polynomial starts
+  double end_time() const { return delay + duration; }
   State1d At(double t) const {
+    if (t < delay) return {poly.c[0], 0.0, 0.0, 0.0};
+    t -= delay;
     if (t <= duration) return poly.At(t);
     const State1d e = poly.At(duration);
     return {e.p + e.v * (t - duration), e.v, 0.0, 0.0};
