@@ -3,6 +3,7 @@
 // samples. 0 with ample room; about 1 bumper to bumper.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "frenetic/cost/cost_registry.h"
 
@@ -23,40 +24,42 @@ class BufferCost : public CostTerm {
     if (n == 0 || ctx.num_cars == 0) return 0.0;
     // Same lane: the centres are closer laterally than a car width plus a little.
     const double same_lane = ctx.car_width + 0.6;
-    const double car_v_max = ctx.max_car_speed;
-    double max_speed = car_v_max;
+    // No car farther in s than a car length plus the largest desired gap can fall short.
+    double max_speed = ctx.max_car_speed;
     for (int k = 0; k < n; ++k) max_speed = std::max(max_speed, in.s_d[k]);
-    const double max_reach = ctx.car_length + min_gap_ + headway_ * max_speed;
-    if (!AnyCarNear(ctx, in, same_lane, max_reach)) return 0.0;
+    const NearCars near(ctx, in, same_lane, ctx.car_length + min_gap_ + headway_ * max_speed);
+    if (!near.Any(n)) return 0.0;
     double sum = 0;
     for (int k = 0; k < n; ++k) {
-      double worst = 0;
-      // The desired gap depends on the follower: the ego for a car ahead, the car for one behind.
-      const double ego_speed = std::max(in.s_d[k], 0.0);
-      const double desired_ahead = min_gap_ + headway_ * ego_speed;
-      const double inv_ahead = 1.0 / desired_ahead;
-      // No car farther in s than a car length plus the largest desired gap can fall short.
-      const double reach = ctx.car_length + min_gap_ + headway_ * std::max(ego_speed, car_v_max);
-      ForEachCarNear(ctx, in, k, same_lane, reach, [&](int c) {
+      // The desired gap depends on the follower: the ego for a car ahead (whose nearest one
+      // falls shortest), the car itself for one behind.
+      double nearest_ahead = std::numeric_limits<double>::infinity(), worst = 0;
+      near.ForEach(k, [&](int c) {
         if (std::abs(ctx.car_d[c * n + k] - in.d[k]) > same_lane) return true;
         const double ds = ctx.car_s[c * n + k] - in.s[k];
-        const double gap = std::abs(ds) - ctx.car_length;
-        double ratio;  // gap / desired gap
         if (ds >= 0) {
-          ratio = gap * inv_ahead;
+          nearest_ahead = std::min(nearest_ahead, ds);
         } else {
-          ratio = gap / (min_gap_ + headway_ * std::max(ctx.car_v[c * n + k], 0.0));
+          const double desired = min_gap_ + headway_ * std::max(ctx.car_v[c * n + k], 0.0);
+          worst = std::max(worst, Shortfall(-ds - ctx.car_length, desired));
         }
-        const double shortfall = std::clamp(1.0 - ratio, 0.0, 3.0);
-        worst = std::max(worst, shortfall * shortfall);
         return true;
       });
+      if (nearest_ahead < std::numeric_limits<double>::infinity()) {
+        const double desired = min_gap_ + headway_ * std::max(in.s_d[k], 0.0);
+        worst = std::max(worst, Shortfall(nearest_ahead - ctx.car_length, desired));
+      }
       sum += worst;
     }
     return sum / n;
   }
 
  private:
+  // (1 - gap / desired)^2 where the gap falls short, capped; 0 with ample room.
+  static double Shortfall(double gap, double desired) {
+    const double shortfall = std::clamp(1.0 - gap / desired, 0.0, 3.0);
+    return shortfall * shortfall;
+  }
   double min_gap_ = 8.0, headway_ = 1.2;
 };
 

@@ -23,18 +23,23 @@ class CollisionCost : public CostTerm {
     const int n = ctx.num_samples;
     if (n == 0 || ctx.num_cars == 0) return 0.0;
     const double hl = 0.5 * ctx.car_length + margin_, hw = 0.5 * ctx.car_width + margin_;
-    // Cheap reject first: no overlap is possible beyond the boxes' circumscribed reach.
+    // Cheap reject first: no overlap is possible beyond the boxes' circumscribed reach, nor
+    // laterally beyond the ego's turned half-extent plus the car's half-width, at most
+    // hl |sin| + 2 hw with |sin| <= |d'|/s' (the heading from the Frenet velocity, s' floored:
+    // no spin at rest).
     const double reach = 2.0 * std::hypot(hl, hw);
-    if (!AnyCarNear(ctx, in, hl + 2.0 * hw, reach)) return 0.0;
+    double max_sin = 0;
+    for (int k = 0; k < n; ++k) {
+      max_sin = std::max(max_sin, std::abs(in.d_d[k]) / std::max(in.s_d[k], 0.5));
+    }
+    const NearCars near(ctx, in, hl * std::min(1.0, max_sin) + 2.0 * hw, reach);
+    if (!near.Any(n)) return 0.0;
     double sum = 0;
     for (int k = 0; k < n; ++k) {
-      // Ego heading from the Frenet velocity (s' floored: no spin at rest). Its lateral
-      // half-extent plus the car's half-width is at most hl |sin| + 2 hw, and |sin| <= |d'|/s'.
       const double vs = std::max(in.s_d[k], 0.5), vd = in.d_d[k];
-      const double lateral = hl * std::min(1.0, std::abs(vd) / vs) + 2.0 * hw;
       double ch = 0, sh = 0;  // unit heading, computed for the first car within reach
       bool hit = false;
-      ForEachCarNear(ctx, in, k, lateral, reach, [&](int c) {
+      near.ForEach(k, [&](int c) {
         const double ds = ctx.car_s[c * n + k] - in.s[k], dd = ctx.car_d[c * n + k] - in.d[k];
         if (std::abs(ds) > reach || std::abs(dd) > reach) return true;
         if (ch == 0) {

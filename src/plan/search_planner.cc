@@ -29,7 +29,7 @@ constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s
 // m: cars closer than this (map frame) decide whether the last plan may be reused. Farther cars
 // cannot reach the ego's path within the few ticks a reused plan covers before the next search.
 constexpr double kRelevantRange = 120.0;
-// m: reaches of the cost terms' broad-phase masks (cost::ForEachCarNear), tighter first.
+// m: reaches of the cost terms' broad-phase masks (cost::NearCars), tighter first.
 // Laterally: the buffer term's same-lane test; the collision term's boxes up to a ~20 degree
 // heading. Longitudinally: the collision term's boxes; the buffer term's desired gap up to
 // ~50 m. A term that needs more reach falls back to examining every car.

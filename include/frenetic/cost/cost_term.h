@@ -49,7 +49,7 @@ struct CostContext {
   // An upper bound of every car_v value (m/s; infinity when unknown): bounds broad-phase reaches.
   double max_car_speed = std::numeric_limits<double>::infinity();
   double car_length = 4.8, car_width = 2.4;  // footprint of every car, ego included, m
-  // Reaches of the broad-phase masks in CostInput (m), tighter first: see ForEachCarNear.
+  // Reaches of the broad-phase masks in CostInput (m), tighter first: see NearCars.
   double near_lateral[2] = {0, 0};
   double near_longitudinal[2] = {0, 0};
 };
@@ -82,54 +82,60 @@ struct CostInput {
   const std::uint64_t* near_lon[2] = {nullptr, nullptr};
 };
 
-namespace internal {
-// The tightest of two masks whose reach exceeds `reach`, or nullptr.
-inline const std::uint64_t* Mask(const std::uint64_t* const masks[2], const double reaches[2],
-                                 double reach) {
-  for (int i = 0; i < 2; ++i) {
-    if (masks[i] != nullptr && reach < reaches[i]) return masks[i];
-  }
-  return nullptr;
-}
-}  // namespace internal
+// The broad-phase masks a term may use for given reaches: the tightest of CostInput::near_lat and
+// near_lon that cover them (either may be absent: then that direction does not filter). Choose
+// once per candidate, then visit the cars near each sample. A superset: terms still apply their
+// exact test. Cars are visited in index order either way.
+class NearCars {
+ public:
+  NearCars(const CostContext& ctx, const CostInput& in, double lateral, double longitudinal)
+      : lat_(Pick(in.near_lat, ctx.near_lateral, lateral)),
+        lon_(Pick(in.near_lon, ctx.near_longitudinal, longitudinal)),
+        all_(ctx.num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << ctx.num_cars) - 1),
+        num_cars_(ctx.num_cars) {}
 
-// Calls fn(c) for every car c that may lie within `lateral` metres in d and `longitudinal`
-// metres in s of the candidate at sample k, until fn returns false: the cars of the tightest
-// broad-phase masks that cover those reaches, else every car. A superset: terms still apply
-// their exact test. Cars are visited in index order either way.
-template <typename Fn>
-inline void ForEachCarNear(const CostContext& ctx, const CostInput& in, int k, double lateral,
-                           double longitudinal, Fn&& fn) {
-  const std::uint64_t* lat = internal::Mask(in.near_lat, ctx.near_lateral, lateral);
-  const std::uint64_t* lon = internal::Mask(in.near_lon, ctx.near_longitudinal, longitudinal);
-  if (lat == nullptr && lon == nullptr) {
-    for (int c = 0; c < ctx.num_cars; ++c) {
-      if (!fn(c)) return;
+  // Bit c set: car c may be near at sample k.
+  std::uint64_t At(int k) const {
+    std::uint64_t m = all_;
+    if (lat_ != nullptr) m &= lat_[k];
+    if (lon_ != nullptr) m &= lon_[k];
+    return m;
+  }
+  // Whether any car may be near at any of the n samples.
+  bool Any(int n) const {
+    if (num_cars_ == 0) return false;
+    if (lat_ == nullptr && lon_ == nullptr) return true;
+    std::uint64_t any = 0;
+    for (int k = 0; k < n; ++k) any |= At(k);
+    return any != 0;
+  }
+  // Calls fn(c) for the cars near sample k until fn returns false.
+  template <typename Fn>
+  void ForEach(int k, Fn&& fn) const {
+    if (num_cars_ > 64) {  // beyond the masks' reach: every car
+      for (int c = 0; c < num_cars_; ++c) {
+        if (!fn(c)) return;
+      }
+      return;
     }
-    return;
+    for (std::uint64_t m = At(k); m != 0; m &= m - 1) {
+      if (!fn(std::countr_zero(m))) return;
+    }
   }
-  std::uint64_t m = ~std::uint64_t{0};
-  if (lat != nullptr) m &= lat[k];
-  if (lon != nullptr) m &= lon[k];
-  for (; m != 0; m &= m - 1) {
-    if (!fn(std::countr_zero(m))) return;
-  }
-}
 
-// Whether ForEachCarNear could visit any car at any sample, for reaches that hold at every
-// sample: lets a term skip its per-sample work for candidates far from all traffic.
-inline bool AnyCarNear(const CostContext& ctx, const CostInput& in, double lateral,
-                       double longitudinal) {
-  if (ctx.num_cars == 0) return false;
-  const std::uint64_t* lat = internal::Mask(in.near_lat, ctx.near_lateral, lateral);
-  const std::uint64_t* lon = internal::Mask(in.near_lon, ctx.near_longitudinal, longitudinal);
-  if (lat == nullptr && lon == nullptr) return true;
-  std::uint64_t any = 0;
-  for (int k = 0; k < ctx.num_samples; ++k) {
-    any |= (lat != nullptr ? lat[k] : ~std::uint64_t{0}) & (lon != nullptr ? lon[k] : ~std::uint64_t{0});
+ private:
+  static const std::uint64_t* Pick(const std::uint64_t* const masks[2], const double reaches[2],
+                                   double reach) {
+    for (int i = 0; i < 2; ++i) {
+      if (masks[i] != nullptr && reach < reaches[i]) return masks[i];
+    }
+    return nullptr;
   }
-  return any != 0;
-}
+  const std::uint64_t* lat_;
+  const std::uint64_t* lon_;
+  std::uint64_t all_;
+  int num_cars_;
+};
 
 // A tunable parameter a term declares, with its default and a sensible range.
 struct CostParamSpec {
