@@ -28,14 +28,16 @@ class CollisionCost : public CostTerm {
     // hl |sin| + 2 hw with |sin| <= |d'|/s' (the heading from the Frenet velocity, s' floored:
     // no spin at rest).
     const double reach = 2.0 * std::hypot(hl, hw);
-    double max_sin = 0;
+    double max_d_d = 0, min_s_d = 1e9;
     for (int k = 0; k < n; ++k) {
-      max_sin = std::max(max_sin, std::abs(in.d_d[k]) / std::max(in.s_d[k], 0.5));
+      max_d_d = std::max(max_d_d, std::abs(in.d_d[k]));
+      min_s_d = std::min(min_s_d, in.s_d[k]);
     }
-    const NearCars near(ctx, in, hl * std::min(1.0, max_sin) + 2.0 * hw, reach);
-    if (!near.Any(n)) return 0.0;
+    const double max_sin = std::min(1.0, max_d_d / std::max(min_s_d, 0.5));
+    const NearCars near(ctx, in, hl * max_sin + 2.0 * hw, reach);
     double sum = 0;
     for (int k = 0; k < n; ++k) {
+      if (near.At(k) == 0) continue;
       const double vs = std::max(in.s_d[k], 0.5), vd = in.d_d[k];
       double ch = 0, sh = 0;  // unit heading, computed for the first car within reach
       bool hit = false;

@@ -35,24 +35,36 @@ XyChecker::XyChecker(int capacity) {
 }
 
 XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first) {
-  XyMeasure m;
+  n = Compute(x, y, n, 1);
+  return n < 2 ? XyMeasure{} : Worst(n, first);
+}
+
+void XyChecker::SetPrefix(const double* x, const double* y, int n) {
+  prefix_ = std::max(0, Compute(x, y, n, 1));
+}
+
+XyMeasure XyChecker::MeasureWithPrefix(const double* x, const double* y, int n, int first) {
+  n = Compute(x, y, n, std::max(1, prefix_));
+  return n < 2 ? XyMeasure{} : Worst(n, first);
+}
+
+int XyChecker::Compute(const double* x, const double* y, int n, int from) {
   n = std::min(n, static_cast<int>(v_.size()) - 1);
-  if (n < 2) return m;
-  first = std::clamp(first, 1, n - 1);
-  // v_[i]: speed at tick i (from i-1); kappa_[i]: Menger curvature of (i-1, i, i+1).
+  if (n < 2) return n;
+  from = std::clamp(from, 1, n);
+  // v_[i]: speed at tick i (from i-1); kappa_[i]: Menger curvature of (i-1, i, i+1), 0 for the
+  // last point (recomputed once a later point exists).
   v_[0] = 0;
-  for (int i = 1; i < n; ++i) v_[i] = Norm(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
+  for (int i = from; i < n; ++i) v_[i] = Norm(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
   kappa_[0] = 0;
-  kappa_[n - 1] = 0;
-  for (int i = 1; i + 1 < n; ++i) {
+  for (int i = std::max(1, from - 1); i + 1 < n; ++i) {
     kappa_[i] = Menger(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
   }
-  for (int i = first; i < n; ++i) m.max_speed = std::max(m.max_speed, v_[i]);
-  if (std::isnan(v_[n - 1])) m.max_speed = NAN;
+  kappa_[n - 1] = 0;
   // Prefix sums make every sliding block mean O(1).
   vsum_[0] = 0;
   ksum_[0] = 0;
-  for (int i = 0; i < n; ++i) {
+  for (int i = std::max(0, from - 1); i < n; ++i) {
     vsum_[i + 1] = vsum_[i] + v_[i];
     ksum_[i + 1] = ksum_[i] + kappa_[i];
   }
@@ -60,17 +72,24 @@ XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first)
   // Block ending at tick j holds ticks j-9..j; its triples are centred at j-8..j-1.
   auto kmean = [&](int j) { return (ksum_[j] - ksum_[j - 8]) / 8.0; };
   // acc_[j] valid for j >= 2 * kBlock (needs the previous block, which starts at tick >= 1).
-  const int a0 = 2 * kBlock;
-  for (int j = a0; j < n; ++j) {
+  for (int j = std::max(2 * kBlock, from); j < n; ++j) {
     const double vm = vmean(j), vp = vmean(j - kBlock);
     const double at = (vm - vp) / (kBlock * kDt), an = vm * vm * kmean(j);
     acc_[j] = Norm(at, an);
-    if (j >= first) m.max_accel = std::max(m.max_accel, acc_[j]);
   }
+  return n;
+}
+
+XyMeasure XyChecker::Worst(int n, int first) const {
+  XyMeasure m;
+  first = std::clamp(first, 1, n - 1);
+  for (int i = first; i < n; ++i) m.max_speed = std::max(m.max_speed, v_[i]);
+  if (std::isnan(v_[n - 1])) m.max_speed = NAN;
+  const int a0 = 2 * kBlock;
+  for (int j = std::max(a0, first); j < n; ++j) m.max_accel = std::max(m.max_accel, acc_[j]);
   // Jerk from 1 s means of the acceleration samples, block-aligned with j.
   const int span = kBlock * kJerkBlocks;
-  for (int j = a0 + (kJerkBlocks - 1) * kBlock + span; j < n; ++j) {
-    if (j < first) continue;
+  for (int j = std::max(a0 + (kJerkBlocks - 1) * kBlock + span, first); j < n; ++j) {
     double now = 0, before = 0;
     for (int b = 0; b < kJerkBlocks; ++b) {
       now += acc_[j - b * kBlock];

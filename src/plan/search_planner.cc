@@ -210,7 +210,6 @@ class SearchPlanner : public Planner {
     order_.reserve(max_lon * max_lat);
     first_hit_.reserve(max_lon * max_lat);
     clearance_.reserve(max_lon * max_lat);
-    rank_.reserve(max_lon * max_lat);
     for (auto* v : {&car_s_, &car_d_, &car_v_}) v->assign(kMaxCars * n_samples_, 0.0);
     car_index_.assign(kMaxCars, 0);
     car_s0_.assign(kMaxCars, 0.0);
@@ -378,6 +377,7 @@ class SearchPlanner : public Planner {
     // Prediction (relative to the start state's s; the observation is "now").
     predictor_->Observe(t.sensor_fusion, start.s, clock_);
     BuildContext();
+    SetXyPrefix();
     sum.ms_prepare = MsSince(t0_);
 
     bool found = false;       // a candidate passed every check
@@ -968,10 +968,22 @@ class SearchPlanner : public Planner {
       cand_cost_[c] = Finite(v) ? v : 1e300;
       order_[c] = c;
     }
-    // Ties break by index: the comparison is a strict total order.
-    std::sort(order_.begin(), order_.end(), [&](int a, int b) {
-      return cand_cost_[a] < cand_cost_[b] || (cand_cost_[a] == cand_cost_[b] && a < b);
-    });
+    sorted_ = 0;
+  }
+
+  // Cost order, ties by index: a strict total order.
+  bool Cheaper(int a, int b) const {
+    return cand_cost_[a] < cand_cost_[b] || (cand_cost_[a] == cand_cost_[b] && a < b);
+  }
+  // Sorts order_ lazily: the lazy check mostly looks at the first few candidates, so a full sort
+  // would be wasted; ranks up to `rank` are in cost order afterwards.
+  void SortUpTo(int rank) {
+    const int n = static_cast<int>(order_.size());
+    if (rank < sorted_ || sorted_ >= n) return;
+    const int upto = std::min(n, std::max(rank + 1, 2 * sorted_ + 32));
+    std::partial_sort(order_.begin() + sorted_, order_.begin() + upto, order_.end(),
+                      [this](int a, int b) { return Cheaper(a, b); });
+    sorted_ = upto;
   }
 
   // ---- Hard checks --------------------------------------------------------------------------
@@ -989,8 +1001,8 @@ class SearchPlanner : public Planner {
     }
   }
 
-  // Builds history | kept | ticks in the XY buffers; returns the path length.
-  int BuildXyPath() {
+  // The XY path's part common to every candidate of the cycle, history | kept, measured once.
+  void SetXyPrefix() {
     int n = 0;
     for (int i = 0; i < hist_n_; ++i, ++n) {
       chk_x_[n] = hist_x_[i];
@@ -1001,6 +1013,12 @@ class SearchPlanner : public Planner {
       chk_y_[n] = plan_y_[i];
     }
     first_new_ = n;
+    checker_.SetPrefix(chk_x_.data(), chk_y_.data(), n);
+  }
+
+  // Appends the ticks to the XY prefix; returns the path length.
+  int BuildXyPath() {
+    int n = first_new_;
     for (int i = 1; i <= n_ticks_; ++i, ++n) {
       const map::CartesianPose p = line_->ToCartesian(tk_s_[i], tk_d_[i]);
       chk_x_[n] = p.x;
@@ -1050,7 +1068,7 @@ class SearchPlanner : public Planner {
       return worst;
     }
     const int n = BuildXyPath();
-    const XyMeasure m = checker_.Measure(chk_x_.data(), chk_y_.data(), n, first_new_);
+    const XyMeasure m = checker_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
     take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
     take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
     take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
@@ -1149,6 +1167,7 @@ class SearchPlanner : public Planner {
         *over_budget = true;
         return false;
       }
+      SortUpTo(r);
       const int c = order_[r];
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
@@ -1176,6 +1195,7 @@ class SearchPlanner : public Planner {
       for (int rr = r + 1;
            rr < n && trace_ != nullptr && static_cast<int>(trace_->candidates.size()) < trace_max_;
            ++rr) {
+        SortUpTo(rr);
         Trace(rr, false, -1);
       }
       return true;
@@ -1200,25 +1220,24 @@ class SearchPlanner : public Planner {
     const int n = static_cast<int>(order_.size());
     first_hit_.resize(n);
     clearance_.resize(n);
-    rank_.resize(n);
     for (int r = 0; r < n; ++r) {
       if ((r & 31) == 31 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
       }
       const int c = order_[r];
-      rank_[c] = r;
       const FrenetTrajectory tr = Candidate(c);
       first_hit_[c] = FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0, 1.0);
       clearance_[c] = first_hit_[c] > n_steps_ ? Clearance(tr) : 0.0;
     }
-    // Latest contact first, then most room; the scoring order breaks ties (a strict total order:
+    // Latest contact first, then most room; the cost order breaks ties (a strict total order:
     // std::stable_sort would allocate).
     std::sort(order_.begin(), order_.end(), [&](int a, int b) {
       if (first_hit_[a] != first_hit_[b]) return first_hit_[a] > first_hit_[b];
       if (clearance_[a] != clearance_[b]) return clearance_[a] > clearance_[b];
-      return rank_[a] < rank_[b];
+      return Cheaper(a, b);
     });
+    sorted_ = n;
     // Feasible first; then ignoring the lane-line timer (an incident, but not a crash).
     for (const bool lane_line : {true, false}) {
       for (int r = 0; r < n; ++r) {
@@ -1542,8 +1561,9 @@ class SearchPlanner : public Planner {
   std::vector<LatTraj> lat_;
   std::vector<double> lon_s_, lon_sd_, lon_sdd_, lat_d_, lat_dd_, lat_ddd_;
   std::vector<int> cand_lon_, cand_lat_, order_;
+  int sorted_ = 0;  // order_[0, sorted_) is in cost order (SortUpTo)
   // Per candidate (LeastHarm): first collision step and clearance on bare boxes.
-  std::vector<int> first_hit_, rank_;
+  std::vector<int> first_hit_;
   std::vector<double> clearance_;
   std::vector<double> cand_cost_;
   // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples

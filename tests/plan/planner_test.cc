@@ -601,6 +601,35 @@ TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
   EXPECT_NEAR(cv->Predict(0, 3.0).d, 9.0, 0.05);
 }
 
+TEST(FeasibilityTest, MeasureWithAPrefixEqualsTheWholeMeasure) {
+  // A 400-tick path with speed changes and a bend; prefix of 120 points.
+  std::vector<double> x, y;
+  double px = 0, py = 0, h = 0, v = 15;
+  for (int i = 0; i < 400; ++i) {
+    v += (i < 150 ? 0.05 : -0.03);
+    h += i > 200 && i < 260 ? 0.004 : 0.0;
+    px += v * 0.02 * std::cos(h);
+    py += v * 0.02 * std::sin(h);
+    x.push_back(px);
+    y.push_back(py);
+  }
+  XyChecker whole(512), cached(512);
+  const XyMeasure a = whole.Measure(x.data(), y.data(), 400, 120);
+  cached.SetPrefix(x.data(), y.data(), 120);
+  const XyMeasure b = cached.MeasureWithPrefix(x.data(), y.data(), 400, 120);
+  EXPECT_EQ(a.max_speed, b.max_speed);
+  EXPECT_EQ(a.max_accel, b.max_accel);
+  EXPECT_EQ(a.max_jerk, b.max_jerk);
+  EXPECT_GT(a.max_accel, 0.5);
+  // A different continuation of the same prefix is measured on its own points.
+  for (int i = 300; i < 400; ++i) y[i] += 0.002 * (i - 300) * (i - 300);
+  const XyMeasure c = whole.Measure(x.data(), y.data(), 400, 120);
+  const XyMeasure d = cached.MeasureWithPrefix(x.data(), y.data(), 400, 120);
+  EXPECT_EQ(c.max_accel, d.max_accel);
+  EXPECT_EQ(c.max_jerk, d.max_jerk);
+  EXPECT_GT(c.max_accel, a.max_accel);
+}
+
 TEST(FeasibilityTest, SlidingCheckBoundsTheSimulatorsMeasureAndSeesKinks) {
   // From rest at 2 m/s^2 to 22 m/s, then straight on, with a 4 degree kink at tick 800.
   std::vector<double> x{0}, y{0};

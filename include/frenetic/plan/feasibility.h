@@ -28,8 +28,18 @@ class XyChecker {
   // end at or after index `first`. Windows reaching before index 0 are skipped. Does not
   // allocate for n <= capacity (larger n is truncated to capacity). NaN points give NaN values.
   XyMeasure Measure(const double* x, const double* y, int n, int first);
+  // The same for paths that all start with the same points (the driven history and the kept
+  // points, common to every candidate of a cycle): SetPrefix computes their part once, and
+  // MeasureWithPrefix, given a path whose first prefix points are those, only the rest.
+  void SetPrefix(const double* x, const double* y, int n);
+  XyMeasure MeasureWithPrefix(const double* x, const double* y, int n, int first);
 
  private:
+  // Fills the per-tick arrays from index `from` on (1: the whole path), assuming the earlier
+  // entries are those of the same path; returns the path length used.
+  int Compute(const double* x, const double* y, int n, int from);
+  XyMeasure Worst(int n, int first) const;
+  int prefix_ = 0;
   std::vector<double> v_, kappa_, vsum_, ksum_, acc_, asum_;
 };
 
