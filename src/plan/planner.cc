@@ -15,6 +15,16 @@ const char* ToString(PlanStatus status) {
   return "unknown";
 }
 
+const char* ToString(PlanSummary::Stage stage) {
+  switch (stage) {
+    case PlanSummary::Stage::kNone: return "none";
+    case PlanSummary::Stage::kScore: return "score";
+    case PlanSummary::Stage::kCheck: return "check";
+    case PlanSummary::Stage::kRefine: return "refine";
+  }
+  return "unknown";
+}
+
 const char* ToString(Reject reason) {
   switch (reason) {
     case Reject::kSpeed: return "speed";

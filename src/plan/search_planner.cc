@@ -36,6 +36,8 @@ constexpr double kRelevantRange = 120.0;
 constexpr double kNearLateral[2] = {3.2, 4.5};
 constexpr double kNearLongitudinal[2] = {8.0, 60.0};
 constexpr int kMaxCars = 64;
+// Share of budget_ms after which scoring stops (the rest of the budget is for the checks).
+constexpr double kScoreShare = 0.5;
 // m: a car behind within this lateral offset is following the ego (the simulator's traffic sees
 // a leader within 2 m and brakes for it).
 constexpr double kFollowerLateral = 1.0;
@@ -48,8 +50,8 @@ constexpr double kStraddle = 0.8;       // m
 constexpr double kLaneLineBand = 0.9;   // m
 constexpr int kMaxStraddleTicks = 135;  // one bit each in the broad-phase masks
 
-double MsSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+double SteadyMs() {
+  return std::chrono::duration<double, std::milli>(Clock::now().time_since_epoch()).count();
 }
 
 bool Finite(double v) { return std::isfinite(v); }
@@ -164,8 +166,9 @@ double Linspace(double lo, double hi, int count, int i) {
 class SearchPlanner : public Planner {
  public:
   SearchPlanner(const PlannerConfig& config, std::shared_ptr<const map::ReferenceLine> line,
-                std::shared_ptr<const cost::CostSet> costs)
-      : cfg_(config),
+                std::shared_ptr<const cost::CostSet> costs, PlannerClock clock)
+      : clock_ms_(clock ? std::move(clock) : PlannerClock(SteadyMs)),
+        cfg_(config),
         line_(std::move(line)),
         costs_(std::move(costs)),
         checker_(kHistory + 64 + static_cast<int>(std::ceil(cfg_.check_horizon / kTickSeconds)) +
@@ -286,7 +289,7 @@ class SearchPlanner : public Planner {
   }
 
   const PlanResult& Plan(const Telemetry& t) override {
-    t0_ = Clock::now();
+    t0_ = clock_ms_();
     PlanSummary& sum = result_.summary;
     ResetSummary(sum);
     result_.status = PlanStatus::kOk;
@@ -378,7 +381,7 @@ class SearchPlanner : public Planner {
     predictor_->Observe(t.sensor_fusion, start.s, clock_);
     BuildContext();
     SetXyPrefix();
-    sum.ms_prepare = MsSince(t0_);
+    sum.ms_prepare = Elapsed();
 
     bool found = false;       // a candidate passed every check
     bool least_harm = false;  // none did: the least harmful feasible one was taken instead
@@ -386,23 +389,35 @@ class SearchPlanner : public Planner {
     if (!invalid || synced) {
       GenerateBundles();
       sum.candidates_generated = static_cast<int>(cand_lon_.size());
-      sum.ms_generate = MsSince(t0_) - sum.ms_prepare;
-      const double t_score = MsSince(t0_);
-      Score();
-      sum.candidates_scored = static_cast<int>(cand_lon_.size());
-      sum.ms_score = MsSince(t0_) - t_score;
-      const double t_check = MsSince(t0_);
-      found = CheckLazily(&over_budget);
-      if (!found && !over_budget) least_harm = LeastHarm(&over_budget);
-      sum.ms_check = MsSince(t0_) - t_check;
-      if (found && cfg_.refine && opt_ != nullptr &&
-          MsSince(t0_) + cfg_.refine_budget_ms < 0.8 * cfg_.budget_ms) {
-        const double t_ref = MsSince(t0_);
-        Refine();
-        sum.ms_refine = MsSince(t0_) - t_ref;
+      sum.ms_generate = Elapsed() - sum.ms_prepare;
+      const double t_score = Elapsed();
+      if (!Score()) {
+        over_budget = true;
+        sum.deadline_stage = PlanSummary::Stage::kScore;
+      }
+      sum.candidates_scored = static_cast<int>(order_.size());
+      sum.ms_score = Elapsed() - t_score;
+      const double t_check = Elapsed();
+      bool check_cut = false;
+      found = CheckLazily(&check_cut);
+      if (!found && !check_cut) least_harm = LeastHarm(&check_cut);
+      if (check_cut) {
+        over_budget = true;
+        sum.deadline_stage = PlanSummary::Stage::kCheck;
+      }
+      sum.ms_check = Elapsed() - t_check;
+      if (found && cfg_.refine && opt_ != nullptr) {
+        if (Elapsed() + cfg_.refine_budget_ms < 0.8 * cfg_.budget_ms) {
+          const double t_ref = Elapsed();
+          Refine();
+          sum.ms_refine = Elapsed() - t_ref;
+        } else if (sum.deadline_stage == PlanSummary::Stage::kNone) {
+          // Not enough time left: the unrefined winner goes out, on time.
+          sum.deadline_stage = PlanSummary::Stage::kRefine;
+        }
       }
     }
-    const double t_out = MsSince(t0_);
+    const double t_out = Elapsed();
     if (found || least_harm) {
       FillTicks(winner_);
       sum.winner_lane = lat_[winner_lat_].lane;
@@ -427,8 +442,8 @@ class SearchPlanner : public Planner {
     can_reuse_ = found && !invalid && !over_budget;
     ticks_since_search_ = 0;
     Snapshot(t);
-    sum.ms_output = MsSince(t0_) - t_out;
-    sum.ms_total = MsSince(t0_);
+    sum.ms_output = Elapsed() - t_out;
+    sum.ms_total = Elapsed();
     if (invalid) {
       result_.status = PlanStatus::kInvalidInput;
     } else if (over_budget) {
@@ -440,6 +455,9 @@ class SearchPlanner : public Planner {
   }
 
  private:
+  // ms since the start of the cycle.
+  double Elapsed() const { return clock_ms_() - t0_; }
+
   static nlopt_algorithm AlgorithmFromName(const std::string& name) {
     const nlopt_algorithm a = nlopt_algorithm_from_string(name.c_str());
     return static_cast<int>(a) < 0 ? NLOPT_LN_COBYLA : a;
@@ -456,6 +474,7 @@ class SearchPlanner : public Planner {
     s.refine_iterations = 0;
     s.refine_cost_before = s.refine_cost_after = 0;
     s.points_kept = 0;
+    s.deadline_stage = PlanSummary::Stage::kNone;
     s.ms_prepare = s.ms_generate = s.ms_score = s.ms_check = s.ms_refine = s.ms_output = 0;
     s.ms_total = 0;
   }
@@ -542,7 +561,7 @@ class SearchPlanner : public Planner {
     sum.winner_lane = reuse_lane_;
     sum.winner_end_speed = reuse_end_speed_;
     sum.winner_duration = reuse_duration_;
-    sum.ms_total = MsSince(t0_);
+    sum.ms_total = Elapsed();
   }
 
   void PushHistory(int consumed) {
@@ -959,16 +978,23 @@ class SearchPlanner : public Planner {
     return in;
   }
 
-  void Score() {
+  // Scores every candidate; false when the deadline stopped it early (the candidates scored so
+  // far, in generation order, are the cycle's candidates then).
+  bool Score() {
     const int n = static_cast<int>(cand_lon_.size());
     cand_cost_.resize(n);
     order_.resize(n);
+    sorted_ = 0;
     for (int c = 0; c < n; ++c) {
+      if ((c & 63) == 63 && Elapsed() > kScoreShare * cfg_.budget_ms) {
+        order_.resize(c);
+        return false;
+      }
       const double v = costs_->Evaluate(ctx_, InputFor(cand_lon_[c], cand_lat_[c]));
       cand_cost_[c] = Finite(v) ? v : 1e300;
       order_[c] = c;
     }
-    sorted_ = 0;
+    return true;
   }
 
   // Cost order, ties by index: a strict total order.
@@ -1163,7 +1189,7 @@ class SearchPlanner : public Planner {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(order_.size());
     for (int r = 0; r < n; ++r) {
-      if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+      if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
       }
@@ -1221,7 +1247,7 @@ class SearchPlanner : public Planner {
     first_hit_.resize(n);
     clearance_.resize(n);
     for (int r = 0; r < n; ++r) {
-      if ((r & 31) == 31 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+      if ((r & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
       }
@@ -1241,7 +1267,7 @@ class SearchPlanner : public Planner {
     // Feasible first; then ignoring the lane-line timer (an incident, but not a crash).
     for (const bool lane_line : {true, false}) {
       for (int r = 0; r < n; ++r) {
-        if ((r & 7) == 7 && MsSince(t0_) > 0.85 * cfg_.budget_ms) {
+        if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
           *over_budget = true;
           return false;
         }
@@ -1403,7 +1429,7 @@ class SearchPlanner : public Planner {
     double step[4];
     for (int i = 0; i < 4; ++i) step[i] = std::max(1e-3, 0.1 * (hi[i] - lo[i]));
     nlopt_set_initial_step(opt_, step);
-    const double remaining = 0.8 * cfg_.budget_ms - MsSince(t0_);
+    const double remaining = 0.8 * cfg_.budget_ms - Elapsed();
     nlopt_set_maxtime(opt_, std::max(1e-3, std::min(cfg_.refine_budget_ms, remaining)) * 1e-3);
     refine_evals_ = 0;
     double best = 0;
@@ -1536,6 +1562,7 @@ class SearchPlanner : public Planner {
     have_plan_ = true;
   }
 
+  PlannerClock clock_ms_;
   Settings cfg_;
   std::shared_ptr<const map::ReferenceLine> line_;
   std::shared_ptr<const cost::CostSet> costs_;
@@ -1548,7 +1575,7 @@ class SearchPlanner : public Planner {
   double lane_nominal_[cost::kMaxLanes] = {};  // configured lane centres, m
   double lane_center_[cost::kMaxLanes] = {};   // this cycle's (LaneCentres), m
   int n_samples_ = 0, n_ticks_ = 0;
-  Clock::time_point t0_;
+  double t0_ = 0;  // ms, clock_ms_ at the start of the cycle
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
 
@@ -1626,8 +1653,10 @@ class SearchPlanner : public Planner {
 
 std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
                                            std::shared_ptr<const map::ReferenceLine> line,
-                                           std::shared_ptr<const cost::CostSet> costs) {
-  return std::make_unique<SearchPlanner>(config, std::move(line), std::move(costs));
+                                           std::shared_ptr<const cost::CostSet> costs,
+                                           PlannerClock clock) {
+  return std::make_unique<SearchPlanner>(config, std::move(line), std::move(costs),
+                                         std::move(clock));
 }
 
 }  // namespace frenetic::plan

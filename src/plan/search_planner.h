@@ -9,6 +9,7 @@
 // every call (e.g. to benchmark the search itself).
 #pragma once
 
+#include <functional>
 #include <memory>
 
 #include "frenetic/cost/cost_set.h"
@@ -17,9 +18,15 @@
 
 namespace frenetic::plan {
 
+// Milliseconds from an arbitrary origin, increasing: what the deadline (budget_ms) is measured
+// with. Tests inject a fake one to trip the deadline in a chosen stage without depending on the
+// machine's speed; the default is std::chrono::steady_clock.
+using PlannerClock = std::function<double()>;
+
 std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
                                            std::shared_ptr<const map::ReferenceLine> line,
-                                           std::shared_ptr<const cost::CostSet> costs);
+                                           std::shared_ptr<const cost::CostSet> costs,
+                                           PlannerClock clock = nullptr);
 
 std::unique_ptr<Planner> MakeBaselinePlanner(const PlannerConfig& config,
                                              std::shared_ptr<const map::ReferenceLine> line);

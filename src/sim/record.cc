@@ -184,6 +184,7 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
       {"winner_end_speed", Finite(s.winner_end_speed)},
       {"winner_duration", Finite(s.winner_duration)},
       {"refine_iterations", s.refine_iterations},
+      {"deadline_stage", plan::ToString(s.deadline_stage)},
       {"refine_cost_before", Finite(s.refine_cost_before)},
       {"refine_cost_after", Finite(s.refine_cost_after)},
       {"points_kept", s.points_kept},

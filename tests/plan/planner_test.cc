@@ -18,6 +18,7 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
+#include "plan/search_planner.h"
 
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
@@ -346,6 +347,59 @@ TEST(SearchPlannerTest, SummaryIsFilled) {
   int winners = 0;
   for (const auto& c : trace.candidates) winners += c.winner;
   EXPECT_EQ(winners, 1);
+}
+
+// The per-cycle deadline, tripped in a chosen stage by a fake clock that advances a fixed step
+// at every reading (deterministic, whatever the machine's speed).
+struct DeadlineRun {
+  PlanStatus status;
+  PlanSummary::Stage stage;
+  int generated, scored, refine_iterations;
+};
+DeadlineRun RunWithClock(std::shared_ptr<const map::ReferenceLine> line, double budget_ms,
+                         double step_ms) {
+  PlannerConfig config = Config();
+  EXPECT_TRUE(config.Set("budget_ms", budget_ms).ok());
+  EXPECT_TRUE(config.Set("continuity.replan_min_ticks", 1).ok());
+  auto costs = cost::CostSet::Build(config.cost_terms());
+  EXPECT_TRUE(costs.ok());
+  auto now = std::make_shared<double>(0.0);
+  auto planner = MakeSearchPlanner(config, line, *costs, [now, step_ms] {
+    *now += step_ms;
+    return *now;
+  });
+  Loop loop(line, planner.get(), 800, 6.0, 15.0, 3);
+  for (int i = 0; i < 6; ++i) loop.cars.push_back({i, 830.0 + 25 * i, 2.0 + 4 * (i % 3), 14.0});
+  RunFor(loop, 1.0);
+  const PlanResult& r = planner->Plan(loop.Make());
+  EXPECT_GE(r.x.size(), static_cast<size_t>(kMinPathPoints));
+  for (size_t i = 0; i < r.x.size(); ++i) EXPECT_TRUE(std::isfinite(r.x[i] + r.y[i]));
+  return {r.status, r.summary.deadline_stage, r.summary.candidates_generated,
+          r.summary.candidates_scored, r.summary.refine_iterations};
+}
+
+TEST(SearchPlannerTest, DeadlineStopsScoringSkipsRefinementAndSaysSo) {
+  REQUIRE_MAP(line);
+  // A clock that stands still: nothing is cut, the refinement runs.
+  const DeadlineRun free = RunWithClock(line, 15, 0.0);
+  EXPECT_EQ(free.status, PlanStatus::kOk);
+  EXPECT_EQ(free.stage, PlanSummary::Stage::kNone);
+  EXPECT_EQ(free.scored, free.generated);
+  EXPECT_GE(free.generated, 300);
+  EXPECT_GT(free.refine_iterations, 0);
+  // 0.2 ms per reading against a 1 ms budget: scoring stops at half the budget (it reads the
+  // clock every 64 candidates), and what was scored is still checked and sent.
+  const DeadlineRun cut = RunWithClock(line, 1, 0.2);
+  EXPECT_EQ(cut.status, PlanStatus::kOverBudget);
+  EXPECT_EQ(cut.stage, PlanSummary::Stage::kScore);
+  EXPECT_LT(cut.scored, cut.generated);
+  EXPECT_EQ(cut.refine_iterations, 0);
+  // 0.02 ms per reading against 3 ms: everything is scored and checked, but the 2 ms the
+  // refinement may take no longer fit before 80% of the budget: it is skipped.
+  const DeadlineRun late = RunWithClock(line, 3, 0.02);
+  EXPECT_EQ(late.stage, PlanSummary::Stage::kRefine);
+  EXPECT_EQ(late.scored, late.generated);
+  EXPECT_EQ(late.refine_iterations, 0);
 }
 
 TEST(SearchPlannerTest, NoAllocationAfterWarmUp) {

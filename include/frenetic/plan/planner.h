@@ -56,10 +56,17 @@ struct PlanSummary {
   double refine_cost_before = 0;
   double refine_cost_after = 0;
   int points_kept = 0;            // from the previous path
+  // The stage the per-cycle deadline (budget_ms) cut short, kNone when it did not: scoring (the
+  // candidates not yet scored are left out), the lazy check or the least-harm choice (the best
+  // found so far, else last cycle's plan or the braking fallback), refinement (skipped).
+  enum class Stage : std::uint8_t { kNone, kScore, kCheck, kRefine };
+  Stage deadline_stage = Stage::kNone;
   // Time per stage, milliseconds.
   double ms_prepare = 0, ms_generate = 0, ms_score = 0, ms_check = 0, ms_refine = 0,
          ms_output = 0, ms_total = 0;
 };
+
+const char* ToString(PlanSummary::Stage stage);  // "none", "score", "check", "refine"
 
 struct PlanResult {
   PlanStatus status = PlanStatus::kOk;
