@@ -26,14 +26,15 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/status.h"
+#include "../tests/common/malloc_counter.h"
 
 namespace frenetic::bench {
 
 // Process-wide count of malloc/calloc/realloc calls made while g_count_allocations is set
-// (defined in plan_bench.cc, which interposes glibc's malloc so that C libraries such as NLopt
-// are counted too). Stays 0 in sanitizer builds, where the interposition is left out.
-extern std::atomic<bool> g_count_allocations;
-extern std::atomic<std::int64_t> g_allocations;
+// (tests/common/malloc_counter.h, included by plan_bench.cc, interposes glibc's malloc so that
+// C libraries such as NLopt are counted too). Stays 0 in sanitizer builds.
+using testing_util::g_allocations;
+using testing_util::g_count_allocations;
 
 // One recorded scene: consecutive telemetry messages of one drive.
 struct Scene {

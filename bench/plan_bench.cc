@@ -16,47 +16,12 @@
 #include <string>
 #include <vector>
 
+// Before bench_util.h, which includes it for the counters only.
+#define FRENETIC_DEFINE_MALLOC_INTERPOSER
+#include "../tests/common/malloc_counter.h"
 #include "bench_util.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
-
-namespace frenetic::bench {
-
-std::atomic<bool> g_count_allocations{false};
-std::atomic<std::int64_t> g_allocations{0};
-
-}  // namespace frenetic::bench
-
-// Interposing malloc in the executable counts every allocation of the process, including those
-// of shared C libraries (NLopt allocates its work arrays with malloc inside nlopt_optimize), which
-// a replaced operator new or -Wl,--wrap=malloc (static references only) would miss. glibc 2.36
-// exports __libc_malloc & co. to forward to. Left out under sanitizers, which own malloc.
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t n, std::size_t size);
-void* __libc_realloc(void* p, std::size_t size);
-
-void* malloc(std::size_t size) noexcept {
-  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
-    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t n, std::size_t size) noexcept {
-  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
-    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t size) noexcept {
-  if (frenetic::bench::g_count_allocations.load(std::memory_order_relaxed)) {
-    frenetic::bench::g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  return __libc_realloc(p, size);
-}
-}  // extern "C"
-#endif
 
 namespace frenetic::bench {
 namespace {
