@@ -29,12 +29,6 @@ constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s
 // m: cars closer than this (map frame) decide whether the last plan may be reused. Farther cars
 // cannot reach the ego's path within the few ticks a reused plan covers before the next search.
 constexpr double kRelevantRange = 120.0;
-// m: reaches of the cost terms' broad-phase masks (cost::NearCars), tighter first.
-// Laterally: the buffer term's same-lane test; the collision term's boxes up to a ~20 degree
-// heading. Longitudinally: the collision term's boxes; the buffer term's desired gap up to
-// ~50 m. A term that needs more reach falls back to examining every car.
-constexpr double kNearLateral[2] = {3.2, 4.5};
-constexpr double kNearLongitudinal[2] = {8.0, 60.0};
 constexpr int kMaxCars = 64;
 // Share of budget_ms after which scoring stops (the rest of the budget is for the checks).
 constexpr double kScoreShare = 0.5;
@@ -709,10 +703,10 @@ class SearchPlanner : public Planner {
     c.max_car_speed = 0;
     for (int i = 0; i < nc * n_samples_; ++i)
       c.max_car_speed = std::max(c.max_car_speed, car_v_[i]);
-    c.near_lateral[0] = kNearLateral[0];
-    c.near_lateral[1] = kNearLateral[1];
-    c.near_longitudinal[0] = kNearLongitudinal[0];
-    c.near_longitudinal[1] = kNearLongitudinal[1];
+    c.near_lateral[0] = cost::kNearLateral[0];
+    c.near_lateral[1] = cost::kNearLateral[1];
+    c.near_longitudinal[0] = cost::kNearLongitudinal[0];
+    c.near_longitudinal[1] = cost::kNearLongitudinal[1];
     c.car_s = car_s_.data();
     c.car_d = car_d_.data();
     c.car_v = car_v_.data();
@@ -751,26 +745,12 @@ class SearchPlanner : public Planner {
   // Broad phase of the cost terms (cost::CostInput::near_lat, near_lon): which cars are within
   // each reach of d[k] (near[0..n) and near[n..2n)), and of s[k].
   void NearLat(const double* d, std::uint64_t* near) const {
-    NearMasks(d, kNearLateral, near, [this](int c, int k) { return car_d_[c * n_samples_ + k]; });
+    cost::FillNearMasks(d, n_samples_, ctx_.num_cars, cost::kNearLateral,
+                        [this](int c, int k) { return car_d_[c * n_samples_ + k]; }, near);
   }
   void NearLon(const double* s, std::uint64_t* near) const {
-    NearMasks(s, kNearLongitudinal, near,
-              [this](int c, int k) { return car_s_[c * n_samples_ + k]; });
-  }
-  // Bit c of near[k] (of near[n + k]) when |car_at(c, k) - x[k]| < reach[0] (reach[1]).
-  // Car-major, so that the inner loop over samples vectorises.
-  template <typename CarAt>
-  void NearMasks(const double* x, const double reach[2], std::uint64_t* near, CarAt car_at) const {
-    const int n = n_samples_;
-    std::fill(near, near + 2 * n, 0);
-    for (int c = 0; c < ctx_.num_cars; ++c) {
-      const std::uint64_t bit = std::uint64_t{1} << c;
-      for (int k = 0; k < n; ++k) {
-        const double dist = std::abs(car_at(c, k) - x[k]);
-        near[k] |= dist < reach[0] ? bit : 0;
-        near[n + k] |= dist < reach[1] ? bit : 0;
-      }
-    }
+    cost::FillNearMasks(s, n_samples_, ctx_.num_cars, cost::kNearLongitudinal,
+                        [this](int c, int k) { return car_s_[c * n_samples_ + k]; }, near);
   }
 
   LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, int lead = -1) const {

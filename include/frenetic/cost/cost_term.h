@@ -5,7 +5,9 @@
 // FRENETIC_REGISTER_COST (cost_registry.h).
 #pragma once
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -136,6 +138,31 @@ class NearCars {
   std::uint64_t all_;
   int num_cars_;
 };
+
+// m: the broad-phase reaches the planner builds its masks with, tighter first. Laterally: the
+// buffer term's same-lane test; the collision term's boxes up to a ~20 degree heading.
+// Longitudinally: the collision term's boxes; the buffer term's desired gap up to ~50 m. A term
+// that needs more reach than a mask covers is handed every car instead (NearCars).
+inline constexpr double kNearLateral[2] = {3.2, 4.5};
+inline constexpr double kNearLongitudinal[2] = {8.0, 60.0};
+
+// Builds one trajectory's pair of broad-phase masks (CostInput::near_lat or near_lon): bit c of
+// near[k] (of near[n + k]) is set when |car_at(c, k) - x[k]| < reach[0] (reach[1]), for cars
+// c < num_cars <= 64, with x the trajectory's d (or s) at the n samples. Car-major, so that the
+// inner loop over samples vectorises.
+template <typename CarAt>
+void FillNearMasks(const double* x, int n, int num_cars, const double reach[2], CarAt car_at,
+                   std::uint64_t* near) {
+  std::fill(near, near + 2 * n, std::uint64_t{0});
+  for (int c = 0; c < num_cars && c < 64; ++c) {
+    const std::uint64_t bit = std::uint64_t{1} << c;
+    for (int k = 0; k < n; ++k) {
+      const double dist = std::abs(car_at(c, k) - x[k]);
+      near[k] |= dist < reach[0] ? bit : 0;
+      near[n + k] |= dist < reach[1] ? bit : 0;
+    }
+  }
+}
 
 // A tunable parameter a term declares, with its default and a sensible range.
 struct CostParamSpec {
