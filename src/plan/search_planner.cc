@@ -1090,11 +1090,6 @@ class SearchPlanner : public Planner {
                },
                1.0) <= n_steps_;
   }
-  // The same test evaluating the polynomials only at the collision steps: most rejected
-  // candidates fail here, so they never pay for the full tick sampling.
-  bool Collides(const FrenetTrajectory& tr) const {
-    return FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0) <= n_steps_;
-  }
   // The first collision step (1..n_steps_) of `state_at` (state at a tick index), or
   // n_steps_ + 1 when none. The safety margins are scaled by margin_scale (0: bare boxes),
   // except the room kept for a car behind in another lane, scaled by behind_scale: that car
