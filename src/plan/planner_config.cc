@@ -114,11 +114,8 @@ PlannerConfig PlannerConfig::Defaults() {
 }
 
 void PlannerConfig::PinDeadlines() {
-  for (const char* key : {"budget_ms", "refine.budget_ms"}) {
-    Param* p = Find(key);
-    FRENETIC_CHECK(p != nullptr);
-    p->value = p->hi;
-  }
+  budget_pinned_ = true;
+  refine_budget_pinned_ = true;
 }
 
 PlannerConfig::Param* PlannerConfig::Find(std::string_view key) {
@@ -144,7 +141,13 @@ Status PlannerConfig::Set(std::string_view key, double value) {
   const double old = p->value;
   p->value = value;
   Status s = Validate();
-  if (!s.ok()) p->value = old;
+  if (!s.ok()) {
+    p->value = old;
+  } else if (key == "budget_ms") {
+    budget_pinned_ = false;
+  } else if (key == "refine.budget_ms") {
+    refine_budget_pinned_ = false;
+  }
   return s;
 }
 

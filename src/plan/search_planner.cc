@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "frenetic/plan/feasibility.h"
 #include "frenetic/plan/predictor.h"
@@ -25,6 +26,7 @@ using traj::Polynomial5;
 using traj::Trajectory1d;
 
 constexpr double kMphToMps = 0.44704;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s of blocks)
 // m: cars closer than this (map frame) decide whether the last plan may be reused. Farther cars
 // cannot reach the ego's path within the few ticks a reused plan covers before the next search.
@@ -145,11 +147,12 @@ struct Settings {
     behind_time = c.value("check.behind_time");
     refine = c.int_value("refine.enabled") != 0;
     refine_iterations = c.int_value("refine.max_iterations");
-    refine_budget_ms = c.value("refine.budget_ms");
+    // A pinned deadline never fires (PlannerConfig::PinDeadlines).
+    refine_budget_ms = c.refine_budget_pinned() ? kInf : c.value("refine.budget_ms");
     fallback_decel = c.value("fallback.decel");
     fallback_jerk = c.value("fallback.jerk");
     fallback_lat_duration = c.value("fallback.lat_duration");
-    budget_ms = c.budget_ms();
+    budget_ms = c.budget_pinned() ? kInf : c.budget_ms();
   }
 };
 
@@ -401,7 +404,8 @@ class SearchPlanner : public Planner {
       }
       sum.ms_check = Elapsed() - t_check;
       if (found && cfg_.refine && opt_ != nullptr) {
-        if (Elapsed() + cfg_.refine_budget_ms < 0.8 * cfg_.budget_ms) {
+        const double refine_ms = std::isfinite(cfg_.refine_budget_ms) ? cfg_.refine_budget_ms : 0;
+        if (!std::isfinite(cfg_.budget_ms) || Elapsed() + refine_ms < 0.8 * cfg_.budget_ms) {
           const double t_ref = Elapsed();
           Refine();
           sum.ms_refine = Elapsed() - t_ref;
@@ -1405,7 +1409,9 @@ class SearchPlanner : public Planner {
     for (int i = 0; i < 4; ++i) step[i] = std::max(1e-3, 0.1 * (hi[i] - lo[i]));
     nlopt_set_initial_step(opt_, step);
     const double remaining = 0.8 * cfg_.budget_ms - Elapsed();
-    nlopt_set_maxtime(opt_, std::max(1e-3, std::min(cfg_.refine_budget_ms, remaining)) * 1e-3);
+    const double maxtime_ms = std::min(cfg_.refine_budget_ms, remaining);
+    // 0 switches NLopt's clock off: pinned deadlines leave refine.max_iterations as the bound.
+    nlopt_set_maxtime(opt_, std::isfinite(maxtime_ms) ? std::max(1e-3, maxtime_ms) * 1e-3 : 0.0);
     refine_evals_ = 0;
     double best = 0;
     const nlopt_result r = nlopt_optimize(opt_, x, &best);

@@ -346,10 +346,11 @@ struct DeadlineRun {
   int generated, scored, refine_iterations;
 };
 DeadlineRun RunWithClock(std::shared_ptr<const map::ReferenceLine> line, double budget_ms,
-                         double step_ms) {
+                         double step_ms, bool pinned = false) {
   PlannerConfig config = Config();
   EXPECT_TRUE(config.Set("budget_ms", budget_ms).ok());
   EXPECT_TRUE(config.Set("continuity.replan_min_ticks", 1).ok());
+  if (pinned) config.PinDeadlines();
   auto costs = cost::CostSet::Build(config.cost_terms());
   EXPECT_TRUE(costs.ok());
   auto now = std::make_shared<double>(0.0);
@@ -389,6 +390,25 @@ TEST(SearchPlannerTest, DeadlineStopsScoringSkipsRefinementAndSaysSo) {
   EXPECT_EQ(late.stage, PlanSummary::Stage::kRefine);
   EXPECT_EQ(late.scored, late.generated);
   EXPECT_EQ(late.refine_iterations, 0);
+  // Pinned deadlines (headless drives, tuning): the same slow clock cuts nothing.
+  const DeadlineRun pinned = RunWithClock(line, 1, 0.2, /*pinned=*/true);
+  EXPECT_EQ(pinned.status, PlanStatus::kOk);
+  EXPECT_EQ(pinned.stage, PlanSummary::Stage::kNone);
+  EXPECT_EQ(pinned.scored, pinned.generated);
+  EXPECT_EQ(pinned.refine_iterations, free.refine_iterations);
+}
+
+TEST(PlannerConfigTest, SettingAPinnedDeadlineSwitchesItBackOn) {
+  PlannerConfig config = PlannerConfig::Defaults();
+  config.PinDeadlines();
+  EXPECT_TRUE(config.budget_pinned());
+  EXPECT_TRUE(config.refine_budget_pinned());
+  ASSERT_TRUE(config.Set("budget_ms", 5).ok());
+  EXPECT_FALSE(config.budget_pinned());
+  EXPECT_TRUE(config.refine_budget_pinned());
+  EXPECT_DOUBLE_EQ(config.budget_ms(), 5);
+  EXPECT_FALSE(config.Set("refine.budget_ms", -1).ok());  // rejected: stays pinned
+  EXPECT_TRUE(config.refine_budget_pinned());
 }
 
 // No heap allocation in Plan() after warm-up, counted at malloc (C libraries included): none at

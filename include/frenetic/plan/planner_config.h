@@ -36,11 +36,14 @@ class PlannerConfig {
   std::vector<Param> Params() const;
   std::string ToYaml() const;  // round-trips through Parse
   double budget_ms() const;    // per-cycle deadline (config key budget_ms)
-  // Sets the wall-clock budgets (budget_ms, refine.budget_ms) to their maxima, so that on any
-  // sane machine no deadline cuts a cycle short: the planner's answers then depend on its
-  // inputs only (refinement stays on, bounded by refine.max_iterations). For headless drives,
-  // tuning and fidelity runs, whose latency is counted in ticks, not measured.
+  // Switches the wall-clock deadlines (budget_ms, refine.budget_ms) off: no deadline cuts a
+  // cycle short however loaded the machine is, so the planner's answers depend on its inputs
+  // only (refinement stays on, bounded by refine.max_iterations). For headless drives, tuning
+  // and fidelity runs, whose latency is counted in ticks, not measured. A later Set() of either
+  // key switches that deadline back on at the value set.
   void PinDeadlines();
+  bool budget_pinned() const { return budget_pinned_; }
+  bool refine_budget_pinned() const { return refine_budget_pinned_; }
 
   // The value of a declared key; aborts on an undeclared one (a program error).
   double value(std::string_view key) const;
@@ -62,6 +65,8 @@ class PlannerConfig {
   std::vector<std::string> cost_order_;    // term names in config order
   std::string refine_algorithm_ = "LN_COBYLA";
   std::string source_ = "<defaults>";
+  bool budget_pinned_ = false;
+  bool refine_budget_pinned_ = false;
 };
 
 }  // namespace frenetic::plan
