@@ -187,7 +187,7 @@ void RegisterDrive(CLI::App& app) {
   sub->add_flag("--real-time-deadlines", args->real_time_deadlines,
                 "Apply the planner's wall-clock deadlines (budget_ms, refine.budget_ms) as "
                 "configured. Default: off - the headless simulator counts latency in ticks, so "
-                "the deadlines are pinned at their maxima and every run of a seed gives the "
+                "the deadlines are switched off and every run of a seed gives the "
                 "same drive whatever the machine's load (planning times are still measured)");
   sub->add_flag("--no-timing", args->no_timing,
                 "Report and record planning times as 0, so the same seed gives byte-identical "

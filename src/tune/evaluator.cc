@@ -107,7 +107,7 @@ struct Evaluator::Impl {
       if (Status s = config.Set(suite.params[i].key, values[i]); !s.ok()) return s;
     }
     if (pin) {
-      // Deadlines are wall-clock: at their maxima the search is never cut short and the
+      // Deadlines are wall-clock: switched off, the search is never cut short and the
       // refinement runs its iterations, so an episode does not depend on load (rank and thread
       // counts included). A tuned budget keeps its tuned value.
       config.PinDeadlines();

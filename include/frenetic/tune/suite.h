@@ -68,7 +68,7 @@ struct Suite {
   ObjectiveWeights objective;
   SearchOptions search;
   // Make every episode independent of wall-clock time while evaluating: the planner's deadlines
-  // (budget_ms, refine.budget_ms) go to their maxima (PlannerConfig::PinDeadlines), unless the
+  // (budget_ms, refine.budget_ms) are switched off (PlannerConfig::PinDeadlines), unless the
   // suite tunes those keys; the refinement runs its iteration budget. Then an evaluation does
   // not depend on machine load, threads or ranks, and a resumed run retraces the logged one.
   // The tuned config keeps the start config's values of these keys.
