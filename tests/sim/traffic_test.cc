@@ -133,35 +133,53 @@ TEST(Traffic, SpeedsBrakingAndDistanceBandLikeTheRealRecordings) {
 // One 59 mph car queued behind a ghost ego at 14.6 m/s in its lane (the recorded situation of
 // car 2 in the advanced run). Returns the share of the last 30 s spent braking hard and the
 // lowest speed there.
+// One car in the left lane behind a ghost ego held at `ego_speed` in the same lane (s 500), lane
+// changes and respawns off, braking from 35 m; the caller steps both.
+struct CarBehindGhost {
+  Ghost ego;
+  Traffic traffic;
+  CarBehindGhost(std::shared_ptr<const World> world, TrafficOptions o, double ego_speed,
+                 double car_s, double top_mph, double car_v)
+      : ego{world.get(), 500, 2, ego_speed},
+        traffic(world, OneCar(o), 4.6, 2.4, 3, ego.View()) {
+    TrafficCar& c = traffic.mutable_cars()[0];
+    c.spawned = true;
+    c.lane = 0;
+    c.s = car_s;
+    c.d = 2;
+    c.top_speed = top_mph / kMph;
+    c.v = car_v;
+    traffic.Place(c);
+  }
+  static TrafficOptions OneCar(TrafficOptions o) {
+    o.cars = 1;
+    o.lane_changes = false;
+    o.respawn_distance = 1000;
+    o.brake_gap_max = 35;
+    return o;
+  }
+  void Step(int tick) {
+    ego.Step();
+    traffic.Tick(ego.View(), tick);
+  }
+  const TrafficCar& car() const { return traffic.cars()[0]; }
+};
+
 std::pair<double, double> QueueBehindSlowEgo(std::shared_ptr<const World> world, double delay) {
   TrafficOptions o;
-  o.cars = 1;
-  o.lane_changes = false;
-  o.respawn_distance = 1000;
-  o.brake_gap_max = 35;
   o.brake_delay = delay;
-  Ghost ego{world.get(), 500, 2, 14.6};
-  Traffic traffic(world, o, 4.6, 2.4, 3, ego.View());
-  TrafficCar& car = traffic.mutable_cars()[0];
-  car.spawned = true;
-  car.lane = 0;
-  car.s = 440;
-  car.d = 2;
-  car.top_speed = 59.1 / kMph;
-  car.v = 20;
-  traffic.Place(car);
+  CarBehindGhost run(world, o, 14.6, 440, 59.1, 20);
   int hard = 0, ticks = 0;
   double v_min = 1e9;
   for (int tick = 0; tick < 4000; ++tick) {
-    ego.Step();
-    traffic.Tick(ego.View(), tick);
+    run.Step(tick);
     if (tick >= 2500) {
       ++ticks;
-      if (traffic.cars()[0].accel < -7) ++hard;
-      v_min = std::min(v_min, traffic.cars()[0].v);
+      if (run.car().accel < -7) ++hard;
+      v_min = std::min(v_min, run.car().v);
     }
     // Never runs into the ego.
-    EXPECT_GT(world->line->DiffS(ego.s, traffic.cars()[0].s), 4.6) << "tick " << tick;
+    EXPECT_GT(world->line->DiffS(run.ego.s, run.car().s), 4.6) << "tick " << tick;
   }
   return {static_cast<double>(hard) / ticks, v_min};
 }
@@ -276,32 +294,18 @@ struct Cycle {
 };
 Cycle FollowSteadyLeader(std::shared_ptr<const World> world, double delay, double release) {
   TrafficOptions o;
-  o.cars = 1;
-  o.lane_changes = false;
-  o.respawn_distance = 1000;
-  o.brake_gap_max = 35;
   o.brake_delay = delay;
   o.brake_release_delay = release;
-  Ghost ego{world.get(), 500, 2, 15.65};
-  Traffic traffic(world, o, 4.6, 2.4, 3, ego.View());
-  TrafficCar& car = traffic.mutable_cars()[0];
-  car.spawned = true;
-  car.lane = 0;
-  car.s = 475;
-  car.d = 2;
-  car.top_speed = 46.9 / kMph;
-  car.v = 17;
-  traffic.Place(car);
+  CarBehindGhost run(world, o, 15.65, 475, 46.9, 17);
   Cycle c;
   bool was_braking = false;
   for (int tick = 0; tick < 4000; ++tick) {
-    ego.Step();
-    traffic.Tick(ego.View(), tick);
+    run.Step(tick);
     if (tick < 2500) continue;
-    const double v = traffic.cars()[0].v;
+    const double v = run.car().v;
     c.v_min = std::min(c.v_min, v);
     c.v_max = std::max(c.v_max, v);
-    const bool braking = traffic.cars()[0].accel < -5;
+    const bool braking = run.car().accel < -5;
     if (braking && !was_braking) ++c.onsets;
     was_braking = braking;
   }
