@@ -731,6 +731,7 @@ FrenetPoint ReferenceLine::ToFrenet(double x, double y) const {
 
 FrenetPoint ReferenceLine::ToFrenet(double x, double y, double s_hint) const {
   if (!std::isfinite(x) || !std::isfinite(y)) return FrenetPoint{0, 0};
+  if (!std::isfinite(s_hint)) return ToFrenet(x, y);
   const Impl& m = *impl_;
   int start = static_cast<int>(WrapS(s_hint) * m.inv_step);
   if (start >= m.n) start = m.n - 1;
@@ -754,9 +755,10 @@ ReferenceLine::OffsetRange ReferenceLine::ChordOffset(double s_from, double s_to
   // Every sample from the one at or before s_from to the one at or after s_to.
   const double lo = WrapS(s_from) * m.inv_step;
   const int first = static_cast<int>(lo);
-  const int count = std::min(m.n, static_cast<int>(std::ceil(
-                                      lo + std::max(0.0, s_to - s_from) * m.inv_step)) -
-                                      first + 1);
+  // Clamped in double before the cast: a huge span (hostile input) must not overflow the int.
+  const double span =
+      std::ceil(lo + std::max(0.0, s_to - s_from) * m.inv_step) - static_cast<double>(first) + 1;
+  const int count = static_cast<int>(std::min(static_cast<double>(m.n), span));
   const double w = d / kChordD1;
   r.lo = std::numeric_limits<double>::infinity();
   r.hi = -r.lo;

@@ -84,7 +84,7 @@ class BaselinePlanner : public Planner {
         prev_ok ? std::min<int>(static_cast<int>(t.previous_path_x.size()), points_ - 1) : 0;
 
     const map::FrenetPoint ego = line_->ToFrenet(cx, cy);
-    if (lane_ < 0) lane_ = std::clamp(static_cast<int>(ego.d / lane_width_), 0, num_lanes_ - 1);
+    if (lane_ < 0) lane_ = LaneOf(ego.d);
     double end_s = ego.s;
     if (prev_size > 0) {
       end_s = line_->ToFrenet(t.previous_path_x[prev_size - 1], t.previous_path_y[prev_size - 1],
@@ -113,7 +113,7 @@ class BaselinePlanner : public Planner {
       if (s < 0 && -s < behind[l]) behind[l] = -s;
     }
     // State machine.
-    const int ego_lane = std::clamp(static_cast<int>(ego.d / lane_width_), 0, num_lanes_ - 1);
+    const int ego_lane = LaneOf(ego.d);
     if (state_ == State::kOvertake) {
       const double centre = (lane_ + 0.5) * lane_width_;
       if (std::abs(ego.d - centre) < 0.5) state_ = State::kDrive;
@@ -236,6 +236,13 @@ class BaselinePlanner : public Planner {
   }
 
  private:
+  // The lane of a lateral offset, clamped in double first: a hostile pose far off the road must
+  // not overflow the int.
+  int LaneOf(double d) const {
+    const double lane = std::floor(d / lane_width_);
+    return static_cast<int>(std::clamp(std::isfinite(lane) ? lane : 0.0, 0.0, num_lanes_ - 1.0));
+  }
+
   std::shared_ptr<const map::ReferenceLine> line_;
   std::unique_ptr<Predictor> predictor_;
   double follow_distance_, ahead_free_, behind_free_, step_, max_speed_, lane_width_;
