@@ -45,7 +45,8 @@ configure_and_build() {
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }
 
-# A separate build with AddressSanitizer + UndefinedBehaviorSanitizer of the library test suites
+# A separate build with AddressSanitizer + UndefinedBehaviorSanitizer (plus float-to-int overflow,
+# which -fsanitize=undefined leaves out) of the library test suites
 # (not the executable's end-to-end tests, the tuner or the benchmarks, which the Release run covers).
 ASAN_TEST_MODULES=(map traj cost plan sim net report)
 configure_and_build_asan() {
@@ -53,7 +54,7 @@ configure_and_build_asan() {
   command -v ninja >/dev/null && generator=(-G Ninja)
   if [ ! -f "$dir/CMakeCache.txt" ]; then
     cmake -S "$FRENETIC_ROOT" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=None \
-      -DCMAKE_CXX_FLAGS="-O1 -g1" -DFRENETIC_SANITIZE=address,undefined \
+      -DCMAKE_CXX_FLAGS="-O1 -g1" -DFRENETIC_SANITIZE=address,undefined,float-cast-overflow \
       -DFRENETIC_BUILD_BENCHMARKS=OFF -DFRENETIC_WITH_MPI=OFF \
       -DFRENETIC_TEST_MODULES="$(IFS=';'; echo "${ASAN_TEST_MODULES[*]}")" \
       -DFRENETIC_SHARED_DIR="${SHARED_DIR:-$FRENETIC_ROOT/../shared}" >/dev/null
