@@ -44,7 +44,7 @@ constexpr double kAlongside = 20.0;
 // less time.
 constexpr double kStraddle = 0.8;       // m
 constexpr double kLaneLineBand = 0.9;   // m
-constexpr int kMaxStraddleTicks = 135;  // one bit each in the broad-phase masks
+constexpr int kMaxStraddleTicks = 135;  // ticks
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(Clock::now().time_since_epoch()).count();
@@ -404,8 +404,10 @@ class SearchPlanner : public Planner {
       }
       sum.ms_check = Elapsed() - t_check;
       if (found && cfg_.refine && opt_ != nullptr) {
+        // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
+        // asks for none beyond the cycle's.
         const double refine_ms = std::isfinite(cfg_.refine_budget_ms) ? cfg_.refine_budget_ms : 0;
-        if (!std::isfinite(cfg_.budget_ms) || Elapsed() + refine_ms < 0.8 * cfg_.budget_ms) {
+        if (Elapsed() + refine_ms < 0.8 * cfg_.budget_ms) {
           const double t_ref = Elapsed();
           Refine();
           sum.ms_refine = Elapsed() - t_ref;
@@ -752,6 +754,13 @@ class SearchPlanner : public Planner {
     cost::FillNearMasks(d, n_samples_, ctx_.num_cars, cost::kNearLateral,
                         [this](int c, int k) { return car_d_[c * n_samples_ + k]; }, near);
   }
+  // Points a cost input at a trajectory's masks (each 2 * n_samples_ words, as Near* fill them).
+  void SetNear(cost::CostInput& in, const std::uint64_t* lat, const std::uint64_t* lon) const {
+    in.near_lat[0] = lat;
+    in.near_lat[1] = lat + n_samples_;
+    in.near_lon[0] = lon;
+    in.near_lon[1] = lon + n_samples_;
+  }
   void NearLon(const double* s, std::uint64_t* near) const {
     cost::FillNearMasks(s, n_samples_, ctx_.num_cars, cost::kNearLongitudinal,
                         [this](int c, int k) { return car_s_[c * n_samples_ + k]; }, near);
@@ -955,10 +964,7 @@ class SearchPlanner : public Planner {
     in.end_d = lat_d_[oj + n_samples_ - 1];
     in.target_lane = lat_[j].lane;
     in.kind = lon_[i].kind;
-    in.near_lat[0] = lat_near_.data() + 2 * oj;
-    in.near_lat[1] = lat_near_.data() + 2 * oj + n_samples_;
-    in.near_lon[0] = lon_near_.data() + 2 * oi;
-    in.near_lon[1] = lon_near_.data() + 2 * oi + n_samples_;
+    SetNear(in, lat_near_.data() + 2 * oj, lon_near_.data() + 2 * oi);
     return in;
   }
 
@@ -1332,10 +1338,7 @@ class SearchPlanner : public Planner {
     in.kind = lbase.kind;
     NearLat(ref_d_.data(), ref_near_lat_.data());
     NearLon(ref_s_.data(), ref_near_lon_.data());
-    in.near_lat[0] = ref_near_lat_.data();
-    in.near_lat[1] = ref_near_lat_.data() + n_samples_;
-    in.near_lon[0] = ref_near_lon_.data();
-    in.near_lon[1] = ref_near_lon_.data() + n_samples_;
+    SetNear(in, ref_near_lat_.data(), ref_near_lon_.data());
     return in;
   }
 
