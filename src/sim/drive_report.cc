@@ -18,6 +18,31 @@ std::string Maybe(double v, const char* fmt_unit) {
   return std::isfinite(v) ? fmt::format(fmt::runtime(fmt_unit), v) : std::string("none");
 }
 
+double Share(double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0; }
+
+// The "time" and "passes" lines of a report.
+std::string BreakdownText(const LapBreakdown& b) {
+  return fmt::format(
+      "time            at the limit {:.1f} s ({:.1f}%), following {:.1f} s ({:.1f}%), of it "
+      "{:.1f} s with a neighbour lane open\n"
+      "passes          {} made, {} missed (a neighbour lane open >= 3 s while following), "
+      "passed by {}\n",
+      b.at_limit_s, Share(b.at_limit_s, b.seconds), b.following_s,
+      Share(b.following_s, b.seconds), b.following_open_s, b.passes, b.missed_passes,
+      b.passed_by);
+}
+
+nlohmann::json BreakdownJson(const LapBreakdown& total, const std::vector<LapBreakdown>* laps) {
+  nlohmann::json j = total.ToJson();
+  j.erase("lap");
+  if (laps != nullptr) {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const LapBreakdown& b : *laps) arr.push_back(b.ToJson());
+    j["laps"] = std::move(arr);
+  }
+  return j;
+}
+
 }  // namespace
 
 double DriveReport::per_mile(IncidentKind kind) const {
@@ -61,6 +86,7 @@ nlohmann::json DriveReport::ToJson() const {
           {"min_headway_s", Finite(min_headway_s)},
           {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
           {"plan_fallbacks", plan_fallbacks},
+          {"breakdown", BreakdownJson(breakdown, &laps)},
           {"incident_log", log}};
 }
 
@@ -83,6 +109,15 @@ std::string DriveReport::ToText() const {
   o << fmt::format("maxima          speed {:.2f} mph, acceleration {:.2f} m/s^2, jerk {:.2f} m/s^3\n",
                    max_speed_mph, max_acc, max_jerk);
   o << fmt::format("lane changes    {}\n", lane_changes);
+  o << BreakdownText(breakdown);
+  if (laps.size() > 1) {
+    o << "  lap  time s    mph  at limit s  following s  (lane open)  passes  missed  passed by\n";
+    for (const LapBreakdown& b : laps) {
+      o << fmt::format("  {:3d}  {:6.1f}  {:5.2f}  {:10.1f}  {:11.1f}  {:11.1f}  {:6d}  {:6d}  {:9d}\n",
+                       b.lap + 1, b.seconds, b.avg_speed_mph(), b.at_limit_s, b.following_s,
+                       b.following_open_s, b.passes, b.missed_passes, b.passed_by);
+    }
+  }
   o << "closest ahead   gap " << Maybe(min_gap_m, "{:.1f} m") << ", headway "
     << Maybe(min_headway_s, "{:.2f} s") << "\n";
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
@@ -107,6 +142,7 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
     a.plan_ms_p50 = std::max(a.plan_ms_p50, r.plan_ms_p50);
     a.plan_ms_p99 = std::max(a.plan_ms_p99, r.plan_ms_p99);
     a.plan_ms_max = std::max(a.plan_ms_max, r.plan_ms_max);
+    a.breakdown.Add(r.breakdown);
   }
   for (int k = 0; k < kIncidentKinds; ++k) {
     a.per_100_miles[k] = a.total_miles > 0 ? 100.0 * counts[k] / a.total_miles : 0;
@@ -150,6 +186,7 @@ nlohmann::json AggregateReport::ToJson() const {
           {"avg_speed_stddev_mph", avg_speed_stddev},
           {"worst_episode", worst >= 0 ? nlohmann::json(episodes[worst].seed) : nlohmann::json()},
           {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
+          {"breakdown", BreakdownJson(breakdown, nullptr)},
           {"per_episode", eps}};
 }
 
@@ -166,6 +203,7 @@ std::string AggregateReport::ToText() const {
                    avg_speed_stddev);
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms (worst episode)\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max);
+  o << BreakdownText(breakdown);
   for (const DriveReport& r : episodes) {
     o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi\n",
                      r.seed, r.miles(), r.avg_speed_mph, r.incidents, r.miles_to_first_incident);

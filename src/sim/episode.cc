@@ -57,6 +57,8 @@ DriveReport MakeReport(const Episode& ep, std::string_view planner,
   r.plan_ms_max = plan_ms.empty() ? 0 : *std::max_element(plan_ms.begin(), plan_ms.end());
   r.plan_fallbacks = fallbacks;
   r.incident_log = m.log();
+  r.laps = sim.breakdown().laps();
+  r.breakdown = sim.breakdown().Total();
   return r;
 }
 

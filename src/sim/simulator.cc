@@ -162,17 +162,29 @@ void Simulator::Tick() {
     frame_phase_ -= 1.0;
     traffic_->Frame(view_);
   }
-  UpdateMetrics();
+  const bool changed_lane = UpdateMetrics();
+  breakdown_.Update(kTick, view_, view_.d >= 0 && view_.d < 12 ? lane_ : -1, changed_lane,
+                    monitor_.distance(), leader_.id >= 0 ? leader_.gap : kInf,
+                    traffic_->cars(), *world_->line);
 }
 
-void Simulator::UpdateMetrics() {
+bool Simulator::UpdateMetrics() {
   // Ego lane with hysteresis: a lane counts once d is within 1.5 m of its centre.
+  bool changed = false;
   for (int j = 0; j < 3; ++j) {
     if (std::abs(view_.d - (2.0 + 4.0 * j)) < 1.5) {
-      if (lane_ >= 0 && j != lane_) ++lane_changes_;
+      if (lane_ >= 0 && j != lane_) {
+        ++lane_changes_;
+        changed = true;
+      }
       lane_ = j;
     }
   }
+  UpdateLeader();
+  return changed;
+}
+
+void Simulator::UpdateLeader() {
   leader_ = LeaderGap();
   if (view_.d < 0 || view_.d >= 12) return;
   const int ego_lane = static_cast<int>(view_.d / 4.0);

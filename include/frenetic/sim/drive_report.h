@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/sim/drive_breakdown.h"
 #include "frenetic/sim/incident_monitor.h"
 
 namespace frenetic::sim {
@@ -34,6 +35,9 @@ struct DriveReport {
   double plan_ms_p50 = 0, plan_ms_p99 = 0, plan_ms_max = 0;  // wall time per Plan() call
   int plan_fallbacks = 0;     // cycles whose status was not ok
   std::vector<Incident> incident_log;
+  // Where the time went: the whole drive and each lap (following, at the limit, passes).
+  LapBreakdown breakdown;
+  std::vector<LapBreakdown> laps;
 
   double miles() const { return distance_m / 1609.344; }
   // Incidents per mile of `kind` (0 for a drive of no distance).
@@ -50,6 +54,7 @@ struct AggregateReport {
   double avg_speed_mph = 0, avg_speed_stddev = 0;  // over episodes
   int worst = -1;  // index of the worst episode: most incidents per mile, then slowest
   double plan_ms_p50 = 0, plan_ms_p99 = 0, plan_ms_max = 0;  // over episodes (max of each)
+  LapBreakdown breakdown;  // summed over episodes
   static AggregateReport From(std::vector<DriveReport> episodes);
   nlohmann::json ToJson() const;
   std::string ToText() const;

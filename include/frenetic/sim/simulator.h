@@ -8,6 +8,7 @@
 #include <span>
 
 #include "frenetic/plan/telemetry.h"
+#include "frenetic/sim/drive_breakdown.h"
 #include "frenetic/sim/ego.h"
 #include "frenetic/sim/incident_monitor.h"
 #include "frenetic/sim/scenario.h"
@@ -63,13 +64,16 @@ class Simulator {
   double min_headway() const { return min_headway_; }  // s, +inf if never a leader
   int lane_changes() const { return lane_changes_; }
   int lane() const { return lane_; }  // current ego lane (0..2), -1 off the carriageway
+  // Where the time went, per lap (following, at the limit, passes made and missed).
+  const DriveBreakdown& breakdown() const { return breakdown_; }
 
  private:
   Simulator(std::shared_ptr<const World> world, const Scenario& scenario, std::uint64_t seed,
             float x, float y, double yaw);
   void Tick();
   void UpdateView();
-  void UpdateMetrics();
+  bool UpdateMetrics();  // true when the ego changed lane
+  void UpdateLeader();
 
   std::shared_ptr<const World> world_;
   Scenario scenario_;
@@ -84,6 +88,7 @@ class Simulator {
   LeaderGap leader_;
   double min_gap_, min_headway_;
   int lane_changes_ = 0, lane_ = -1;
+  DriveBreakdown breakdown_;
 };
 
 }  // namespace frenetic::sim
