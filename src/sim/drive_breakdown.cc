@@ -21,10 +21,15 @@ double LapBreakdown::avg_speed_mph() const {
   return seconds > 0 ? distance_m / seconds * kMpsToMph : 0;
 }
 
+double LapBreakdown::at_limit_mph() const {
+  return at_limit_s > 0 ? at_limit_m / at_limit_s * kMpsToMph : 0;
+}
+
 void LapBreakdown::Add(const LapBreakdown& o) {
   seconds += o.seconds;
   distance_m += o.distance_m;
   at_limit_s += o.at_limit_s;
+  at_limit_m += o.at_limit_m;
   following_s += o.following_s;
   following_open_s += o.following_open_s;
   passes += o.passes;
@@ -39,6 +44,7 @@ nlohmann::json LapBreakdown::ToJson() const {
           {"distance_m", distance_m},
           {"avg_speed_mph", avg_speed_mph()},
           {"at_limit_s", at_limit_s},
+          {"at_limit_mph", at_limit_mph()},
           {"following_s", following_s},
           {"following_open_lane_s", following_open_s},
           {"passes", passes},
@@ -63,7 +69,10 @@ void DriveBreakdown::Update(double dt, const EgoView& ego, int ego_lane, bool la
   if (lane_changed) ++b.lane_changes;
 
   const bool at_limit = ego.speed * kMpsToMph >= opt_.at_limit_mph;
-  if (at_limit) b.at_limit_s += dt;
+  if (at_limit) {
+    b.at_limit_s += dt;
+    b.at_limit_m += ego.speed * dt;
+  }
   const double reach = std::max(opt_.follow_min_gap, opt_.follow_time * ego.speed);
   const bool following = !at_limit && ego_lane >= 0 && leader_gap <= reach;
 

@@ -23,11 +23,11 @@ double Share(double part, double whole) { return whole > 0 ? 100.0 * part / whol
 // The "time" and "passes" lines of a report.
 std::string BreakdownText(const LapBreakdown& b) {
   return fmt::format(
-      "time            at the limit {:.1f} s ({:.1f}%), following {:.1f} s ({:.1f}%), of it "
+      "time            at the limit {:.1f} s ({:.1f}%, {:.2f} mph there), following {:.1f} s ({:.1f}%), of it "
       "{:.1f} s with a neighbour lane open\n"
       "passes          {} made, {} missed (a neighbour lane open >= 3 s while following), "
       "passed by {}\n",
-      b.at_limit_s, Share(b.at_limit_s, b.seconds), b.following_s,
+      b.at_limit_s, Share(b.at_limit_s, b.seconds), b.at_limit_mph(), b.following_s,
       Share(b.following_s, b.seconds), b.following_open_s, b.passes, b.missed_passes,
       b.passed_by);
 }

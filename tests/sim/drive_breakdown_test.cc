@@ -61,6 +61,7 @@ TEST(DriveBreakdown, FreeRoadAtTheLimitIsNotFollowing) {
   const LapBreakdown t = d.b.Total();
   EXPECT_NEAR(t.seconds, 5.0, 1e-9);
   EXPECT_NEAR(t.at_limit_s, 5.0, 1e-9);
+  EXPECT_NEAR(t.at_limit_mph(), 22.0 * 2.23693629, 1e-6);
   EXPECT_EQ(t.following_s, 0);
   EXPECT_EQ(t.missed_passes, 0);
   EXPECT_NEAR(t.avg_speed_mph(), 22.0 * 2.23693629, 1e-6);

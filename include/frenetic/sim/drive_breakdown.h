@@ -41,6 +41,7 @@ struct LapBreakdown {
   double seconds = 0;      // simulated s in this lap
   double distance_m = 0;
   double at_limit_s = 0;
+  double at_limit_m = 0;   // distance driven at the limit (its mean speed: how close to it)
   double following_s = 0;
   double following_open_s = 0;  // part of following_s with a neighbour lane open
   int passes = 0;               // cars the ego overtook (ahead in any lane -> behind)
@@ -49,6 +50,7 @@ struct LapBreakdown {
   int lane_changes = 0;
 
   double avg_speed_mph() const;
+  double at_limit_mph() const;  // mean speed while at the limit (0 if never)
   void Add(const LapBreakdown& other);  // sums every count and time (lap is kept)
   nlohmann::json ToJson() const;
 };
