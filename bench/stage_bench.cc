@@ -1,10 +1,11 @@
 // The stages of a planning cycle alone, on the public building blocks the search planner is
-// made of (src/plan/search_planner.cc keeps its stages private; their in-planner times are the
-// gen_us / score_us / check_us / refine_us counters of BM_Plan*): polynomial solves, bundle
-// generation (solve + sample, the planner's GenerateBundles work), cost scoring, the collision
-// check, XY feasibility, Frenet <-> XY, NLopt refinement, telemetry parsing and control
-// serialisation. Inputs are deterministic: a fixed start state, the default configuration and
-// its cost set, traffic at fixed spacing (or a recorded message where one is parsed).
+// made of (its stages, src/plan/search_*.h, are private to the plan module; their in-planner
+// times are the gen_us / score_us / check_us / refine_us counters of BM_Plan*): polynomial
+// solves, bundle generation (solve + sample, the planner's Lattice::Generate work), cost
+// scoring, the collision check, XY feasibility, Frenet <-> XY, NLopt refinement, telemetry
+// parsing and control serialisation. Inputs are deterministic: a fixed start state, the default
+// configuration and its cost set, traffic at fixed spacing (or a recorded message where one is
+// parsed).
 #include <benchmark/benchmark.h>
 #include <nlopt.h>
 
@@ -71,7 +72,7 @@ struct Fixture {
   }
 };
 
-// GenerateBundles' work for a grid shape: velocity-keeping quartics (+ stopping quintic) per
+// Lattice::Generate's work for a grid shape: velocity-keeping quartics (+ stopping quintic) per
 // duration and lateral quintics per lane, duration and offset, each sampled at the score times.
 void Generate(const traj::FrenetState& s0, const GridShape& g, Bundles* b) {
   b->lon.clear();

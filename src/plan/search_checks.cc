@@ -1,0 +1,104 @@
+#include "plan/search_checks.h"
+
+namespace frenetic::plan::search {
+
+Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
+    : cfg_(cfg),
+      line_(line),
+      ws_(ws),
+      xy_(kHistory + 64 + static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds)) +
+          cfg.output_points) {
+  const int path_cap = kHistory + cfg.output_points + ws_.n_ticks + 8;
+  chk_x_.assign(path_cap, 0.0);
+  chk_y_.assign(path_cap, 0.0);
+}
+
+void Checker::FillTicks(const traj::FrenetTrajectory& tr) {
+  for (int i = 1; i <= ws_.n_ticks; ++i) {
+    const traj::FrenetState st = tr.At(i * kTickSeconds);
+    ws_.tk_s[i] = st.s;
+    ws_.tk_sd[i] = st.s_d;
+    ws_.tk_sdd[i] = st.s_dd;
+    ws_.tk_d[i] = st.d;
+    ws_.tk_dd[i] = st.d_d;
+    ws_.tk_ddd[i] = st.d_dd;
+  }
+}
+
+void Checker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n,
+                          const double* kept_x, const double* kept_y, int kept) {
+  int n = 0;
+  for (int i = 0; i < hist_n; ++i, ++n) {
+    chk_x_[n] = hist_x[i];
+    chk_y_[n] = hist_y[i];
+  }
+  for (int i = 0; i < kept; ++i, ++n) {
+    chk_x_[n] = kept_x[i];
+    chk_y_[n] = kept_y[i];
+  }
+  first_new_ = n;
+  xy_.SetPrefix(chk_x_.data(), chk_y_.data(), n);
+}
+
+int Checker::BuildXyPath() {
+  int n = first_new_;
+  for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
+    const map::CartesianPose p = line_.ToCartesian(ws_.tk_s[i], ws_.tk_d[i]);
+    chk_x_[n] = p.x;
+    chk_y_[n] = p.y;
+  }
+  return n;
+}
+
+double Checker::Violation(Reject* reason, bool lane_line) {
+  const int n_ticks = ws_.n_ticks;
+  const std::vector<double>& tk_s = ws_.tk_s;
+  const std::vector<double>& tk_d = ws_.tk_d;
+  double worst = -1e9;
+  Reject why = Reject::kCount;
+  auto take = [&](double v, Reject r) {
+    if (!(v <= worst)) {  // NaN counts as a violation
+      worst = Finite(v) ? v : 1e9;
+      why = r;
+    }
+  };
+  // d as the simulator reads it (from chords), bounded every 5 ticks over the s swept since
+  // the previous check point.
+  // The lane-line timer runs on, from the start state's count, while the read d may be astride
+  // a line; a trajectory still astride at its end would stay there.
+  double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
+  int straddle = ws_.straddle_at_start, worst_straddle = straddle;
+  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ws_.tk_sd[i]);
+  for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
+       prev = i, i = std::min(i + 5, n_ticks)) {
+    const double d_lo = std::min(tk_d[prev], tk_d[i]), d_hi = std::max(tk_d[prev], tk_d[i]);
+    const map::ReferenceLine::OffsetRange r = line_.ChordOffset(
+        std::min(tk_s[prev], tk_s[i]), std::max(tk_s[prev], tk_s[i]), 0.5 * (d_lo + d_hi));
+    dmin = std::min(dmin, d_lo + r.lo);
+    dmax = std::max(dmax, d_hi + r.hi);
+    straddle =
+        StraddlesRead(cfg_, d_lo + r.lo, d_hi + r.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+    worst_straddle = std::max(worst_straddle, straddle);
+    if (i == n_ticks) break;
+  }
+  if (straddle > 0) worst_straddle = 1 << 20;
+  take(std::max(cfg_.d_min - dmin, dmax - cfg_.d_max) / cfg_.lane_width, Reject::kOffRoad);
+  if (lane_line) {
+    take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
+         Reject::kLaneLine);
+  }
+  take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
+  if (worst > 0) {                      // already infeasible: skip the XY conversion
+    if (reason != nullptr) *reason = why;
+    return worst;
+  }
+  const int n = BuildXyPath();
+  const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
+  take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
+  take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
+  take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
+  if (reason != nullptr) *reason = worst > 0 ? why : Reject::kCount;
+  return worst;
+}
+
+}  // namespace frenetic::plan::search

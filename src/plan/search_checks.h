@@ -1,0 +1,134 @@
+// The search planner's hard checks (filters with a named reason, never costs): a candidate is
+// sampled at every 0.02 s tick of the check horizon; then off-road, never backwards and the
+// simulator's lane-line timer on d as the simulator reads it, and its speed, acceleration and
+// jerk limits on the XY path (history | kept points | the ticks, feasibility.h); and collisions
+// with the predicted traffic as oriented boxes inflated by the safety margins (headway to a car
+// ahead, room for a car behind in another lane).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "frenetic/map/reference_line.h"
+#include "frenetic/plan/feasibility.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/traj/box.h"
+#include "frenetic/traj/frenet.h"
+#include "plan/search_settings.h"
+#include "plan/search_workspace.h"
+
+namespace frenetic::plan::search {
+
+// Whether read d in [lo, hi] (m) comes within kStraddle of a lane line: the simulator's
+// lane-line timer runs then.
+inline bool StraddlesRead(const Settings& cfg, double lo, double hi) {
+  for (int l = 1; l < cfg.num_lanes; ++l) {
+    const double line = l * cfg.lane_width;
+    if (hi > line - kStraddle && lo < line + kStraddle) return true;
+  }
+  return false;
+}
+// Whether the simulator may read d within kStraddle of a lane line for a point with s in
+// [s0, s1] and d in [d0, d1] (it reads d from chords: ReferenceLine::ChordOffset).
+inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, double s0, double s1,
+                      double d0, double d1) {
+  const map::ReferenceLine::OffsetRange r = line.ChordOffset(s0, s1, 0.5 * (d0 + d1));
+  return StraddlesRead(cfg, d0 + r.lo, d1 + r.hi);
+}
+
+class Checker {
+ public:
+  // `line` and `ws` must outlive the checker; the check reads the traffic and the start state
+  // of ws and the ticks ws.tk_*.
+  Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws);
+
+  // Samples a trajectory at every tick of the check horizon into ws.tk_* [1, n_ticks].
+  void FillTicks(const traj::FrenetTrajectory& tr);
+  // The XY path's part common to every candidate of the cycle, the driven history then the
+  // kept points (oldest first), measured once.
+  void SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n, const double* kept_x,
+                   const double* kept_y, int kept);
+
+  // The worst normalised excess over all limits of the ticks (<= 0: feasible), and the first
+  // reason (kCount when feasible; reason may be null). lane_line: include the lane-line timer
+  // (the least-harm choice may drop it: a collision is worse). NaN counts as a violation.
+  double Violation(Reject* reason, bool lane_line = true);
+
+  // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
+  bool Collides() const {
+    return FirstCollision(
+               [this](int i) {
+                 return traj::FrenetState{ws_.tk_s[i], ws_.tk_sd[i], 0.0,
+                                          ws_.tk_d[i], ws_.tk_dd[i], 0.0};
+               },
+               1.0) <= ws_.n_steps;
+  }
+
+  // The first collision step (1..n_steps) of `state_at` (state at a tick index), or
+  // n_steps + 1 when none; car_hit (optional) receives the context index of the car hit. The
+  // safety margins are scaled by margin_scale (0: bare boxes), except the room kept for a car
+  // behind in another lane, scaled by behind_scale: that car does not see the ego until it is
+  // in front of it (the simulator's traffic only brakes for a car within 2 m laterally), so
+  // moving into its way is never safe.
+  template <typename StateAt>
+  int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
+                     int* car_hit = nullptr) const;
+
+ private:
+  // Appends the ticks to the XY prefix; returns the path length.
+  int BuildXyPath();
+
+  const Settings& cfg_;
+  const map::ReferenceLine& line_;
+  Workspace& ws_;
+  XyChecker xy_;
+  std::vector<double> chk_x_, chk_y_;  // the XY path: prefix | ticks
+  int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
+};
+
+template <typename StateAt>
+int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
+                            int* car_hit) const {
+  const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
+  const int n_steps = ws_.n_steps;
+  for (int j = 1; j <= n_steps; ++j) {
+    const traj::FrenetState st = state_at(j * ws_.collision_step);
+    const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
+    const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+    const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
+    for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+      const int at = c * (n_steps + 1) + j;
+      const double cs = ws_.step_s[at], cd = ws_.step_d[at];
+      // A car behind in another lane than the start's is one the ego would cut in front of:
+      // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
+      // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
+      // A car ahead needs room to brake behind it: headway_min at the ego's speed.
+      const bool behind_other_lane =
+          cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
+      // A car behind in another lane needs room to react and brake when it closes in.
+      const double closing = std::max(0.0, ws_.step_v[at] - st.s_d);
+      // The headway to a car ahead is kept in full while the ego is in its lane and tapers
+      // to margin_s as the ego moves out of it (pulling out from behind a car is how a
+      // lane change starts).
+      const double inside = std::clamp(
+          (cfg_.car_width - std::abs(cd - st.d)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
+      const double margin =
+          cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * st.s_d)
+          : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
+                              : margin_scale * cfg_.margin_s;
+      if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
+      // The car's heading from its predicted velocity (a lane change turns it).
+      const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
+      const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+      const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
+      if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) {
+        if (car_hit != nullptr) *car_hit = c;
+        return j;
+      }
+    }
+  }
+  return n_steps + 1;
+}
+
+}  // namespace frenetic::plan::search

@@ -1,0 +1,130 @@
+#include "plan/search_context.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "frenetic/plan/planner.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+// The lanes' centres for this cycle: the nominal ones, moved just enough that the simulator,
+// which measures d from the chords between waypoints (up to ~1.3 m outward mid-segment on
+// left bends, udacity-sim.md §5.3 and §9.3), reads the ego inside its lane over the next
+// stretch: clear of the lane lines' +-0.8 m bands (the 3 s timer) and of the road edges.
+void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws) {
+  const double ahead = std::max(ws.start.s_d, 10.0) * cfg.score_horizon + 20.0;
+  const int last = cfg.num_lanes - 1;
+  for (int l = 0; l <= last; ++l) {
+    const map::ReferenceLine::OffsetRange r =
+        line.ChordOffset(ws.start.s - 10.0, ws.start.s + ahead, ws.lane_nominal[l]);
+    const double lo_read = l == 0 ? cfg.d_min : l * cfg.lane_width + kLaneLineBand;
+    const double hi_read = l == last ? cfg.d_max : (l + 1) * cfg.lane_width - kLaneLineBand;
+    const double lo = lo_read - r.lo, hi = hi_read - r.hi;
+    ws.lane_center[l] = lo <= hi ? std::clamp(ws.lane_nominal[l], lo, hi) : 0.5 * (lo + hi);
+  }
+}
+
+}  // namespace
+
+int LaneOf(const Settings& cfg, const Workspace& ws, double d) {
+  int best = 0;
+  for (int l = 1; l < cfg.num_lanes; ++l) {
+    if (std::abs(d - ws.lane_center[l]) < std::abs(d - ws.lane_center[best])) best = l;
+  }
+  return best;
+}
+
+void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Predictor& predictor,
+                  Workspace& ws) {
+  const traj::FrenetState& start = ws.start;
+  const int n_samples = ws.n_samples, n_steps = ws.n_steps;
+  cost::CostContext& c = ws.ctx;
+  c.num_samples = n_samples;
+  c.dt = cfg.score_dt;
+  c.lane_width = cfg.lane_width;
+  c.num_lanes = cfg.num_lanes;
+  c.car_length = cfg.car_length;
+  c.car_width = cfg.car_width;
+  c.start_s = start.s;
+  c.start_d = start.d;
+  c.start_speed = start.s_d;
+  c.current_lane = LaneOf(cfg, ws, start.d);
+  c.previous_target_lane = ws.prev_target_lane;
+  c.time_since_lane_change = ws.time_since_change;
+  c.lane_before_change = ws.lane_before_change;
+  LaneCentres(cfg, line, ws);
+  // Lane speed limits: the XY speed of an offset curve is s' (1 + kappa d) with d to the right
+  // and kappa positive to the left, so the outer lane of a left bend is faster in XY.
+  const double reach = cfg.max_speed * cfg.score_horizon + 20;
+  double kmax = 0, kmin = 0;
+  for (double ds = -10; ds <= reach; ds += 2.0) {
+    const double k = line.At(start.s + ds).kappa;
+    if (Finite(k)) {
+      kmax = std::max(kmax, k);
+      kmin = std::min(kmin, k);
+    }
+  }
+  for (int l = 0; l < cfg.num_lanes; ++l) {
+    c.lane_center[l] = ws.lane_center[l];
+    const double d = ws.lane_center[l];
+    const double factor = std::max({1.0, 1.0 + kmax * d, 1.0 + kmin * d});
+    // A little below the cap: lateral motion and the splice add a few cm/s in XY.
+    c.lane_speed_limit[l] = cfg.max_speed / factor - 0.05;
+  }
+  // Previous choice at this cycle's sample times.
+  if (ws.have_prev_traj) {
+    for (int k = 0; k < n_samples; ++k) {
+      const traj::FrenetState p = ws.prev_traj.At(k * cfg.score_dt + ws.prev_elapsed);
+      ws.prev_s[k] = p.s;
+      ws.prev_d[k] = p.d;
+    }
+    c.previous_s = ws.prev_s.data();
+    c.previous_d = ws.prev_d.data();
+  } else {
+    c.previous_s = c.previous_d = nullptr;
+  }
+  // Traffic: relevant cars only. A car right behind the ego in its lane is its follower's
+  // problem (the simulator's traffic brakes for the car ahead) — but only once the ego is
+  // squarely in front of it: mid lane change the car may not have seen the ego yet.
+  // Predictions are sampled once here: at the scoring samples and at the collision-check
+  // steps, t_keep after the observation.
+  const auto cars = predictor.cars();
+  int nc = 0;
+  for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
+    const TrackedCar& car = cars[i];
+    if (car.s < -cfg.car_length && std::abs(car.d - start.d) < kFollowerLateral) continue;
+    ws.car_index[nc] = i;
+    const Predictor::Prediction at_start = predictor.Predict(i, ws.t_keep);
+    ws.car_s0[nc] = start.s + at_start.s;  // at the start instant, in the start's s frame
+    ws.car_d0[nc] = at_start.d;
+    for (int k = 0; k < n_samples; ++k) {
+      const Predictor::Prediction p = predictor.Predict(i, ws.t_keep + k * cfg.score_dt);
+      ws.car_s[nc * n_samples + k] = start.s + p.s;
+      ws.car_d[nc * n_samples + k] = p.d;
+      ws.car_v[nc * n_samples + k] = p.v;
+    }
+    const int row = nc * (n_steps + 1);
+    for (int j = 1; j <= n_steps; ++j) {
+      const Predictor::Prediction p =
+          predictor.Predict(i, ws.t_keep + j * ws.collision_step * kTickSeconds);
+      ws.step_s[row + j] = start.s + p.s;
+      ws.step_d[row + j] = p.d;
+      ws.step_v[row + j] = p.v;
+      ws.step_vd[row + j] = p.v_d;
+    }
+    ++nc;
+  }
+  c.num_cars = nc;
+  c.max_car_speed = 0;
+  for (int i = 0; i < nc * n_samples; ++i) c.max_car_speed = std::max(c.max_car_speed, ws.car_v[i]);
+  c.near_lateral[0] = cost::kNearLateral[0];
+  c.near_lateral[1] = cost::kNearLateral[1];
+  c.near_longitudinal[0] = cost::kNearLongitudinal[0];
+  c.near_longitudinal[1] = cost::kNearLongitudinal[1];
+  c.car_s = ws.car_s.data();
+  c.car_d = ws.car_d.data();
+  c.car_v = ws.car_v.data();
+}
+
+}  // namespace frenetic::plan::search

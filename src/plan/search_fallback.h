@@ -1,0 +1,21 @@
+// What the search planner sends when the search found nothing: last cycle's winner if it is
+// still clear of traffic (after a search cut short by the deadline), else keep-lane braking.
+#pragma once
+
+#include "plan/search_checks.h"
+#include "plan/search_settings.h"
+#include "plan/search_workspace.h"
+
+namespace frenetic::plan::search {
+
+// Samples last cycle's winner (ws.prev_traj) from the current start on into ws.tk_*; false
+// when there is none or it now collides. The XY limits were checked on it when it won. On
+// success the next cycle's elapsed time on it counts from this start (ws.prev_base).
+bool ContinuePrevious(Workspace& ws, const Checker& checker);
+
+// Keep-lane braking into ws.tk_*, at a jerk-limited constant deceleration integrated tick by
+// tick back to the current lane's centre; it never exceeds the limits. The first of three
+// braking levels that clears the traffic wins, else the hardest.
+void BuildFallback(const Settings& cfg, Workspace& ws, const Checker& checker);
+
+}  // namespace frenetic::plan::search

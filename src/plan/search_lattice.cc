@@ -1,0 +1,232 @@
+#include "plan/search_lattice.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plan/search_scoring.h"
+#include "plan/search_workspace.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+// m along s: a car in another lane this close is alongside (a lane change must yield to it).
+constexpr double kAlongside = 20.0;
+
+double Linspace(double lo, double hi, int count, int i) {
+  return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
+}
+
+}  // namespace
+
+void Lattice::AddLon(const LonTraj& l) {
+  if (!l.traj.poly.IsFinite()) return;
+  const int i = static_cast<int>(ws_.lon.size());
+  ws_.lon.push_back(l);
+  ws_.lon.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+  const int n = ws_.n_samples;
+  for (int k = 0; k < n; ++k) {
+    const traj::State1d st = l.traj.At(k * cfg_.score_dt);
+    ws_.lon_s[i * n + k] = st.p;
+    ws_.lon_sd[i * n + k] = st.v;
+    ws_.lon_sdd[i * n + k] = st.a;
+  }
+  NearLon(ws_, ws_.lon_s.data() + i * n, ws_.lon_near.data() + 2 * i * n);
+}
+
+void Lattice::AddLat(const LatTraj& l) {
+  if (!l.traj.poly.IsFinite()) return;
+  const int i = static_cast<int>(ws_.lat.size());
+  ws_.lat.push_back(l);
+  ws_.lat.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+  const int n = ws_.n_samples;
+  for (int k = 0; k < n; ++k) {
+    const traj::State1d st = l.traj.At(k * cfg_.score_dt);
+    ws_.lat_d[i * n + k] = st.p;
+    ws_.lat_dd[i * n + k] = st.v;
+    ws_.lat_ddd[i * n + k] = st.a;
+  }
+  NearLat(ws_, ws_.lat_d.data() + i * n, ws_.lat_near.data() + 2 * i * n);
+}
+
+LonTraj Lattice::MakeLon(cost::LonKind kind, int lane, double param, double T, int lead) const {
+  LonTraj l;
+  l.kind = kind;
+  l.lane = lane;
+  l.param = param;
+  l.lead = lead;
+  l.traj.duration = T;
+  const traj::FrenetState& s0 = ws_.start;
+  switch (kind) {
+    case cost::LonKind::kVelocityKeeping:
+      l.traj.poly = traj::SolveQuartic(s0.s, s0.s_d, s0.s_dd, std::max(param, 0.0), 0.0, T);
+      break;
+    case cost::LonKind::kFollowing: {
+      // Constant time-gap law on the leader's predicted state at T:
+      // s_target = s_lead(T) - (D0 + tau v_lead(T)), minus `param` more.
+      const Predictor::Prediction lead_at = predictor_.Predict(lead, ws_.t_keep + T);
+      const double s_lead = ws_.start.s + lead_at.s;
+      const double target = s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param;
+      l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_at.v, 0.0, T);
+      break;
+    }
+    case cost::LonKind::kStopping:
+      l.traj.poly =
+          traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, s0.s + std::max(param, 0.0), 0.0, 0.0, T);
+      break;
+    case cost::LonKind::kBraking:
+      // Decelerate at `param` at once for T, then hold the speed reached (the trajectory's
+      // constant-velocity continuation): s0 + v0 t - param t^2 / 2.
+      l.traj.poly = {};
+      l.traj.poly.c[0] = s0.s;
+      l.traj.poly.c[1] = s0.s_d;
+      l.traj.poly.c[2] = -0.5 * param;
+      break;
+  }
+  return l;
+}
+
+LatTraj Lattice::MakeLat(int lane, double offset, double T, double delay) const {
+  LatTraj l;
+  l.lane = lane;
+  l.offset = offset;
+  l.traj.duration = T;
+  l.traj.delay = delay;
+  const traj::FrenetState& s0 = ws_.start;
+  const double target =
+      std::clamp(ws_.lane_center[lane] + offset, 0.0, cfg_.num_lanes * cfg_.lane_width);
+  // A delayed move holds still first (only offered when the ego is nearly at rest laterally).
+  l.traj.poly = delay > 0 ? traj::SolveQuintic(s0.d, 0.0, 0.0, target, 0.0, 0.0, T)
+                          : traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, target, 0.0, 0.0, T);
+  return l;
+}
+
+// The nearest car ahead in `lane` at the start instant (context index), or -1.
+int Lattice::Leader(int lane) const {
+  int best = -1;
+  double best_s = 1e18;
+  for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    if (ws_.car_s0[c] <= ws_.start.s) continue;
+    if (ws_.car_s0[c] < best_s) {
+      best_s = ws_.car_s0[c];
+      best = c;
+    }
+  }
+  return best;
+}
+
+// Constant-deceleration braking, each level to a few lower speeds (fractions of the current
+// one): the quick, strong braking a quintic cannot start with.
+void Lattice::AddBraking() {
+  const double v0 = std::max(ws_.start.s_d, 0.0);
+  if (v0 < 1.0) return;
+  for (int bi = 0; bi < cfg_.brake_decels; ++bi) {
+    const double a = Linspace(cfg_.brake_min_decel, cfg_.brake_max_decel, cfg_.brake_decels, bi);
+    for (int ti = 0; ti < cfg_.brake_targets; ++ti) {
+      // Target speeds from standstill up to (but not including) the current speed.
+      const double target = v0 * ti / cfg_.brake_targets;
+      AddLon(MakeLon(cost::LonKind::kBraking, -1, a, (v0 - target) / a));
+    }
+  }
+}
+
+// The car in `lane` nearest to the ego along s within kAlongside at the start instant (context
+// index), or -1: the one a lane change into that lane must pass behind or in front of.
+int Lattice::Alongside(int lane) const {
+  int best = -1;
+  double best_ds = kAlongside;
+  for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    const double ds = std::abs(ws_.car_s0[c] - ws_.start.s);
+    if (ds < best_ds) {
+      best_ds = ds;
+      best = c;
+    }
+  }
+  return best;
+}
+
+void Lattice::Generate() {
+  const traj::FrenetState& start = ws_.start;
+  ws_.lon.clear();
+  ws_.lat.clear();
+  ws_.cand_lon.clear();
+  ws_.cand_lat.clear();
+  // Lanes within reach: the current one and its neighbours.
+  bool reachable[cost::kMaxLanes] = {};
+  for (int l = 0; l < cfg_.num_lanes; ++l) {
+    reachable[l] = std::abs(ws_.lane_center[l] - start.d) <= 2.5 * cfg_.lane_width;
+  }
+  for (int di = 0; di < cfg_.durations; ++di) {
+    const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
+    for (int vi = 0; vi < cfg_.speeds; ++vi) {
+      // Velocity keeping to end speeds from 0 to the fastest lane's limit.
+      double vmax = 0;
+      for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
+      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T));
+    }
+    if (cfg_.stop) {
+      AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start.s_d * T, T));
+    }
+    if (di == 0) AddBraking();
+    for (int l = 0; l < cfg_.num_lanes; ++l) {
+      if (!reachable[l]) continue;
+      // Follow the lane's leader, and yield to (drop behind) the car alongside, which the
+      // delayed lane changes below need to pass behind it (Apollo's yield samples).
+      const int targets[2] = {Leader(l), Alongside(l)};
+      for (int k = 0; k < 2; ++k) {
+        const int lead = targets[k];
+        if (lead < 0 || (k == 1 && lead == targets[0])) continue;
+        for (int g = 0; g < cfg_.follow_gaps; ++g) {
+          // Longer time gaps are extra distance on top of the base law.
+          const double extra = g * cfg_.follow_tau_step * ws_.car_v[lead * ws_.n_samples];
+          AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, ws_.car_index[lead]));
+        }
+      }
+    }
+  }
+  // Laterally at rest (keeping a lane): one duration stands for all for the own lane (they
+  // coincide), and lane changes may also wait before they start.
+  const bool at_rest = std::abs(start.d_d) < 0.2 && std::abs(start.d_dd) < 0.5;
+  for (int l = 0; l < cfg_.num_lanes; ++l) {
+    if (!reachable[l]) continue;
+    const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.lane_width;
+    const bool centred = own && at_rest && std::abs(ws_.lane_center[l] - start.d) < 0.1;
+    for (int ti = 0; ti < (centred ? 1 : cfg_.lat_durations); ++ti) {
+      const double T =
+          Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, cfg_.lat_durations, ti);
+      for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
+        const double off = (oi - cfg_.lat_offsets / 2) * cfg_.lat_offset_step;
+        AddLat(MakeLat(l, off, T));
+      }
+    }
+    if (!own && at_rest) {
+      const double T = Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, 3, 1);
+      for (int k = 1; k <= cfg_.lat_delays; ++k) {
+        AddLat(MakeLat(l, 0.0, T, k * cfg_.lat_delay_step));
+      }
+    }
+    // The lateral move under way, to its planned end time: replanning with full durations
+    // every cycle would stretch a lane change indefinitely (more time astride the line), and
+    // a waiting one would never start.
+    if (ws_.have_prev_traj && l == ws_.prev_lat_lane) {
+      const traj::Trajectory1d& prev = ws_.prev_traj.lat;
+      const double wait = prev.delay - ws_.prev_elapsed;
+      const double remaining = prev.end_time() - ws_.prev_elapsed;
+      if (wait > 0.05) {
+        AddLat(MakeLat(l, ws_.prev_lat_offset, prev.duration, wait));
+      } else if (remaining > 0.3 && remaining < cfg_.lat_min_duration - 0.05) {
+        AddLat(MakeLat(l, ws_.prev_lat_offset, remaining));
+      }
+    }
+  }
+  for (int i = 0; i < static_cast<int>(ws_.lon.size()); ++i) {
+    for (int j = 0; j < static_cast<int>(ws_.lat.size()); ++j) {
+      if (ws_.lon[i].lane >= 0 && ws_.lon[i].lane != ws_.lat[j].lane) continue;
+      ws_.cand_lon.push_back(i);
+      ws_.cand_lat.push_back(j);
+    }
+  }
+}
+
+}  // namespace frenetic::plan::search

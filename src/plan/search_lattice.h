@@ -1,0 +1,64 @@
+// The search planner's lattice (Werling et al., ICRA 2010, §III): from the cycle's start state,
+// a bundle of 1-D longitudinal trajectories (velocity keeping, following a lane's leader or
+// yielding to the car alongside, stopping, constant-deceleration braking) and one of lateral
+// moves to lane centres (with small offsets, and delayed starts), sampled on the scoring grid;
+// the candidates are every compatible lon x lat pair.
+#pragma once
+
+#include "frenetic/cost/cost_term.h"
+#include "frenetic/plan/predictor.h"
+#include "frenetic/traj/frenet.h"
+#include "plan/search_settings.h"
+
+namespace frenetic::plan::search {
+
+struct Workspace;
+
+// One longitudinal trajectory of the bundle.
+struct LonTraj {
+  traj::Trajectory1d traj;
+  cost::LonKind kind = cost::LonKind::kVelocityKeeping;
+  int lane = -1;  // -1: usable in every lane; else only with this lane's lateral moves
+  // End speed (velocity keeping), extra gap (following), distance (stop), deceleration (braking).
+  double param = 0;
+  int lead = -1;  // following: the leader's index in the predictor's cars of this cycle
+  double jerk2 = 0;
+};
+
+// One lateral move of the bundle: to `lane`'s centre plus `offset` (m).
+struct LatTraj {
+  traj::Trajectory1d traj;
+  int lane = 0;
+  double offset = 0;
+  double jerk2 = 0;
+};
+
+class Lattice {
+ public:
+  // Reads the context (start state, lanes, traffic) from `ws`, which must outlive the lattice.
+  Lattice(const Settings& cfg, const Predictor& predictor, Workspace& ws)
+      : cfg_(cfg), predictor_(predictor), ws_(ws) {}
+
+  // Fills ws.lon, ws.lat with their samples and masks, and ws.cand_lon / cand_lat with every
+  // compatible pair, in a fixed order (the order ties break by). Needs the cycle's context.
+  void Generate();
+
+  // One trajectory of a family from the start state over T s; `param` as in LonTraj, `lead` the
+  // leader's predictor index (following only). The result may be non-finite.
+  LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, int lead = -1) const;
+  // A quintic move to lane's centre + offset over T s, after `delay` s holding still.
+  LatTraj MakeLat(int lane, double offset, double T, double delay = 0) const;
+
+ private:
+  void AddLon(const LonTraj& l);
+  void AddLat(const LatTraj& l);
+  void AddBraking();
+  int Leader(int lane) const;
+  int Alongside(int lane) const;
+
+  const Settings& cfg_;
+  const Predictor& predictor_;
+  Workspace& ws_;
+};
+
+}  // namespace frenetic::plan::search

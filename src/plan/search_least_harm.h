@@ -1,0 +1,43 @@
+// The search planner's choice when no candidate is feasible and clear of traffic with the
+// safety margins: the least harmful feasible one, judged on bare car boxes (but still never
+// cutting in front of a car behind in another lane) — among the collision-free ones the one that
+// keeps farthest from every car, else the one whose first contact comes latest (more time for
+// the others to react, and for the next cycles to find a way out).
+#pragma once
+
+#include <vector>
+
+#include "frenetic/traj/frenet.h"
+#include "plan/search_checks.h"
+#include "plan/search_settings.h"
+#include "plan/search_workspace.h"
+
+namespace frenetic::plan::search {
+
+// The smallest separation (m) of the bare boxes of `tr` from any car of ws over the check
+// horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - length,
+// |dd| - width), < 0 on overlap.
+double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr);
+
+class LeastHarm {
+ public:
+  // `ws`, `checker` and `clock` must outlive this; sized for ws's largest candidate set.
+  LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock);
+
+  // Ranks the scored candidates ws.order by harm (latest contact, then most clearance, then
+  // cost; ws.order is left in that order) and makes the first feasible one the winner, else
+  // the first feasible but for the lane-line timer. False when none is even that, or when the
+  // deadline (85% of budget_ms) cut it short: then *over_budget is set.
+  bool Choose(bool* over_budget);
+
+ private:
+  const Settings& cfg_;
+  Workspace& ws_;
+  Checker& checker_;
+  const CycleClock& clock_;
+  // Per candidate: first collision step and clearance on bare boxes.
+  std::vector<int> first_hit_;
+  std::vector<double> clearance_;
+};
+
+}  // namespace frenetic::plan::search

@@ -1,0 +1,126 @@
+#include "plan/search_refiner.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace frenetic::plan::search {
+namespace {
+
+nlopt_algorithm AlgorithmFromName(const std::string& name) {
+  const nlopt_algorithm a = nlopt_algorithm_from_string(name.c_str());
+  return static_cast<int>(a) < 0 ? NLOPT_LN_COBYLA : a;
+}
+
+}  // namespace
+
+Refiner::Refiner(const Settings& cfg, const std::string& algorithm, Workspace& ws,
+                 const Lattice& lattice, Scorer& scorer, Checker& checker, const CycleClock& clock)
+    : cfg_(cfg),
+      ws_(ws),
+      lattice_(lattice),
+      scorer_(scorer),
+      checker_(checker),
+      clock_(clock),
+      opt_(nlopt_create(AlgorithmFromName(algorithm), 4)) {
+  if (opt_ != nullptr) {
+    nlopt_set_min_objective(opt_, &Refiner::Objective, this);
+    constraints_ok_ =
+        nlopt_add_inequality_constraint(opt_, &Refiner::Constraint, this, 1e-6) == NLOPT_SUCCESS;
+    nlopt_set_maxeval(opt_, cfg_.refine_iterations);
+  }
+}
+
+Refiner::~Refiner() {
+  if (opt_ != nullptr) nlopt_destroy(opt_);
+}
+
+traj::FrenetTrajectory Refiner::FromParams(const double* x) const {
+  const LonTraj& base = ws_.lon[ws_.winner_lon];
+  const LatTraj& lbase = ws_.lat[ws_.winner_lat];
+  LonTraj l = lattice_.MakeLon(base.kind, base.lane, x[0], x[1], base.lead);
+  LatTraj d = lattice_.MakeLat(lbase.lane, x[3], x[2]);
+  return {l.traj, d.traj};
+}
+
+double Refiner::Objective(unsigned n, const double* x, double* grad, void* data) {
+  (void)n;
+  (void)grad;  // derivative-free
+  auto* self = static_cast<Refiner*>(data);
+  ++self->evals_;
+  const traj::FrenetTrajectory tr = self->FromParams(x);
+  const Workspace& ws = self->ws_;
+  double v = self->scorer_.CostOf(tr, ws.lon[ws.winner_lon], ws.lat[ws.winner_lat]);
+  if (!self->constraints_ok_) {
+    // Algorithms without constraint support get the limits as a steep penalty.
+    self->checker_.FillTicks(tr);
+    v += 1e3 * std::max(0.0, self->checker_.Violation(nullptr));
+  }
+  return v;
+}
+
+double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data) {
+  (void)n;
+  (void)grad;
+  auto* self = static_cast<Refiner*>(data);
+  self->checker_.FillTicks(self->FromParams(x));
+  return self->checker_.Violation(nullptr);
+}
+
+void Refiner::Refine(PlanSummary& sum) {
+  const LonTraj& lb = ws_.lon[ws_.winner_lon];
+  const LatTraj& db = ws_.lat[ws_.winner_lat];
+  // Braking is the emergency family: it is sent as sampled, at once.
+  if (lb.kind == cost::LonKind::kBraking) return;
+  double x[4] = {lb.param, lb.traj.duration, db.traj.duration, db.offset};
+  double lo[4], hi[4];
+  switch (lb.kind) {
+    case cost::LonKind::kVelocityKeeping:
+      lo[0] = 0;
+      hi[0] = ws_.ctx.lane_speed_limit[db.lane];
+      break;
+    case cost::LonKind::kFollowing:
+      lo[0] = -5;
+      hi[0] = 30;
+      break;
+    case cost::LonKind::kStopping:
+      lo[0] = 0;
+      hi[0] = std::max(1.0, ws_.start.s_d * cfg_.max_duration);
+      break;
+    case cost::LonKind::kBraking:
+      return;
+  }
+  lo[1] = cfg_.min_duration;
+  hi[1] = cfg_.max_duration;
+  lo[2] = std::min(cfg_.lat_min_duration, db.traj.duration);
+  hi[2] = std::max(cfg_.lat_max_duration, db.traj.duration);
+  lo[3] = -0.5;
+  hi[3] = 0.5;
+  for (int i = 0; i < 4; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
+  const double before = scorer_.CostOf(ws_.winner, lb, db);
+  sum.refine_cost_before = before;
+  sum.refine_cost_after = before;
+  nlopt_set_lower_bounds(opt_, lo);
+  nlopt_set_upper_bounds(opt_, hi);
+  // The first steps: a tenth of each range. Explicit, or NLopt would keep the step it derived
+  // from the first refinement ever run (state carried across cycles and episodes).
+  double step[4];
+  for (int i = 0; i < 4; ++i) step[i] = std::max(1e-3, 0.1 * (hi[i] - lo[i]));
+  nlopt_set_initial_step(opt_, step);
+  const double remaining = 0.8 * cfg_.budget_ms - clock_.Elapsed();
+  const double maxtime_ms = std::min(cfg_.refine_budget_ms, remaining);
+  // 0 switches NLopt's clock off: pinned deadlines leave refine.max_iterations as the bound.
+  nlopt_set_maxtime(opt_, std::isfinite(maxtime_ms) ? std::max(1e-3, maxtime_ms) * 1e-3 : 0.0);
+  evals_ = 0;
+  double best = 0;
+  const nlopt_result r = nlopt_optimize(opt_, x, &best);
+  sum.refine_iterations = evals_;
+  if (r < 0 || !Finite(best) || best >= before) return;
+  // Safety re-check of the refined trajectory; keep the unrefined winner if it fails.
+  const traj::FrenetTrajectory refined = FromParams(x);
+  checker_.FillTicks(refined);
+  if (checker_.Violation(nullptr) > 0 || checker_.Collides()) return;
+  ws_.winner = refined;
+  sum.refine_cost_after = scorer_.CostOf(refined, lb, db);
+}
+
+}  // namespace frenetic::plan::search

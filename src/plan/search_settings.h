@@ -1,0 +1,61 @@
+// The search planner's settings, read once from PlannerConfig (SI units: the configured mph
+// speed limit is converted here), and the fixed constants its stages share. Private to
+// src/plan/: the stages of the search planner (search_*.h) live in frenetic::plan::search.
+#pragma once
+
+#include <cmath>
+
+#include "frenetic/plan/planner_config.h"
+
+namespace frenetic::plan::search {
+
+inline constexpr int kHistory = 110;  // driven points kept for the jerk windows (> 2 s of blocks)
+inline constexpr int kMaxCars = 64;   // cars in a cycle's context (the broad-phase masks' width)
+// m: a car behind within this lateral offset is following the ego (the simulator's traffic sees
+// a leader within 2 m and brakes for it).
+inline constexpr double kFollowerLateral = 1.0;
+// The simulator times a car whose d is within 0.8 m of a lane line and flags it after 150 ticks
+// (udacity-sim.md §7.4). Lane centres keep a little more room; the hard check allows a little
+// less time.
+inline constexpr double kStraddle = 0.8;       // m
+inline constexpr double kLaneLineBand = 0.9;   // m
+inline constexpr int kMaxStraddleTicks = 135;  // ticks
+
+inline bool Finite(double v) { return std::isfinite(v); }
+
+// Every key the search planner reads, by its config name (see config/planner.yaml). A pinned
+// deadline (PlannerConfig::PinDeadlines) reads as an infinite budget_ms / refine_budget_ms.
+struct Settings {
+  double max_speed, max_accel, max_jerk, d_min, d_max;  // m/s, m/s^2, m/s^3, m, m
+  double lane_width, outer_inset;
+  int num_lanes;  // clamped to [1, cost::kMaxLanes]
+  int keep_points, output_points;
+  double resync_tolerance;
+  int replan_min_ticks;
+  double replan_deviation;
+  int speeds, durations;
+  double min_duration, max_duration;
+  int follow_gaps;
+  double follow_d0, follow_tau, follow_tau_step;
+  bool stop;
+  int brake_decels, brake_targets;
+  double brake_min_decel, brake_max_decel;
+  int lat_durations;
+  double lat_min_duration, lat_max_duration;
+  int lat_offsets;
+  double lat_offset_step;
+  int lat_delays;
+  double lat_delay_step;
+  double score_dt, score_horizon;
+  double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
+  double headway_min, behind_time;
+  bool refine;
+  int refine_iterations;
+  double refine_budget_ms;
+  double fallback_decel, fallback_jerk, fallback_lat_duration;
+  double budget_ms;
+
+  explicit Settings(const PlannerConfig& c);
+};
+
+}  // namespace frenetic::plan::search

@@ -1,0 +1,50 @@
+#include "plan/search_workspace.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "frenetic/plan/planner.h"
+
+namespace frenetic::plan::search {
+
+Workspace::Workspace(const Settings& cfg) {
+  for (int l = 0; l < cfg.num_lanes; ++l) {
+    lane_nominal[l] = lane_center[l] = (l + 0.5) * cfg.lane_width;
+  }
+  if (cfg.num_lanes > 1) {
+    lane_nominal[cfg.num_lanes - 1] -= cfg.outer_inset;
+    lane_center[cfg.num_lanes - 1] -= cfg.outer_inset;
+  }
+
+  n_samples = static_cast<int>(std::floor(cfg.score_horizon / cfg.score_dt + 1e-9)) + 1;
+  n_ticks = static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds));
+  n_ticks = std::max(n_ticks, cfg.output_points);
+  // The lattice's largest bundles (Lattice::Generate), with a little slack.
+  const int max_lon = cfg.speeds * cfg.durations + cfg.durations +
+                      2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
+                      cfg.brake_decels * cfg.brake_targets + 8;
+  const int max_lat =
+      cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + 8;
+  lon.reserve(max_lon);
+  lat.reserve(max_lat);
+  for (auto* v : {&lon_s, &lon_sd, &lon_sdd}) v->assign(max_lon * n_samples, 0.0);
+  for (auto* v : {&lat_d, &lat_dd, &lat_ddd}) v->assign(max_lat * n_samples, 0.0);
+  cand_lon.reserve(max_lon * max_lat);
+  cand_lat.reserve(max_lon * max_lat);
+  cand_cost.reserve(max_lon * max_lat);
+  order.reserve(max_lon * max_lat);
+  for (auto* v : {&car_s, &car_d, &car_v}) v->assign(kMaxCars * n_samples, 0.0);
+  car_index.assign(kMaxCars, 0);
+  car_s0.assign(kMaxCars, 0.0);
+  car_d0.assign(kMaxCars, 0.0);
+  collision_step = std::max(1, static_cast<int>(std::lround(cfg.collision_dt / kTickSeconds)));
+  n_steps = n_ticks / collision_step;
+  for (auto* v : {&step_s, &step_d, &step_v, &step_vd}) v->assign(kMaxCars * (n_steps + 1), 0.0);
+  lat_near.assign(2 * max_lat * n_samples, 0);
+  lon_near.assign(2 * max_lon * n_samples, 0);
+  prev_s.assign(n_samples, 0.0);
+  prev_d.assign(n_samples, 0.0);
+  for (auto* v : {&tk_s, &tk_sd, &tk_sdd, &tk_d, &tk_dd, &tk_ddd}) v->assign(n_ticks + 1, 0.0);
+}
+
+}  // namespace frenetic::plan::search

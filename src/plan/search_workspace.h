@@ -1,0 +1,111 @@
+// The buffers and state the search planner's stages share, in one plain struct: sized once at
+// construction (struct of arrays, capacities from the settings), then only overwritten, so a
+// cycle does not allocate after warm-up. Each stage takes it by reference; the comments say
+// which stage writes what.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "frenetic/cost/cost_term.h"
+#include "frenetic/traj/frenet.h"
+#include "plan/search_lattice.h"
+#include "plan/search_planner.h"
+#include "plan/search_settings.h"
+
+namespace frenetic::plan::search {
+
+// Milliseconds since the start of the cycle, on the planner's clock: what the stages compare
+// with their share of budget_ms.
+class CycleClock {
+ public:
+  explicit CycleClock(PlannerClock now_ms) : now_ms_(std::move(now_ms)) {}
+  void Start() { t0_ = now_ms_(); }
+  double Elapsed() const { return now_ms_() - t0_; }
+
+ private:
+  PlannerClock now_ms_;
+  double t0_ = 0;  // ms, now_ms_ at the start of the cycle
+};
+
+struct Workspace {
+  explicit Workspace(const Settings& cfg);
+
+  // The candidate c's trajectory (an index into cand_lon / cand_lat).
+  traj::FrenetTrajectory Candidate(int c) const {
+    return {lon[cand_lon[c]].traj, lat[cand_lat[c]].traj};
+  }
+  // Makes candidate c the cycle's winner.
+  void TakeWinner(int c) {
+    winner_index = c;
+    winner = Candidate(c);
+    winner_lon = cand_lon[c];
+    winner_lat = cand_lat[c];
+    winner_cost = cand_cost[c];
+  }
+
+  // Sizes, fixed at construction.
+  int n_samples = 0;       // scoring samples, score.dt apart over score.horizon
+  int n_ticks = 0;         // check ticks (kTickSeconds) over check.horizon, >= output_points
+  int collision_step = 5;  // ticks between collision-check steps
+  int n_steps = 0;         // collision-check steps over the check horizon
+
+  // Start of the cycle (Plan): the start state, the number of kept points, their duration (s).
+  traj::FrenetState start;
+  int kept = 0;
+  double t_keep = 0;
+  // Ticks the simulator may have read the ego astride a lane line, up to the start state (kept
+  // points included): where the hard check's lane-line timer starts.
+  int straddle_at_start = 0;
+
+  // Context (BuildContext): the lanes and the traffic the costs read.
+  double lane_nominal[cost::kMaxLanes] = {};  // configured lane centres, m
+  double lane_center[cost::kMaxLanes] = {};   // this cycle's (moved off the lane lines), m
+  cost::CostContext ctx;
+  // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples
+  // ([c * n_samples + k]), where it is at the start instant, its predictor index, and its
+  // predicted s, d, speed and lateral speed at the collision-check steps ([c * (n_steps + 1) +
+  // j], t_keep + j * collision_step ticks).
+  std::vector<double> car_s, car_d, car_v, car_s0, car_d0;
+  std::vector<int> car_index;
+  std::vector<double> step_s, step_d, step_v, step_vd;
+  std::vector<double> prev_s, prev_d;  // the previous winner at the scoring samples
+
+  // Bundles (Lattice): the 1-D trajectories, sampled at the scoring samples ([i * n_samples +
+  // k]), with their broad-phase masks (cost::CostInput::near_lat, near_lon; 2 * n_samples words
+  // each), and the candidates: every compatible lon x lat pair.
+  std::vector<LonTraj> lon;
+  std::vector<LatTraj> lat;
+  std::vector<double> lon_s, lon_sd, lon_sdd, lat_d, lat_dd, lat_ddd;
+  std::vector<std::uint64_t> lat_near, lon_near;
+  std::vector<int> cand_lon, cand_lat;
+
+  // Scores (Scorer): the weighted cost per candidate and the candidates by rank; order[0,
+  // sorted) is in cost order (Scorer::SortUpTo).
+  std::vector<double> cand_cost;
+  std::vector<int> order;
+  int sorted = 0;
+
+  // One trajectory sampled at every tick of the check horizon, [1, n_ticks] (Checker::FillTicks,
+  // the fallback); what the hard checks read and what Output stores.
+  std::vector<double> tk_s, tk_sd, tk_sdd, tk_d, tk_dd, tk_ddd;
+
+  // The cycle's winner (TakeWinner; Refiner may replace the trajectory).
+  int winner_index = -1, winner_lon = -1, winner_lat = -1;
+  double winner_cost = 0;
+  traj::FrenetTrajectory winner;
+
+  // The last decision, kept across cycles: the previous winner (consistency cost, the lateral
+  // move under way, the fallback ContinuePrevious) and the lane-change timer.
+  bool have_prev_traj = false;
+  traj::FrenetTrajectory prev_traj;
+  double prev_elapsed = 0;  // s: the current start's time on prev_traj
+  double prev_base = 0;     // s: the stored plan start's time on prev_traj (see ContinuePrevious)
+  int prev_target_lane = -1, lane_before_change = -1;
+  int prev_lat_lane = -1;  // lane and end offset (m) of the previous winner's lateral move
+  double prev_lat_offset = 0;
+  double time_since_change = 1e9;
+};
+
+}  // namespace frenetic::plan::search

@@ -1,0 +1,140 @@
+// The search planner's hard checks: each limit rejects with its own reason, the lane-line timer,
+// and the collision test's boxes, headway and room behind.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "plan/search_stages_testing.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+using testing::Stages;
+
+constexpr double kS = 800;
+
+TEST(SearchChecksTest, SteadyDrivingIsFeasible) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  st.WriteTicks(kS, 20, 6.0, [](double) { return 0.0; });
+  Reject why = Reject::kSpeed;
+  EXPECT_LE(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kCount);
+}
+
+TEST(SearchChecksTest, EachLimitRejectsWithItsReason) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  Reject why = Reject::kCount;
+  // 25 m/s is over 49.5 mph.
+  st.WriteTicks(kS, 25, 6.0, [](double) { return 0.0; });
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kSpeed);
+  // Braking that ramps to 11 m/s^2 over 1.5 s and back (jerk ~7 m/s^3): too hard.
+  auto ramp = [](double peak) {
+    return [peak](double t) {
+      const double k = peak / 1.5;
+      return t < 1.5 ? -k * t : t < 3.0 ? -peak + k * (t - 1.5) : 0.0;
+    };
+  };
+  st.WriteTicks(kS, 22, 6.0, ramp(11));
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kAcceleration);
+  st.WriteTicks(kS, 22, 6.0, ramp(7));
+  EXPECT_LE(st.checker.Violation(&why), 0) << "7 m/s^2 is within the limit";
+  // Off the road on the right.
+  st.WriteTicks(kS, 20, 11.8, [](double) { return 0.0; });
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kOffRoad);
+  // Backwards.
+  st.WriteTicks(kS, -1, 6.0, [](double) { return 0.0; });
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kSpeed);
+  // A NaN is a violation, never a pass.
+  st.WriteTicks(kS, 20, 6.0, [](double) { return 0.0; });
+  st.ws.tk_d[100] = NAN;
+  EXPECT_GT(st.checker.Violation(&why), 0);
+}
+
+TEST(SearchChecksTest, JerkRejectsWithItsReason) {
+  REQUIRE_UDACITY_MAP();
+  // The simulator's acceleration is a magnitude, so with equal limits a jerk excess comes with
+  // an acceleration one: a lower jerk limit isolates it.
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Set("limits.max_jerk", 4).ok());
+  Stages st(config);
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  // After a second of cruising (the jerk windows need the history), 6 m/s^2 of braking.
+  st.WriteTicks(kS, 20, 6.0, [](double t) { return t < 1 ? 0.0 : t < 2.5 ? -6.0 : 0.0; });
+  Reject why = Reject::kCount;
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kJerk);
+  st.WriteTicks(kS, 20, 6.0, [](double t) { return t < 1 ? 0.0 : t < 2.5 ? -3.0 : 0.0; });
+  EXPECT_LE(st.checker.Violation(&why), 0);
+}
+
+TEST(SearchChecksTest, LaneLineTimerCountsFromTheStartAndCanBeLeftOut) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 4.0, 0, 0});
+  // Astride the lane line to the end of the horizon: it would stay there.
+  st.WriteTicks(kS, 20, 4.0, [](double) { return 0.0; });
+  Reject why = Reject::kCount;
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kLaneLine);
+  EXPECT_LE(st.checker.Violation(&why, /*lane_line=*/false), 0);
+  // Astride for a second, then a smooth move into the lane (2.5 s): fine from a fresh timer,
+  // not with 2.5 s already counted.
+  for (int i = 1; i <= st.ws.n_ticks; ++i) {
+    const double u = std::clamp((i * kTickSeconds - 1.0) / 2.5, 0.0, 1.0);
+    st.ws.tk_d[i] = 4.0 + 2.0 * u * u * u * (10 - 15 * u + 6 * u * u);
+  }
+  st.ws.straddle_at_start = 0;
+  EXPECT_LE(st.checker.Violation(&why), 0);
+  st.ws.straddle_at_start = 125;
+  EXPECT_GT(st.checker.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kLaneLine);
+  // The helpers agree: the line at 4 m is within kStraddle of 4.5, not of 5.
+  EXPECT_TRUE(StraddlesRead(st.cfg, 4.5, 4.5));
+  EXPECT_FALSE(StraddlesRead(st.cfg, 5.0, 5.0));
+}
+
+TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  auto steady = [](double s0, double v, double d) {
+    return [=](int tick) { return traj::FrenetState{s0 + v * tick * kTickSeconds, v, 0, d, 0, 0}; };
+  };
+  const int none = st.ws.n_steps + 1;
+  // Same lane, 13 m ahead at the ego's speed: bare boxes clear (13 > 4.8), but not the
+  // headway (0.5 s at 20 m/s).
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 13, 6.0, 20}});
+  int car = -1;
+  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 1.0, 1.0, &car), 1);
+  EXPECT_EQ(car, 0);
+  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), none);
+  // A slower car 40 m ahead is reached later: the first hit is a later step.
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 40, 6.0, 10}});
+  const int hit = st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0);
+  EXPECT_GT(hit, 10);
+  EXPECT_LT(hit, none);
+  // Collides() reads the ticks.
+  st.WriteTicks(kS, 20, 6.0, [](double) { return 0.0; });
+  EXPECT_TRUE(st.checker.Collides());
+  st.WriteTicks(kS, 8, 6.0, [](double) { return 0.0; });
+  EXPECT_FALSE(st.checker.Collides());
+  // Cutting into a lane 10 m in front of a car there: bare boxes clear, but the room behind
+  // (kept even at margin scale 0) is not.
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - 10, 2.0, 20}});
+  EXPECT_LT(st.checker.FirstCollision(steady(kS, 20, 2.0), 0.0, 1.0), none);
+  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 0.0, 0.0), none);
+  // The same car in the ego's own lane at the start is its follower's business.
+  st.Prepare({kS, 20, 0, 2.0, 0, 0}, {{kS - 10, 2.0, 20}});
+  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 1.0, 1.0), none);
+}
+
+}  // namespace
+}  // namespace frenetic::plan::search

@@ -1,0 +1,163 @@
+// The search planner's lattice: bundle counts and families for a given start state and the
+// shipped grid, its boundary conditions, and the following law.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "plan/search_stages_testing.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+using testing::SceneCar;
+using testing::Stages;
+
+// A straight-ish stretch of the Udacity loop; the middle lane, 20 m/s.
+constexpr double kS = 800;
+
+// Centred in the middle lane as this cycle's context moves it (the lane centres depend on s and
+// speed only, so a second context build keeps them).
+void PrepareCentred(Stages& st, double speed, double d_d = 0,
+                    const std::vector<SceneCar>& cars = {}) {
+  st.Prepare({kS, speed, 0, 6.0, d_d, 0}, cars);
+  st.Prepare({kS, speed, 0, st.ws.lane_center[1], d_d, 0}, cars);
+}
+
+int Count(const Workspace& ws, cost::LonKind kind) {
+  int n = 0;
+  for (const LonTraj& l : ws.lon) n += l.kind == kind;
+  return n;
+}
+
+TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  PrepareCentred(st, 20);
+  st.lattice.Generate();
+  const Workspace& ws = st.ws;
+  const Settings& c = st.cfg;
+  // Per duration every end speed and a stop; braking once: levels x targets.
+  EXPECT_EQ(Count(ws, cost::LonKind::kVelocityKeeping), c.speeds * c.durations);
+  EXPECT_EQ(Count(ws, cost::LonKind::kStopping), c.durations);
+  EXPECT_EQ(Count(ws, cost::LonKind::kBraking), c.brake_decels * c.brake_targets);
+  EXPECT_EQ(Count(ws, cost::LonKind::kFollowing), 0);
+  ASSERT_EQ(ws.lon.size(), 87u) << "the shipped grid: 12 x 6 + 6 + 3 x 3";
+  // Own lane centred and at rest: one move; each neighbour: every duration plus the delays.
+  int per_lane[3] = {};
+  for (const LatTraj& l : ws.lat) ++per_lane[l.lane];
+  EXPECT_EQ(per_lane[1], 1);
+  EXPECT_EQ(per_lane[0], c.lat_durations * c.lat_offsets + c.lat_delays);
+  EXPECT_EQ(per_lane[2], c.lat_durations * c.lat_offsets + c.lat_delays);
+  int delayed = 0;
+  for (const LatTraj& l : ws.lat) delayed += l.traj.delay > 0;
+  EXPECT_EQ(delayed, 2 * c.lat_delays);
+  // No lane-bound longitudinal trajectory: every pair is a candidate, lon-major.
+  ASSERT_EQ(ws.cand_lon.size(), ws.lon.size() * ws.lat.size());
+  EXPECT_EQ(ws.cand_lon[1], 0);
+  EXPECT_EQ(ws.cand_lat[1], 1);
+  // Samples start at the start state; the lateral moves end at their lane's centre.
+  for (size_t i = 0; i < ws.lon.size(); ++i) {
+    EXPECT_DOUBLE_EQ(ws.lon_s[i * ws.n_samples], kS);
+    EXPECT_DOUBLE_EQ(ws.lon_sd[i * ws.n_samples], 20);
+    EXPECT_GT(ws.lon[i].jerk2, -1e-12);
+  }
+  for (const LatTraj& l : ws.lat) {
+    EXPECT_NEAR(l.traj.At(l.traj.end_time()).p, ws.lane_center[l.lane] + l.offset, 1e-9);
+  }
+}
+
+TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabled) {
+  REQUIRE_UDACITY_MAP();
+  Stages slow;
+  PrepareCentred(slow, 0.5);
+  slow.lattice.Generate();
+  EXPECT_EQ(Count(slow.ws, cost::LonKind::kBraking), 0);
+  EXPECT_EQ(slow.ws.lon.size(), 78u);
+
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Set("grid.stop", 0).ok());
+  Stages no_stop(config);
+  PrepareCentred(no_stop, 20);
+  no_stop.lattice.Generate();
+  EXPECT_EQ(Count(no_stop.ws, cost::LonKind::kStopping), 0);
+  EXPECT_EQ(no_stop.ws.lon.size(), 81u);
+}
+
+TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  PrepareCentred(st, 20, /*d_d=*/1.0);
+  st.lattice.Generate();
+  EXPECT_EQ(st.ws.lat.size(), 3u * st.cfg.lat_durations * st.cfg.lat_offsets);
+  for (const LatTraj& l : st.ws.lat) {
+    EXPECT_EQ(l.traj.delay, 0);
+    EXPECT_DOUBLE_EQ(l.traj.poly.V(0), 1.0) << "a move starts from the current d'";
+  }
+}
+
+TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  const double v_lead = 15;
+  PrepareCentred(st, 20, 0, {{kS + 40, 6.0, v_lead}});
+  st.lattice.Generate();
+  const Workspace& ws = st.ws;
+  const Settings& c = st.cfg;
+  ASSERT_EQ(Count(ws, cost::LonKind::kFollowing), c.durations * c.follow_gaps);
+  const double follow_d0 = st.config.value("grid.follow_d0");
+  const double follow_tau = st.config.value("grid.follow_tau");
+  int following_pairs = 0;
+  for (size_t i = 0; i < ws.cand_lon.size(); ++i) {
+    const LonTraj& l = ws.lon[ws.cand_lon[i]];
+    if (l.kind != cost::LonKind::kFollowing) continue;
+    ++following_pairs;
+    EXPECT_EQ(ws.lat[ws.cand_lat[i]].lane, 1) << "following is bound to the leader's lane";
+  }
+  // Only the own lane's single move pairs with them.
+  EXPECT_EQ(following_pairs, c.durations * c.follow_gaps);
+  EXPECT_EQ(ws.cand_lon.size(), 87u * ws.lat.size() + following_pairs);
+  for (const LonTraj& l : ws.lon) {
+    if (l.kind != cost::LonKind::kFollowing) continue;
+    EXPECT_EQ(l.lane, 1);
+    EXPECT_EQ(l.lead, 0);
+    const double T = l.traj.duration;
+    // The leader at constant speed; the gap D0 + tau v, plus the longer gap's extra distance.
+    const double target = kS + 40 + v_lead * T - (follow_d0 + follow_tau * v_lead) - l.param;
+    EXPECT_NEAR(l.traj.At(T).p, target, 0.05) << "T " << T;
+    EXPECT_NEAR(l.traj.At(T).v, v_lead, 1e-3);
+    EXPECT_GE(l.param, 0);
+  }
+}
+
+TEST(SearchLatticeTest, YieldsToACarAlongsideInTheNeighbourLane) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  PrepareCentred(st, 20, 0, {{kS - 5, 2.0, 20}});
+  st.lattice.Generate();
+  int yield = 0;
+  for (const LonTraj& l : st.ws.lon) {
+    if (l.kind == cost::LonKind::kFollowing) {
+      EXPECT_EQ(l.lane, 0);
+      ++yield;
+    }
+  }
+  EXPECT_EQ(yield, st.cfg.durations * st.cfg.follow_gaps);
+}
+
+TEST(SearchLatticeTest, MakeLonHitsEachFamilysEndCondition) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  PrepareCentred(st, 20);
+  const LonTraj vk = st.lattice.MakeLon(cost::LonKind::kVelocityKeeping, -1, 12.0, 4.0);
+  EXPECT_NEAR(vk.traj.At(4.0).v, 12.0, 1e-9);
+  EXPECT_NEAR(vk.traj.At(4.0).a, 0.0, 1e-9);
+  const LonTraj stop = st.lattice.MakeLon(cost::LonKind::kStopping, -1, 30.0, 4.0);
+  EXPECT_NEAR(stop.traj.At(4.0).p, kS + 30.0, 1e-9);
+  EXPECT_NEAR(stop.traj.At(4.0).v, 0.0, 1e-9);
+  const LonTraj brake = st.lattice.MakeLon(cost::LonKind::kBraking, -1, 5.0, 2.0);
+  EXPECT_DOUBLE_EQ(brake.traj.At(1.0).a, -5.0);
+  EXPECT_NEAR(brake.traj.At(2.0).v, 10.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace frenetic::plan::search

@@ -1,0 +1,101 @@
+// The search planner's least-harm choice: collision-free before colliding, more clearance
+// before less, the latest contact when all collide, the cost order last, and never infeasible.
+#include <gtest/gtest.h>
+
+#include "plan/search_stages_testing.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+using testing::SceneCar;
+using testing::Stages;
+
+constexpr double kS = 800;
+
+// Candidates by hand: velocity keeping to (end speed, T) in the middle lane, at the given costs.
+struct Option {
+  double end_speed, T, cost;
+};
+void SetCandidates(Stages& st, const std::vector<Option>& options) {
+  Workspace& ws = st.ws;
+  ws.lon.clear();
+  ws.lat.clear();
+  ws.cand_lon.clear();
+  ws.cand_lat.clear();
+  ws.cand_cost.clear();
+  ws.order.clear();
+  ws.lat.push_back(st.lattice.MakeLat(1, 0.0, 3.0));
+  for (const Option& o : options) {
+    ws.cand_lon.push_back(static_cast<int>(ws.lon.size()));
+    ws.lon.push_back(st.lattice.MakeLon(cost::LonKind::kVelocityKeeping, -1, o.end_speed, o.T));
+    ws.cand_lat.push_back(0);
+    ws.order.push_back(static_cast<int>(ws.cand_cost.size()));
+    ws.cand_cost.push_back(o.cost);
+  }
+}
+
+void Start(Stages& st, const std::vector<SceneCar>& cars) {
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, cars);
+  st.Prepare({kS, 20, 0, st.ws.lane_center[1], 0, 0}, cars);
+}
+
+TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  // Alongside in the next lane at the same speed: 4 m apart laterally, 2.4 m wide.
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS, 2.0, 20}});
+  traj::FrenetTrajectory tr;
+  tr.lon.poly.c[0] = kS;
+  tr.lon.poly.c[1] = 20;
+  tr.lon.duration = 5;
+  tr.lat.poly.c[0] = 6.0;
+  tr.lat.duration = 5;
+  EXPECT_NEAR(Clearance(st.cfg, st.ws, tr), 4.0 - st.cfg.car_width, 1e-6);
+  // 30 m ahead in the same lane: the longitudinal gap minus a car length.
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 30, 6.0, 20}});
+  EXPECT_NEAR(Clearance(st.cfg, st.ws, tr), 30.0 - st.cfg.car_length, 1e-6);
+}
+
+TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  // A slower car 30 m ahead: keeping 20 m/s hits it; slowing to 10 m/s in 4 s leaves ~5 m of
+  // clearance, in 3 s ~10 m.
+  Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
+  SetCandidates(st, {{20, 3.0, 1.0}, {10, 4.0, 2.0}, {10, 3.0, 3.0}});
+  bool over_budget = false;
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_FALSE(over_budget);
+  EXPECT_EQ(st.ws.winner_index, 2);
+  EXPECT_EQ(st.ws.order[0], 2);
+  EXPECT_EQ(st.ws.order[1], 1);
+  EXPECT_EQ(st.ws.order[2], 0) << "the collision last";
+  EXPECT_EQ(st.ws.sorted, 3);
+}
+
+TEST(SearchLeastHarmTest, TakesTheLatestContactWhenAllCollideAndCostBreaksTies) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  // A stopped car 40 m ahead: every option reaches it, braking later.
+  Start(st, {{kS + 40, st.ws.lane_center[1], 0}});
+  SetCandidates(st, {{20, 3.0, 1.0}, {10, 3.0, 5.0}, {10, 3.0, 4.0}});
+  bool over_budget = false;
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 2) << "identical trajectories: the cheaper one";
+  EXPECT_EQ(st.ws.order[1], 1);
+  EXPECT_EQ(st.ws.order[2], 0);
+}
+
+TEST(SearchLeastHarmTest, NeverTakesAnInfeasibleCandidate) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Start(st, {});
+  // Accelerating to 30 m/s breaks the speed limit.
+  SetCandidates(st, {{30, 3.0, 1.0}});
+  bool over_budget = false;
+  EXPECT_FALSE(st.least_harm.Choose(&over_budget));
+  EXPECT_FALSE(over_budget);
+}
+
+}  // namespace
+}  // namespace frenetic::plan::search

@@ -1,0 +1,119 @@
+// The search planner's scoring: every candidate costed exactly as the cost set costs its input,
+// the deadline's checkpoint, the broad-phase masks, and the lazy sort into cost order.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "plan/search_stages_testing.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+using testing::Stages;
+
+constexpr double kS = 800;
+
+void Scene(Stages& st) {
+  st.Prepare({kS, 18, 0, 6.0, 0, 0},
+             {{kS + 30, 6.0, 14}, {kS - 10, 2.0, 20}, {kS + 60, 10.0, 16}, {kS + 15, 2.0, 18}});
+  st.lattice.Generate();
+}
+
+TEST(SearchScoringTest, ScoresEveryCandidateWithTheCostSet) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  ASSERT_TRUE(st.scorer.Score());
+  const Workspace& ws = st.ws;
+  const int n = static_cast<int>(ws.cand_lon.size());
+  ASSERT_GT(n, 100);
+  ASSERT_EQ(static_cast<int>(ws.order.size()), n);
+  for (int c = 0; c < n; ++c) {
+    EXPECT_EQ(ws.order[c], c) << "unsorted until asked";
+    const double v = st.costs->Evaluate(ws.ctx, st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]));
+    EXPECT_EQ(ws.cand_cost[c], v);
+    // A trajectory sampled on the fly costs what its bundle pair costs.
+    EXPECT_DOUBLE_EQ(
+        st.scorer.CostOf(ws.Candidate(c), ws.lon[ws.cand_lon[c]], ws.lat[ws.cand_lat[c]]), v)
+        << c;
+  }
+}
+
+TEST(SearchScoringTest, SortsLazilyIntoCostOrderTiesByIndex) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  ASSERT_TRUE(st.scorer.Score());
+  Workspace& ws = st.ws;
+  const int n = static_cast<int>(ws.order.size());
+  // Two equal costs: the lower index ranks first.
+  ws.cand_cost[5] = ws.cand_cost[9] = -1.0;
+  st.scorer.SortUpTo(0);
+  EXPECT_GE(ws.sorted, 1);
+  EXPECT_LT(ws.sorted, n) << "only a prefix is sorted";
+  EXPECT_EQ(ws.order[0], 5);
+  EXPECT_EQ(ws.order[1], 9);
+  st.scorer.SortUpTo(n - 1);
+  EXPECT_EQ(ws.sorted, n);
+  for (int r = 1; r < n; ++r) EXPECT_TRUE(Cheaper(ws, ws.order[r - 1], ws.order[r])) << r;
+}
+
+TEST(SearchScoringTest, DeadlineStopsScoringAtACheckpoint) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Set("budget_ms", 10).ok());
+  Stages st(config);
+  Scene(st);
+  const int n = static_cast<int>(st.ws.cand_lon.size());
+  ASSERT_GT(n, 200);
+  // The clock reads 0 at the start and at the first checkpoint (candidate 63), then 6 ms: more
+  // than half the budget at the second checkpoint (candidate 127).
+  int readings = 0;
+  CycleClock ticking([&readings] { return readings++ < 2 ? 0.0 : 6.0; });
+  Scorer scorer(st.cfg, *st.costs, st.ws, ticking);
+  ticking.Start();
+  EXPECT_FALSE(scorer.Score());
+  EXPECT_EQ(st.ws.order.size(), 127u) << "candidates 0..126, in generation order";
+  for (int c = 0; c < 127; ++c) EXPECT_EQ(st.ws.order[c], c);
+}
+
+TEST(SearchScoringTest, BroadPhaseMasksMarkTheCarsWithinEachReach) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  const Workspace& ws = st.ws;
+  const int n = ws.n_samples;
+  ASSERT_EQ(ws.ctx.num_cars, 4);
+  for (int i = 0; i < static_cast<int>(ws.lon.size()); i += 7) {
+    const double* s = ws.lon_s.data() + i * n;
+    const std::uint64_t* near = ws.lon_near.data() + 2 * i * n;
+    for (int k = 0; k < n; ++k) {
+      for (int c = 0; c < ws.ctx.num_cars; ++c) {
+        const double gap = std::abs(ws.car_s[c * n + k] - s[k]);
+        EXPECT_EQ((near[k] >> c) & 1, gap < cost::kNearLongitudinal[0] ? 1u : 0u);
+        EXPECT_EQ((near[n + k] >> c) & 1, gap < cost::kNearLongitudinal[1] ? 1u : 0u);
+      }
+    }
+  }
+  for (int j = 0; j < static_cast<int>(ws.lat.size()); ++j) {
+    const double* d = ws.lat_d.data() + j * n;
+    const std::uint64_t* near = ws.lat_near.data() + 2 * j * n;
+    for (int k = 0; k < n; ++k) {
+      for (int c = 0; c < ws.ctx.num_cars; ++c) {
+        const double gap = std::abs(ws.car_d[c * n + k] - d[k]);
+        EXPECT_EQ((near[k] >> c) & 1, gap < cost::kNearLateral[0] ? 1u : 0u);
+        EXPECT_EQ((near[n + k] >> c) & 1, gap < cost::kNearLateral[1] ? 1u : 0u);
+      }
+    }
+  }
+  // The cost input of a pair points at its bundles' masks.
+  const cost::CostInput in = st.scorer.InputFor(3, 2);
+  EXPECT_EQ(in.near_lon[0], ws.lon_near.data() + 2 * 3 * n);
+  EXPECT_EQ(in.near_lon[1], ws.lon_near.data() + 2 * 3 * n + n);
+  EXPECT_EQ(in.near_lat[0], ws.lat_near.data() + 2 * 2 * n);
+  EXPECT_EQ(in.near_lat[1], ws.lat_near.data() + 2 * 2 * n + n);
+}
+
+}  // namespace
+}  // namespace frenetic::plan::search
