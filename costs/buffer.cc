@@ -19,6 +19,7 @@ class BufferCost : public CostTerm {
     min_gap_ = v[0];
     headway_ = v[1];
   }
+  bool Expensive() const override { return true; }
   double Evaluate(const CostContext& ctx, const CostInput& in) const override {
     const int n = ctx.num_samples;
     if (n == 0 || ctx.num_cars == 0) return 0.0;

@@ -184,6 +184,8 @@ class SearchPlanner : public Planner {
       const double t_check = Elapsed();
       bool check_cut = false;
       found = CheckLazily(&check_cut);
+      // The least-harm choice ranks every candidate: every cost must be exact first.
+      if (!found && !check_cut && !scorer_.ResolveAll()) check_cut = true;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut);
       if (check_cut) {
         over_budget = true;

@@ -18,6 +18,11 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   for (auto* v : {&ref_s_, &ref_sd_, &ref_sdd_, &ref_d_, &ref_dd_, &ref_ddd_}) {
     v->assign(ws_.n_samples, 0.0);
   }
+  const std::size_t cap = ws_.order.capacity();
+  bound_.reserve(cap);
+  pos_.reserve(cap);
+  pending_.reserve(cap);
+  ready_.reserve(cap);
 }
 
 cost::CostInput Scorer::InputFor(int i, int j) const {
@@ -45,29 +50,92 @@ bool Scorer::Score() {
   const int n = static_cast<int>(ws_.cand_lon.size());
   ws_.cand_cost.resize(n);
   ws_.order.resize(n);
+  bound_.resize(n);
+  pos_.resize(n);
   ws_.sorted = 0;
+  pending_.clear();
+  ready_.clear();
+  int scored = n;
   for (int c = 0; c < n; ++c) {
     if ((c & 63) == 63 && clock_.Elapsed() > kScoreShare * cfg_.budget_ms) {
-      ws_.order.resize(c);
-      return false;
+      scored = c;
+      break;
     }
-    const double v = costs_.Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
-    ws_.cand_cost[c] = Finite(v) ? v : 1e300;
+    // Resolve() makes the cost 1e300 when it is not finite: never below this bound.
+    const double b = costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
+    bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
     ws_.order[c] = c;
+    pos_[c] = c;
+    pending_.push_back(c);
   }
-  return true;
+  ws_.order.resize(scored);
+  std::make_heap(pending_.begin(), pending_.end(), ByBound{this});
+  return scored == n;
 }
 
-// The lazy check mostly looks at the first few candidates, so a full sort would be wasted;
-// each call at least doubles the sorted prefix.
+void Scorer::Resolve(int c) {
+  const double v = costs_.Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
+  ws_.cand_cost[c] = Finite(v) ? v : 1e300;
+}
+
+void Scorer::Emit(int c) {
+  const int r = ws_.sorted++;
+  const int other = ws_.order[r];
+  std::swap(ws_.order[r], ws_.order[pos_[c]]);
+  pos_[other] = pos_[c];
+  pos_[c] = r;
+}
+
+// The lazy check mostly looks at the first few candidates, so a full sort would be wasted.
+// While some costs are unknown: the best known cost is final once it ranks before the smallest
+// bound of the unknown ones (an exact cost is never below its bound, and ties break by index
+// either way); else the candidate with that bound is costed. Once every cost is known, a
+// partial sort, each call at least doubling the sorted prefix.
 void Scorer::SortUpTo(int rank) {
   const int n = static_cast<int>(ws_.order.size());
   if (rank < ws_.sorted || ws_.sorted >= n) return;
-  const int upto = std::min(n, std::max(rank + 1, 2 * ws_.sorted + 32));
   const Workspace& ws = ws_;
+  const auto cheaper = [&ws](int a, int b) { return Cheaper(ws, b, a); };  // min-heap
+  while (!pending_.empty() && ws_.sorted <= rank) {
+    const int p = pending_.front();
+    if (!ready_.empty()) {
+      const int r = ready_.front();
+      const double cr = ws_.cand_cost[r], bp = bound_[p];
+      if (cr < bp || (cr == bp && r < p)) {
+        std::pop_heap(ready_.begin(), ready_.end(), cheaper);
+        ready_.pop_back();
+        Emit(r);
+        continue;
+      }
+    }
+    std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
+    pending_.pop_back();
+    Resolve(p);
+    ready_.push_back(p);
+    std::push_heap(ready_.begin(), ready_.end(), cheaper);
+  }
+  if (!pending_.empty()) return;
+  ready_.clear();  // every cost known: the unranked ones are ws.order[sorted, n)
+  if (rank < ws_.sorted || ws_.sorted >= n) return;
+  const int upto = std::min(n, std::max(rank + 1, 2 * ws_.sorted + 32));
   std::partial_sort(ws_.order.begin() + ws_.sorted, ws_.order.begin() + upto, ws_.order.end(),
                     [&ws](int a, int b) { return Cheaper(ws, a, b); });
   ws_.sorted = upto;
+}
+
+bool Scorer::ResolveAll() {
+  for (int k = 0; !pending_.empty(); ++k) {
+    if ((k & 63) == 63 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;
+    std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
+    const int p = pending_.back();
+    pending_.pop_back();
+    Resolve(p);
+    ready_.push_back(p);
+    std::push_heap(ready_.begin(), ready_.end(),
+                   [this](int a, int b) { return Cheaper(ws_, b, a); });
+  }
+  ready_.clear();
+  return true;
 }
 
 cost::CostInput Scorer::SampleForCost(const traj::FrenetTrajectory& tr, const LonTraj& lbase,

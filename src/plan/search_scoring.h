@@ -45,12 +45,20 @@ class Scorer {
   // `costs`, `ws` and `clock` must outlive the scorer.
   Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws, const CycleClock& clock);
 
-  // Scores every candidate into ws.cand_cost (a non-finite cost counts as 1e300) and sets
-  // ws.order to the candidates, unsorted. False when the deadline (half of budget_ms) stopped
-  // it early: the candidates scored so far, in generation order, are the cycle's candidates then.
+  // Scores every candidate and sets ws.order to the candidates, unsorted. False when the
+  // deadline (half of budget_ms) stopped it early: the candidates scored so far, in generation
+  // order, are the cycle's candidates then. Lazy: only a lower bound of each cost (the cheap
+  // terms, CostSet::LowerBound) is computed here; ws.cand_cost[c] (the cost set's value, a
+  // non-finite cost counting as 1e300) is exact for the ranks SortUpTo has sorted, and for
+  // every candidate after ResolveAll.
   bool Score();
-  // Sorts ws.order lazily: ranks up to `rank` are in cost order afterwards.
+  // Sorts ws.order lazily: ranks up to `rank` are in cost order afterwards. Evaluates the
+  // expensive terms of just the candidates whose lower bound could rank them that early, in
+  // bound order (best first): the result is the one a full sort by exact cost would give.
   void SortUpTo(int rank);
+  // Makes every ws.cand_cost exact (for an order over all candidates). False when the deadline
+  // (85% of budget_ms, the checks' share) stopped it early.
+  bool ResolveAll();
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
   cost::CostInput InputFor(int i, int j) const;
@@ -66,7 +74,25 @@ class Scorer {
   const cost::CostSet& costs_;
   Workspace& ws_;
   const CycleClock& clock_;
+  // Heap order of pending_: smallest bound first, then smallest index.
+  struct ByBound {
+    const Scorer* scorer;
+    bool operator()(int a, int b) const {
+      const double ba = scorer->bound_[a], bb = scorer->bound_[b];
+      return bb < ba || (bb == ba && b < a);
+    }
+  };
+  // The exact cost of candidate c into ws.cand_cost[c].
+  void Resolve(int c);
+  // Moves candidate c to rank ws.sorted of ws.order.
+  void Emit(int c);
+
   std::vector<double> ref_s_, ref_sd_, ref_sdd_, ref_d_, ref_dd_, ref_ddd_;
+  // Lazy sort: each candidate's lower bound, its index in ws.order, the candidates whose exact
+  // cost is still unknown (a heap by bound, then index) and those known but not yet ranked (a
+  // heap by cost, then index). Sized once (capacity of ws.order).
+  std::vector<double> bound_;
+  std::vector<int> pos_, pending_, ready_;
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "plan/search_stages_testing.h"
 
@@ -29,8 +30,9 @@ TEST(SearchScoringTest, ScoresEveryCandidateWithTheCostSet) {
   const int n = static_cast<int>(ws.cand_lon.size());
   ASSERT_GT(n, 100);
   ASSERT_EQ(static_cast<int>(ws.order.size()), n);
+  for (int c = 0; c < n; ++c) EXPECT_EQ(ws.order[c], c) << "unsorted until asked";
+  ASSERT_TRUE(st.scorer.ResolveAll());
   for (int c = 0; c < n; ++c) {
-    EXPECT_EQ(ws.order[c], c) << "unsorted until asked";
     const double v = st.costs->Evaluate(ws.ctx, st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]));
     EXPECT_EQ(ws.cand_cost[c], v);
     // A trajectory sampled on the fly costs what its bundle pair costs.
@@ -45,6 +47,7 @@ TEST(SearchScoringTest, SortsLazilyIntoCostOrderTiesByIndex) {
   Stages st;
   Scene(st);
   ASSERT_TRUE(st.scorer.Score());
+  ASSERT_TRUE(st.scorer.ResolveAll());
   Workspace& ws = st.ws;
   const int n = static_cast<int>(ws.order.size());
   // Two equal costs: the lower index ranks first.
@@ -57,6 +60,32 @@ TEST(SearchScoringTest, SortsLazilyIntoCostOrderTiesByIndex) {
   st.scorer.SortUpTo(n - 1);
   EXPECT_EQ(ws.sorted, n);
   for (int r = 1; r < n; ++r) EXPECT_TRUE(Cheaper(ws, ws.order[r - 1], ws.order[r])) << r;
+}
+
+TEST(SearchScoringTest, LazyCostingRanksLikeAFullSortByExactCost) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  ASSERT_TRUE(st.scorer.Score());
+  Workspace& ws = st.ws;
+  const int n = static_cast<int>(ws.order.size());
+  std::vector<double> exact(n);
+  std::vector<int> want(n);
+  for (int c = 0; c < n; ++c) {
+    const double v = st.costs->Evaluate(ws.ctx, st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]));
+    exact[c] = std::isfinite(v) ? v : 1e300;
+    want[c] = c;
+    EXPECT_LE(st.costs->LowerBound(ws.ctx, st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c])),
+              exact[c]);
+  }
+  std::sort(want.begin(), want.end(), [&exact](int a, int b) {
+    return exact[a] < exact[b] || (exact[a] == exact[b] && a < b);
+  });
+  for (int r = 0; r < n; ++r) {
+    st.scorer.SortUpTo(r);
+    ASSERT_EQ(ws.order[r], want[r]) << "rank " << r;
+    EXPECT_EQ(ws.cand_cost[ws.order[r]], exact[ws.order[r]]) << "rank " << r;
+  }
 }
 
 TEST(SearchScoringTest, DeadlineStopsScoringAtACheckpoint) {

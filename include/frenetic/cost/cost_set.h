@@ -34,6 +34,11 @@ class CostSet {
   // Weighted sum over the terms in config order. When per_term is not null it receives the
   // unweighted value of each term (size() entries). Does not allocate.
   double Evaluate(const CostContext& ctx, const CostInput& in, double* per_term = nullptr) const;
+  // The same weighted sum with every Expensive() term taken as 0: never more than Evaluate(ctx,
+  // in) (terms and weights are >= 0, and rounded addition and multiplication are monotone), so a
+  // candidate whose bound is above another's exact total cannot rank before it. NaN when a
+  // cheap term is NaN (Evaluate is then NaN too). Does not allocate.
+  double LowerBound(const CostContext& ctx, const CostInput& in) const;
 
  private:
   CostSet() = default;

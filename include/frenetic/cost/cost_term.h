@@ -180,6 +180,10 @@ class CostTerm {
   virtual void Configure(std::span<const double> values) { (void)values; }
   // The unweighted cost: finite and >= 0 for any finite input. Must not allocate.
   virtual double Evaluate(const CostContext& ctx, const CostInput& in) const = 0;
+  // Whether Evaluate is costly (it visits the traffic at every sample). A planner may then leave
+  // the term out of a first, cheap lower bound of the total (CostSet::LowerBound) and evaluate it
+  // only for the candidates that bound cannot rule out. Changes no value.
+  virtual bool Expensive() const { return false; }
 };
 
 }  // namespace frenetic::cost
