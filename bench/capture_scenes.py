@@ -8,6 +8,13 @@ Where the window starts:
   --lane-change     first exchange (after --at) whose winner lane differs from the ego's lane
                     while the ego is already off its lane centre (a lane change in progress)
   --seam            the window around the first crossing of the loop's wrap (s falls by > L/2)
+  --most-checked    the window around the search cycle (after --at, before --until) that checked
+                    the most candidates before one passed (ties: the earliest): the cycles that
+                    make the per-exchange tail of whole drives
+  --slowest         the same around the longest planning time (plan.ms_total); needs a record
+                    made without --no-timing, so the window depends on the machine
+The worst cycle is the third of the window (with --count 5): the benchmark plans the first
+message cold and measures the others.
 
 Example (bench/scenes/README.md has the commands for every committed scene):
   frenetic drive --scenario dense --seed 3 --seconds 40 --no-timing --record /tmp/dense.jsonl
@@ -32,6 +39,9 @@ def main():
     ap.add_argument("--at", type=float, default=0.0)
     ap.add_argument("--lane-change", action="store_true")
     ap.add_argument("--seam", action="store_true")
+    ap.add_argument("--most-checked", action="store_true")
+    ap.add_argument("--slowest", action="store_true")
+    ap.add_argument("--until", type=float, default=float("inf"))
     ap.add_argument("--count", type=int, default=5)
     ap.add_argument("--command", default="", help="the drive command, stored in the header")
     a = ap.parse_args()
@@ -52,8 +62,26 @@ def main():
     if header is None:
         fail(f"{a.record}: no header line")
 
+    if a.most_checked and a.slowest:
+        fail("--most-checked and --slowest exclude each other")
     start = None
-    if a.seam:
+    if a.most_checked or a.slowest:
+        key = "candidates_checked" if a.most_checked else "ms_total"
+        best, best_i = None, None
+        for i, e in enumerate(exchanges):
+            p = e.get("plan") or {}
+            if not (a.at <= e["t"] < a.until) or not p.get("candidates_generated"):
+                continue
+            if best is None or p.get(key, 0) > best:
+                best, best_i = p.get(key, 0), i
+        if best_i is None:
+            fail(f"{a.record}: no search cycle between t = {a.at} and {a.until}")
+        if a.slowest and not best:
+            fail(f"{a.record}: no planning times (recorded with --no-timing?)")
+        print(f"worst cycle: #{exchanges[best_i]['i']} (t = {exchanges[best_i]['t']:.2f} s), "
+              f"{key} = {best}")
+        start = min(max(0, best_i - a.count // 2), len(exchanges) - a.count)
+    elif a.seam:
         for i in range(1, len(exchanges)):
             if exchanges[i]["telemetry"]["s"] < exchanges[i - 1]["telemetry"]["s"] - 1000:
                 start = max(0, i - a.count // 2)

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
@@ -92,14 +93,29 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
                             int* car_hit) const {
   const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
+  // The margin below is at most `widest` at a step (inside <= 1, step_v <= step_v_max; rounding
+  // is monotone), so a car farther along s than 8 + widest fails the reach test below anyway:
+  // skipping it first changes nothing. Only with non-negative factors (else no skipping).
+  const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
+                       cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
   for (int j = 1; j <= n_steps; ++j) {
     const traj::FrenetState st = state_at(j * ws_.collision_step);
     const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
     const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
     const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
+    const double widest =
+        bounded ? std::max({margin_scale * std::max(cfg_.margin_s,
+                                                    cfg_.headway_min * std::max(st.s_d, 0.0)),
+                            behind_scale * (cfg_.margin_behind +
+                                            cfg_.behind_time *
+                                                std::max(0.0, ws_.step_v_max - st.s_d)),
+                            margin_scale * cfg_.margin_s})
+                : std::numeric_limits<double>::infinity();
+    const double reach_s = 8 + widest;
     for (int c = 0; c < ws_.ctx.num_cars; ++c) {
       const int at = c * (n_steps + 1) + j;
       const double cs = ws_.step_s[at], cd = ws_.step_d[at];
+      if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > reach_s) continue;
       // A car behind in another lane than the start's is one the ego would cut in front of:
       // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
       // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).

@@ -116,6 +116,13 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
     ++nc;
   }
   c.num_cars = nc;
+  // Bounds the collision check's margins (Checker::FirstCollision).
+  ws.step_v_max = 0;
+  for (int i = 0; i < nc; ++i) {
+    for (int j = 1; j <= n_steps; ++j) {
+      ws.step_v_max = std::max(ws.step_v_max, ws.step_v[i * (n_steps + 1) + j]);
+    }
+  }
   c.max_car_speed = 0;
   for (int i = 0; i < nc * n_samples; ++i) c.max_car_speed = std::max(c.max_car_speed, ws.car_v[i]);
   c.near_lateral[0] = cost::kNearLateral[0];

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -70,6 +71,7 @@ struct Workspace {
   std::vector<double> car_s, car_d, car_v, car_s0, car_d0;
   std::vector<int> car_index;
   std::vector<double> step_s, step_d, step_v, step_vd;
+  double step_v_max = std::numeric_limits<double>::infinity();  // >= every step_v (inf: unknown)
   std::vector<double> prev_s, prev_d;  // the previous winner at the scoring samples
 
   // Bundles (Lattice): the 1-D trajectories, sampled at the scoring samples ([i * n_samples +
