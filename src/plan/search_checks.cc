@@ -1,5 +1,7 @@
 #include "plan/search_checks.h"
 
+#include <cstring>
+
 namespace frenetic::plan::search {
 
 Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
@@ -11,6 +13,38 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   const int path_cap = kHistory + cfg.output_points + ws_.n_ticks + 8;
   chk_x_.assign(path_cap, 0.0);
   chk_y_.assign(path_cap, 0.0);
+  const std::size_t n_lon = ws_.lon.capacity(), n_lat = ws_.lat.capacity();
+  const std::size_t w = ws_.n_steps + 1;
+  lon_key_.resize(n_lon);
+  lat_key_.resize(n_lat);
+  lon_have_.assign(n_lon, 0);
+  lat_have_.assign(n_lat, 0);
+  for (auto* v : {&lon_s_, &lon_sd_}) v->assign(n_lon * w, 0.0);
+  for (auto* v : {&lat_d_, &lat_dd_}) v->assign(n_lat * w, 0.0);
+}
+
+void Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
+                          std::vector<traj::Trajectory1d>& key, std::vector<char>& have,
+                          std::vector<double>& p, std::vector<double>& v) {
+  if (have[i] && std::memcmp(&key[i], &tr, sizeof(tr)) == 0) return;
+  const int w = ws_.n_steps + 1;
+  for (int j = 1; j <= ws_.n_steps; ++j) {
+    // The time FirstCollision's callers sample at: tick j * collision_step.
+    const traj::State1d st = tr.At((j * ws_.collision_step) * kTickSeconds);
+    p[i * w + j] = st.p;
+    v[i * w + j] = st.v;
+  }
+  std::memcpy(&key[i], &tr, sizeof(tr));
+  have[i] = 1;
+}
+
+StepStates Checker::StepsOf(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = ws_.n_steps + 1;
+  SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
+  SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
+  return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
+          lat_dd_.data() + k * w, ws_.collision_step};
 }
 
 void Checker::FillTicks(const traj::FrenetTrajectory& tr) {

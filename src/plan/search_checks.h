@@ -38,6 +38,23 @@ inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, doubl
   return StraddlesRead(cfg, d0 + r.lo, d1 + r.hi);
 }
 
+// A candidate's states at the collision-check steps, as FirstCollision asks for them (a tick
+// index j * collision_step): s, s', d and d' (the second derivatives read 0), the values
+// traj::FrenetTrajectory::At gives at that tick.
+class StepStates {
+ public:
+  StepStates(const double* s, const double* sd, const double* d, const double* dd, int step)
+      : s_(s), sd_(sd), d_(d), dd_(dd), step_(step) {}
+  traj::FrenetState operator()(int tick) const {
+    const int j = tick / step_;
+    return {s_[j], sd_[j], 0.0, d_[j], dd_[j], 0.0};
+  }
+
+ private:
+  const double *s_, *sd_, *d_, *dd_;
+  int step_;
+};
+
 class Checker {
  public:
   // `line` and `ws` must outlive the checker; the check reads the traffic and the start state
@@ -76,7 +93,16 @@ class Checker {
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
                      int* car_hit = nullptr) const;
 
+  // Candidate c's states at the collision-check steps. Each bundle trajectory is sampled once
+  // and kept while it is unchanged (checked bytewise), so the many candidates that share it
+  // do not evaluate its polynomial again. Valid until the bundles change.
+  StepStates StepsOf(int c);
+
  private:
+  // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept.
+  void SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
+                   std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
+
   // Appends the ticks to the XY prefix; returns the path length.
   int BuildXyPath();
 
@@ -85,6 +111,11 @@ class Checker {
   Workspace& ws_;
   XyChecker xy_;
   std::vector<double> chk_x_, chk_y_;  // the XY path: prefix | ticks
+  // StepsOf: per bundle slot, the trajectory sampled, whether sampled, and the samples
+  // ([slot * (n_steps + 1) + j]).
+  std::vector<traj::Trajectory1d> lon_key_, lat_key_;
+  std::vector<char> lon_have_, lat_have_;
+  std::vector<double> lon_s_, lon_sd_, lat_d_, lat_dd_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
 };
 

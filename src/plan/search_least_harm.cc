@@ -9,17 +9,7 @@
 namespace frenetic::plan::search {
 
 double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr) {
-  double worst = 1e9;
-  for (int j = 1; j <= ws.n_steps; ++j) {
-    const traj::FrenetState st = tr.At(j * ws.collision_step * kTickSeconds);
-    for (int c = 0; c < ws.ctx.num_cars; ++c) {
-      const int at = c * (ws.n_steps + 1) + j;
-      const double sep = std::max(std::abs(ws.step_s[at] - st.s) - cfg.car_length,
-                                  std::abs(ws.step_d[at] - st.d) - cfg.car_width);
-      worst = std::min(worst, sep);
-    }
-  }
-  return worst;
+  return ClearanceAt(cfg, ws, [&](int i) { return tr.At(i * kTickSeconds); });
 }
 
 LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock)
@@ -39,10 +29,9 @@ bool LeastHarm::Choose(bool* over_budget) {
       return false;
     }
     const int c = order[r];
-    const traj::FrenetTrajectory tr = ws_.Candidate(c);
-    first_hit_[c] =
-        checker_.FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0, 1.0);
-    clearance_[c] = first_hit_[c] > ws_.n_steps ? Clearance(cfg_, ws_, tr) : 0.0;
+    const StepStates steps = checker_.StepsOf(c);
+    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0);
+    clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(cfg_, ws_, steps) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:
   // std::stable_sort would allocate).

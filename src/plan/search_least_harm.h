@@ -5,6 +5,8 @@
 // the others to react, and for the next cycles to find a way out).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "frenetic/traj/frenet.h"
@@ -18,6 +20,21 @@ namespace frenetic::plan::search {
 // horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - length,
 // |dd| - width), < 0 on overlap.
 double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr);
+// The same from the states at the collision-check steps (state_at(tick), Checker::StepsOf).
+template <typename StateAt>
+double ClearanceAt(const Settings& cfg, const Workspace& ws, StateAt state_at) {
+  double worst = 1e9;
+  for (int j = 1; j <= ws.n_steps; ++j) {
+    const traj::FrenetState st = state_at(j * ws.collision_step);
+    for (int c = 0; c < ws.ctx.num_cars; ++c) {
+      const int at = c * (ws.n_steps + 1) + j;
+      const double sep = std::max(std::abs(ws.step_s[at] - st.s) - cfg.car_length,
+                                  std::abs(ws.step_d[at] - st.d) - cfg.car_width);
+      worst = std::min(worst, sep);
+    }
+  }
+  return worst;
+}
 
 class LeastHarm {
  public:

@@ -275,10 +275,8 @@ class SearchPlanner : public Planner {
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
       // conversion for the many candidates that run into traffic.
-      const FrenetTrajectory tr = ws_.Candidate(c);
       int hit_car = -1;
-      const int hit = checker_.FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0,
-                                              1.0, &hit_car);
+      const int hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
       if (hit <= ws_.n_steps) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
