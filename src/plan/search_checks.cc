@@ -1,6 +1,7 @@
 #include "plan/search_checks.h"
 
 #include <cstring>
+#include <limits>
 
 namespace frenetic::plan::search {
 
@@ -21,12 +22,18 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lat_have_.assign(n_lat, 0);
   for (auto* v : {&lon_s_, &lon_sd_}) v->assign(n_lon * w, 0.0);
   for (auto* v : {&lat_d_, &lat_dd_}) v->assign(n_lat * w, 0.0);
+  lon_near_.assign(n_lon * w, 0);
+  lat_near_.assign(n_lat * w, 0);
+  near_.assign(w, 0);
+  lon_near_key_.assign(n_lon, LonNearKey{});
+  lat_near_stamp_.assign(n_lat, 0);
 }
 
-void Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
+
+bool Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
                           std::vector<traj::Trajectory1d>& key, std::vector<char>& have,
                           std::vector<double>& p, std::vector<double>& v) {
-  if (have[i] && std::memcmp(&key[i], &tr, sizeof(tr)) == 0) return;
+  if (have[i] && std::memcmp(&key[i], &tr, sizeof(tr)) == 0) return false;
   const int w = ws_.n_steps + 1;
   for (int j = 1; j <= ws_.n_steps; ++j) {
     // The time FirstCollision's callers sample at: tick j * collision_step.
@@ -36,15 +43,46 @@ void Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
   }
   std::memcpy(&key[i], &tr, sizeof(tr));
   have[i] = 1;
+  return true;
 }
 
-StepStates Checker::StepsOf(int c) {
+StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = ws_.n_steps + 1;
-  SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
-  SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
+  const int num_cars = ws_.ctx.num_cars;
+  // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
+  const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
+  LonNearKey& lk = lon_near_key_[i];
+  if (new_lon || lk.stamp != ws_.traffic_stamp || lk.margin_scale != margin_scale ||
+      lk.behind_scale != behind_scale) {
+    for (int j = 1; j <= ws_.n_steps; ++j) {
+      const double s = lon_s_[i * w + j];
+      const double reach_s = ReachS(lon_sd_[i * w + j], margin_scale, behind_scale);
+      std::uint64_t m = 0;
+      for (int car = 0; car < num_cars; ++car) {
+        const double cs = ws_.step_s[car * w + j];
+        m |= std::abs(cs - s) > reach_s ? 0 : std::uint64_t{1} << car;
+      }
+      lon_near_[i * w + j] = m;
+    }
+    lk = {ws_.traffic_stamp, margin_scale, behind_scale};
+  }
+  const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
+  if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
+    for (int j = 1; j <= ws_.n_steps; ++j) {
+      const double d = lat_d_[k * w + j];
+      std::uint64_t m = 0;
+      for (int car = 0; car < num_cars; ++car) {
+        const double cd = ws_.step_d[car * w + j];
+        m |= std::abs(cd - d) > 5 ? 0 : std::uint64_t{1} << car;
+      }
+      lat_near_[k * w + j] = m;
+    }
+    lat_near_stamp_[k] = ws_.traffic_stamp;
+  }
+  for (int j = 1; j <= ws_.n_steps; ++j) near_[j] = lon_near_[i * w + j] & lat_near_[k * w + j];
   return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
-          lat_dd_.data() + k * w, ws_.collision_step};
+          lat_dd_.data() + k * w, ws_.collision_step, near_.data()};
 }
 
 void Checker::FillTicks(const traj::FrenetTrajectory& tr) {

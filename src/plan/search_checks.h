@@ -7,7 +7,9 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -41,17 +43,22 @@ inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, doubl
 // A candidate's states at the collision-check steps, as FirstCollision asks for them (a tick
 // index j * collision_step): s, s', d and d' (the second derivatives read 0), the values
 // traj::FrenetTrajectory::At gives at that tick.
+// Near(j): the cars (bit c) that pass FirstCollision's reach test at step j with the scales
+// StepsOf was given; the others are skipped there without changing its result.
 class StepStates {
  public:
-  StepStates(const double* s, const double* sd, const double* d, const double* dd, int step)
-      : s_(s), sd_(sd), d_(d), dd_(dd), step_(step) {}
+  StepStates(const double* s, const double* sd, const double* d, const double* dd, int step,
+             const std::uint64_t* near)
+      : s_(s), sd_(sd), d_(d), dd_(dd), near_(near), step_(step) {}
   traj::FrenetState operator()(int tick) const {
     const int j = tick / step_;
     return {s_[j], sd_[j], 0.0, d_[j], dd_[j], 0.0};
   }
+  std::uint64_t Near(int j) const { return near_[j]; }
 
  private:
   const double *s_, *sd_, *d_, *dd_;
+  const std::uint64_t* near_;
   int step_;
 };
 
@@ -93,14 +100,21 @@ class Checker {
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
                      int* car_hit = nullptr) const;
 
-  // Candidate c's states at the collision-check steps. Each bundle trajectory is sampled once
-  // and kept while it is unchanged (checked bytewise), so the many candidates that share it
-  // do not evaluate its polynomial again. Valid until the bundles change.
-  StepStates StepsOf(int c);
+  // Candidate c's states at the collision-check steps, with the cars within reach of a
+  // FirstCollision(..., margin_scale, behind_scale) at each step. Each bundle trajectory is
+  // sampled once and kept while it is unchanged (checked bytewise), and its cars within reach
+  // once per cycle's traffic (ws.traffic_stamp) and scales, so the many candidates that share
+  // it do not evaluate its polynomial or visit every car again. Valid until the next call.
+  StepStates StepsOf(int c, double margin_scale = 1.0, double behind_scale = 1.0);
+
+  // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
+  // away can collide (+inf when the margins cannot be bounded).
+  double ReachS(double s_d, double margin_scale, double behind_scale) const;
 
  private:
-  // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept.
-  void SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
+  // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept; true
+  // when sampled anew.
+  bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
                    std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
 
   // Appends the ticks to the XY prefix; returns the path length.
@@ -116,37 +130,48 @@ class Checker {
   std::vector<traj::Trajectory1d> lon_key_, lat_key_;
   std::vector<char> lon_have_, lat_have_;
   std::vector<double> lon_s_, lon_sd_, lat_d_, lat_dd_;
+  // Per bundle slot and step, the cars passing the lateral (lat) and the longitudinal (lon)
+  // reach tests, with what they were computed for; near_: the candidate's (their and).
+  struct LonNearKey {
+    std::uint64_t stamp = 0;
+    double margin_scale = 0, behind_scale = 0;
+  };
+  std::vector<std::uint64_t> lon_near_, lat_near_, near_;
+  std::vector<LonNearKey> lon_near_key_;
+  std::vector<std::uint64_t> lat_near_stamp_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
 };
+
+// The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=
+// step_v_max; rounded products and sums are monotone), so a car farther along s than
+// 8 + widest fails its reach test anyway. Only with non-negative factors.
+inline double Checker::ReachS(double s_d, double margin_scale, double behind_scale) const {
+  const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
+                       cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
+  if (!bounded) return std::numeric_limits<double>::infinity();
+  const double widest = std::max(
+      {margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * std::max(s_d, 0.0)),
+       behind_scale * (cfg_.margin_behind + cfg_.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
+       margin_scale * cfg_.margin_s});
+  return 8 + widest;
+}
 
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit) const {
   const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
-  // The margin below is at most `widest` at a step (inside <= 1, step_v <= step_v_max; rounding
-  // is monotone), so a car farther along s than 8 + widest fails the reach test below anyway:
-  // skipping it first changes nothing. Only with non-negative factors (else no skipping).
-  const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
-                       cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
   for (int j = 1; j <= n_steps; ++j) {
     const traj::FrenetState st = state_at(j * ws_.collision_step);
     const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
     const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
     const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
-    const double widest =
-        bounded ? std::max({margin_scale * std::max(cfg_.margin_s,
-                                                    cfg_.headway_min * std::max(st.s_d, 0.0)),
-                            behind_scale * (cfg_.margin_behind +
-                                            cfg_.behind_time *
-                                                std::max(0.0, ws_.step_v_max - st.s_d)),
-                            margin_scale * cfg_.margin_s})
-                : std::numeric_limits<double>::infinity();
-    const double reach_s = 8 + widest;
-    for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+    const double reach_s = ReachS(st.s_d, margin_scale, behind_scale);
+    // Whether car c collides at step j.
+    const auto hits = [&](int c) {
       const int at = c * (n_steps + 1) + j;
       const double cs = ws_.step_s[at], cd = ws_.step_d[at];
-      if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > reach_s) continue;
+      if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > reach_s) return false;
       // A car behind in another lane than the start's is one the ego would cut in front of:
       // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
       // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
@@ -164,14 +189,28 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
           cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * st.s_d)
           : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                               : margin_scale * cfg_.margin_s;
-      if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) continue;
+      if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
       // The car's heading from its predicted velocity (a lane change turns it).
       const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
       const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
       const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
-      if (traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv)) {
-        if (car_hit != nullptr) *car_hit = c;
-        return j;
+      return traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv);
+    };
+    // Cars in index order either way: the first one hit is the same.
+    if constexpr (requires { state_at.Near(j); }) {
+      for (std::uint64_t m = state_at.Near(j); m != 0; m &= m - 1) {
+        const int c = std::countr_zero(m);
+        if (hits(c)) {
+          if (car_hit != nullptr) *car_hit = c;
+          return j;
+        }
+      }
+    } else {
+      for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+        if (hits(c)) {
+          if (car_hit != nullptr) *car_hit = c;
+          return j;
+        }
       }
     }
   }

@@ -117,6 +117,7 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   }
   c.num_cars = nc;
   // Bounds the collision check's margins (Checker::FirstCollision).
+  ++ws.traffic_stamp;
   ws.step_v_max = 0;
   for (int i = 0; i < nc; ++i) {
     for (int j = 1; j <= n_steps; ++j) {
