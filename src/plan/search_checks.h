@@ -55,6 +55,9 @@ class StepStates {
     return {s_[j], sd_[j], 0.0, d_[j], dd_[j], 0.0};
   }
   std::uint64_t Near(int j) const { return near_[j]; }
+  // s and d at step j ([0, n_steps]; rows contiguous in j).
+  const double* s() const { return s_; }
+  const double* d() const { return d_; }
 
  private:
   const double *s_, *sd_, *d_, *dd_;

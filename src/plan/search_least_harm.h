@@ -36,6 +36,33 @@ double ClearanceAt(const Settings& cfg, const Workspace& ws, StateAt state_at) {
   return worst;
 }
 
+// The same from StepStates' rows, car by car over contiguous steps (the loops vectorise): the
+// minimum of the same separations, and a minimum taken with `<` ignores NaN in any order (no
+// separation is -0), so the same value.
+inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepStates& steps) {
+  constexpr int kMaxSteps = 256;
+  const int n_steps = ws.n_steps;
+  if (n_steps >= kMaxSteps) {
+    return ClearanceAt(cfg, ws, [&steps](int i) { return steps(i); });
+  }
+  double col[kMaxSteps];  // per step, the smallest separation so far
+  for (int j = 1; j <= n_steps; ++j) col[j] = 1e9;
+  const double* s = steps.s();
+  const double* d = steps.d();
+  for (int c = 0; c < ws.ctx.num_cars; ++c) {
+    const double* cs = ws.step_s.data() + c * (n_steps + 1);
+    const double* cd = ws.step_d.data() + c * (n_steps + 1);
+    for (int j = 1; j <= n_steps; ++j) {
+      const double sep =
+          std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
+      col[j] = sep < col[j] ? sep : col[j];
+    }
+  }
+  double worst = 1e9;
+  for (int j = 1; j <= n_steps; ++j) worst = std::min(worst, col[j]);
+  return worst;
+}
+
 class LeastHarm {
  public:
   // `ws`, `checker` and `clock` must outlive this; sized for ws's largest candidate set.
