@@ -270,7 +270,10 @@ class SearchPlanner : public Planner {
         *over_budget = true;
         return false;
       }
-      scorer_.SortUpTo(r);
+      if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
+        *over_budget = true;
+        return false;
+      }
       const int c = ws_.order[r];
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
@@ -296,7 +299,7 @@ class SearchPlanner : public Planner {
       for (int rr = r + 1;
            rr < n && trace_ != nullptr && static_cast<int>(trace_->candidates.size()) < trace_max_;
            ++rr) {
-        scorer_.SortUpTo(rr);
+        if (!scorer_.SortUpTo(rr)) break;
         Trace(rr, false, -1);
       }
       return true;

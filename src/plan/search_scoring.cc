@@ -91,12 +91,12 @@ void Scorer::Emit(int c) {
 // bound of the unknown ones (an exact cost is never below its bound, and ties break by index
 // either way); else the candidate with that bound is costed. Once every cost is known, a
 // partial sort, each call at least doubling the sorted prefix.
-void Scorer::SortUpTo(int rank) {
+bool Scorer::SortUpTo(int rank) {
   const int n = static_cast<int>(ws_.order.size());
-  if (rank < ws_.sorted || ws_.sorted >= n) return;
+  if (rank < ws_.sorted || ws_.sorted >= n) return true;
   const Workspace& ws = ws_;
   const auto cheaper = [&ws](int a, int b) { return Cheaper(ws, b, a); };  // min-heap
-  while (!pending_.empty() && ws_.sorted <= rank) {
+  for (int resolved = 0; !pending_.empty() && ws_.sorted <= rank;) {
     const int p = pending_.front();
     if (!ready_.empty()) {
       const int r = ready_.front();
@@ -108,19 +108,21 @@ void Scorer::SortUpTo(int rank) {
         continue;
       }
     }
+    if ((++resolved & 63) == 0 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;
     std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
     pending_.pop_back();
     Resolve(p);
     ready_.push_back(p);
     std::push_heap(ready_.begin(), ready_.end(), cheaper);
   }
-  if (!pending_.empty()) return;
+  if (!pending_.empty()) return true;
   ready_.clear();  // every cost known: the unranked ones are ws.order[sorted, n)
-  if (rank < ws_.sorted || ws_.sorted >= n) return;
+  if (rank < ws_.sorted || ws_.sorted >= n) return true;
   const int upto = std::min(n, std::max(rank + 1, 2 * ws_.sorted + 32));
   std::partial_sort(ws_.order.begin() + ws_.sorted, ws_.order.begin() + upto, ws_.order.end(),
                     [&ws](int a, int b) { return Cheaper(ws, a, b); });
   ws_.sorted = upto;
+  return true;
 }
 
 bool Scorer::ResolveAll() {

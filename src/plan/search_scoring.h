@@ -55,7 +55,9 @@ class Scorer {
   // Sorts ws.order lazily: ranks up to `rank` are in cost order afterwards. Evaluates the
   // expensive terms of just the candidates whose lower bound could rank them that early, in
   // bound order (best first): the result is the one a full sort by exact cost would give.
-  void SortUpTo(int rank);
+  // False when the deadline (85% of budget_ms, the checks' share) stopped that evaluation
+  // first: then `rank` may not be sorted yet.
+  bool SortUpTo(int rank);
   // Makes every ws.cand_cost exact (for an order over all candidates). False when the deadline
   // (85% of budget_ms, the checks' share) stopped it early.
   bool ResolveAll();
