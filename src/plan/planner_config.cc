@@ -35,6 +35,7 @@ constexpr Default kDefaults[] = {
     {"continuity.replan_min_ticks", 4, 1, 20, false},
     {"continuity.replan_deviation", 0.5, 0.05, 5, true},
     {"grid.speeds", 16, 8, 64, false},
+    {"grid.lane_limit_speeds", 1, 0, 1, false},
     {"grid.durations", 6, 4, 16, false},
     {"grid.min_duration", 1.5, 1, 6, false},
     {"grid.max_duration", 6, 1.5, 8, false},

@@ -301,7 +301,12 @@ TEST(SearchPlannerTest, SplicesSmoothlyAtSpeedOnTheWholeLoop) {
 
 TEST(SearchPlannerTest, SummaryIsFilled) {
   REQUIRE_MAP(line);
-  auto planner = Make("search", line);
+  // Every cycle a full search (no plan reuse), so the cycle looked at is one.
+  PlannerConfig config = Config();
+  ASSERT_TRUE(config.Set("continuity.replan_min_ticks", 1).ok());
+  auto made = MakePlanner("search", config, line);
+  ASSERT_TRUE(made.ok()) << made.message();
+  auto planner = std::move(made.value());
   Loop loop(line, planner.get(), 500, 6.0, 15.0, 6);
   loop.cars.push_back({0, 540, 6.0, 12.0});
   RunFor(loop, 1.0);
