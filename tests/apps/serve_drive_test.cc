@@ -10,6 +10,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "apps_test_util.h"
 
@@ -123,6 +124,67 @@ TEST(ServeDrive, NetworkDriveEqualsInProcessDrive) {
     }
   }
   EXPECT_EQ(server.Stop(), 0) << "serve did not shut down cleanly on SIGTERM";
+}
+
+std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<nlohmann::json> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+// `drive --connect --record` writes the record an in-process drive writes, without the planner's
+// internals, and `frenetic report` makes the page from it.
+TEST(ServeDrive, RemoteDriveIsRecordedAndReported) {
+  if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
+  const std::string config = DeterministicConfig();
+  ServerProcess server("--map " + UdacityMap() + " --config " + config +
+                       " --status-interval 1000");
+  ASSERT_GT(server.port(), 0) << "serve did not print its port";
+  const std::string url =
+      "ws://127.0.0.1:" + std::to_string(server.port()) + "/socket.io/?EIO=4&transport=websocket";
+  const std::string dir = ::testing::TempDir();
+  const std::string common = "drive --map " + UdacityMap() + " --config " + config +
+                             " --seconds 10 --seed 3 --latency random --no-timing --json";
+  CommandResult remote =
+      RunFrenetic(common + " --connect '" + url + "' --record " + dir + "/remote.jsonl");
+  ASSERT_EQ(remote.exit_code, 0) << remote.out;
+  CommandResult local = RunFrenetic(common + " --record " + dir + "/local.jsonl");
+  ASSERT_EQ(local.exit_code, 0) << local.out;
+
+  const std::vector<nlohmann::json> r = ReadJsonLines(dir + "/remote.jsonl");
+  const std::vector<nlohmann::json> l = ReadJsonLines(dir + "/local.jsonl");
+  ASSERT_GT(r.size(), 100u);
+  ASSERT_EQ(r.size(), l.size());
+  EXPECT_EQ(r.front()["type"], "header");
+  EXPECT_EQ(r.front()["planner"], "remote");
+  EXPECT_EQ(r.front()["connect"], url);
+  EXPECT_EQ(r.back()["type"], "footer");
+  for (std::size_t i = 1; i + 1 < r.size(); ++i) {
+    ASSERT_EQ(r[i]["type"], "exchange");
+    // The same drive: what the simulator sent and measured is equal line by line.
+    for (const char* key : {"i", "t", "telemetry", "metrics", "incidents"}) {
+      EXPECT_EQ(r[i][key], l[i][key]) << "line " << i << ", " << key;
+    }
+    // What only an in-process planner knows is absent.
+    EXPECT_EQ(r[i]["plan"], (nlohmann::json{{"status", "control"}, {"ms_total", 0.0}}));
+    EXPECT_EQ(r[i]["path"]["x"].size(), l[i]["path"]["x"].size());
+    if (HasFailure()) FAIL() << "line " << i;
+  }
+
+  CommandResult page = RunFrenetic("report " + dir + "/remote.jsonl -o " + dir +
+                                   "/remote.html --json");
+  ASSERT_EQ(page.exit_code, 0) << page.out;
+  const auto summary = nlohmann::json::parse(page.out);
+  EXPECT_EQ(summary["exchanges"], r.size() - 2);
+  EXPECT_EQ(summary["skipped_lines"], 0);
+  EXPECT_EQ(summary["footer"], true);
+  std::ifstream html(dir + "/remote.html");
+  std::stringstream text;
+  text << html.rdbuf();
+  EXPECT_EQ(text.str().rfind("<!doctype html>", 0), 0u);
+  EXPECT_NE(text.str().find(R"("planner":"remote")"), std::string::npos);
+  EXPECT_EQ(server.Stop(), 0);
 }
 
 TEST(ServeDrive, ConnectToNothingFailsWithOneLine) {
