@@ -70,10 +70,11 @@ class Checker {
   // safety margins are scaled by margin_scale (0: bare boxes), except the room kept for a car
   // behind in another lane, scaled by behind_scale: that car does not see the ego until it is
   // in front of it (the simulator's traffic only brakes for a car within 2 m laterally), so
-  // moving into its way is never safe.
+  // moving into its way is never safe. With ghosts false only the real cars count, not the
+  // predictor's lane-change hypotheses (Workspace::num_check_cars).
   template <typename StateAt>
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
-                     int* car_hit = nullptr) const;
+                     int* car_hit = nullptr, bool ghosts = true) const;
 
  private:
   // Appends the ticks to the XY prefix; returns the path length.
@@ -89,7 +90,8 @@ class Checker {
 
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
-                            int* car_hit) const {
+                            int* car_hit, bool ghosts) const {
+  const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
   const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
@@ -97,7 +99,7 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
     const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
     const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
     const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
-    for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+    for (int c = 0; c < num_cars; ++c) {
       const int at = c * (n_steps + 1) + j;
       const double cs = ws_.step_s[at], cd = ws_.step_d[at];
       // A car behind in another lane than the start's is one the ego would cut in front of:

@@ -41,7 +41,8 @@ bool LeastHarm::Choose(bool* over_budget) {
     const int c = order[r];
     const traj::FrenetTrajectory tr = ws_.Candidate(c);
     first_hit_[c] =
-        checker_.FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0, 1.0);
+        checker_.FirstCollision([&](int i) { return tr.At(i * kTickSeconds); }, 0.0, 1.0,
+                                nullptr, false);
     clearance_[c] = first_hit_[c] > ws_.n_steps ? Clearance(cfg_, ws_, tr) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:
