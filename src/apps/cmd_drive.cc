@@ -67,10 +67,18 @@ int Drive(const DriveArgs& a) {
   if (!world.ok()) return Fail(world.message());
 
   if (!a.connect.empty()) {
-    if (a.episodes > 1 || !a.record_path.empty()) {
-      return Fail("--connect drives one episode without --record");
+    if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
+    ConnectOptions connect;
+    connect.url = a.connect;
+    connect.realtime = a.realtime;
+    connect.timing = !a.no_timing;
+    std::unique_ptr<sim::RecordWriter> record;
+    if (!a.record_path.empty()) {
+      auto writer = sim::RecordWriter::Open(a.record_path);
+      if (!writer.ok()) return Fail(writer.message());
+      record = std::move(writer).value();
+      connect.record = record.get();
     }
-    ConnectOptions connect{a.connect, a.realtime};
     auto report = DriveOverNetwork(*world, *scenario, seed, limits, connect);
     if (!report.ok()) return Fail(report.message());
     std::printf("%s", a.json ? (report->ToJson().dump() + "\n").c_str() : report->ToText().c_str());
@@ -169,7 +177,9 @@ void RegisterDrive(CLI::App& app) {
   sub->add_option("--config", args->config_path,
                   "Planner configuration YAML. Default: config/planner.yaml");
   sub->add_option("--record", args->record_path,
-                  "Write one JSON line per exchange to this file (header, exchanges, footer)");
+                  "Write one JSON line per exchange to this file (header, exchanges, footer), "
+                  "for `frenetic report`. With --connect the planner's internals (candidates, "
+                  "costs) are unknown and left out. Default: no record");
   sub->add_flag("--json", args->json, "Print the report as one JSON object on stdout");
   sub->add_option("--latency", args->latency,
                   "Timing: lockstep (1 tick per exchange), fixed (the scenario's l_old, l_new "
@@ -190,8 +200,8 @@ void RegisterDrive(CLI::App& app) {
                 "the deadlines are switched off and every run of a seed gives the "
                 "same drive whatever the machine's load (planning times are still measured)");
   sub->add_flag("--no-timing", args->no_timing,
-                "Report and record planning times as 0, so the same seed gives byte-identical "
-                "records");
+                "Report and record planning times (with --connect: round trips) as 0, so the "
+                "same seed gives byte-identical records");
   sub->add_option("--connect", args->connect,
                   "Play the simulator's side over a WebSocket against a planner server, e.g. "
                   "ws://127.0.0.1:4567/socket.io/?EIO=4&transport=websocket (planning times are "

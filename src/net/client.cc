@@ -23,6 +23,10 @@ namespace beast = boost::beast;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 
+// Beast masks a client's message in chunks of its write buffer (one frame, one socket write per
+// chunk). A buffer that holds a whole telemetry frame (~2-15 kB) makes that a single write.
+constexpr std::size_t kWriteBufferBytes = 64 << 10;
+
 struct Url {
   std::string host, port, target;
 };
@@ -74,6 +78,19 @@ class Connection {
           results, [handler](beast::error_code e, const tcp::endpoint&) mutable { handler(e); });
     });
     if (ec) return Status::Error("cannot connect to " + url.host + ":" + url.port + ": " + ec.message());
+    // Without TCP_NODELAY the telemetry written right after the ping waits for the ping's ACK,
+    // which the server delays (~40 ms) because it has nothing to send back.
+    tcp::socket& socket = beast::get_lowest_layer(ws_).socket();
+    socket.set_option(tcp::no_delay(true), ec);
+    tcp::no_delay nodelay;
+    if (!ec) socket.get_option(nodelay, ec);
+    if (ec) return Status::Error("cannot set TCP_NODELAY: " + ec.message());
+    nodelay_ = nodelay.value();
+    // One frame per message, as the simulator sends (Beast splits messages larger than its
+    // write buffer into continuation frames by default). Set before the handshake, as Beast
+    // requires for the buffer size.
+    ws_.auto_fragment(false);
+    ws_.write_buffer_bytes(kWriteBufferBytes);
     ws_.read_message_max(options_.max_frame_bytes);
     ec = Await([&](auto handler) {
       ws_.async_handshake(url.host + ":" + url.port, url.target,
@@ -103,6 +120,7 @@ class Connection {
     return {static_cast<const char*>(d.data()), d.size()};
   }
   bool binary() const { return !ws_.got_text(); }
+  bool nodelay() const { return nodelay_; }
 
   void CloseGracefully() {
     Await([&](auto handler) {
@@ -132,6 +150,7 @@ class Connection {
   asio::io_context io_;
   websocket::stream<beast::tcp_stream> ws_;
   beast::flat_buffer buffer_;
+  bool nodelay_ = false;
 };
 
 }  // namespace
@@ -148,6 +167,7 @@ Status RunClient(const std::string& url, SimulatorEndpoint& endpoint,
   if (!parsed_url.ok()) return parsed_url.status();
   Connection conn(options);
   if (Status s = conn.Open(*parsed_url); !s.ok()) return s;
+  stats.tcp_nodelay = conn.nodelay();
   if (options.send_ping) {
     if (auto ec = conn.Write(kPingFrame)) return Status::Error("sending the ping: " + ec.message());
   }

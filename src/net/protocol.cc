@@ -14,8 +14,6 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // Telemetry nests four levels deep (frame array, payload, sensor_fusion, row). Deeper input is
 // hostile; refusing it before parsing bounds the parser's memory and time.
 constexpr int kMaxDepth = 16;
@@ -213,8 +211,8 @@ void ParseTelemetry(const json& payload, ParsedFrame* out) {
     out->telemetry = plan::Telemetry();
     return;
   }
-  t.yaw = yaw_deg * kDegToRad;
-  t.speed = speed_mph / kMpsToMph;
+  t.yaw = wire::YawFromDegrees(yaw_deg);
+  t.speed = wire::SpeedFromMph(speed_mph);
   Problems repairs;
   ReadPath(*xs, *ys, &t, &repairs);
   t.sensor_fusion.reserve(rows->size());
@@ -231,15 +229,10 @@ void ParseTelemetry(const json& payload, ParsedFrame* out) {
   if (!repairs.empty()) out->error = repairs.Take();
 }
 
-// Appends a float32 rendering like .NET float.ToString() ("G7"): 7 significant digits,
-// trailing zeros dropped, plain notation for ordinary magnitudes.
+// Appends a float32 rendering like .NET float.ToString() ("G7").
 void AppendFloat32(double value, std::string* out) {
-  float f = std::isfinite(value) ? static_cast<float>(value) : 0.0f;
-  if (!std::isfinite(f)) f = 0.0f;  // beyond float32 range
-  if (f == 0.0f) f = 0.0f;          // no "-0"
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof(buf), f, std::chars_format::general, 7);
-  out->append(buf, r.ptr);
+  char buf[wire::kMaxNumberChars];
+  out->append(buf, wire::FormatTelemetryNumber(value, buf));
 }
 
 void AppendInt(int value, std::string* out) {
@@ -258,17 +251,14 @@ void AppendFloat32Array(const std::vector<double>& values, std::string* out) {
 }
 
 void AppendTelemetryJson(const plan::Telemetry& t, std::string* out) {
-  double yaw_deg = std::fmod(t.yaw * kRadToDeg, 360.0);
-  if (yaw_deg < 0) yaw_deg += 360.0;
-  if (!std::isfinite(yaw_deg) || static_cast<float>(yaw_deg) >= 360.0f) yaw_deg = 0;
   const auto field = [out](const char* name, double v) {
     out->append(name);
     AppendFloat32(v, out);
   };
   field("{\"x\":", t.x);
   field(",\"y\":", t.y);
-  field(",\"yaw\":", yaw_deg);
-  field(",\"speed\":", t.speed * kMpsToMph);
+  field(",\"yaw\":", wire::YawToDegrees(t.yaw));
+  field(",\"speed\":", wire::SpeedToMph(t.speed));
   field(",\"s\":", t.s);
   field(",\"d\":", t.d);
   out->append(",\"previous_path_x\":");
@@ -402,27 +392,15 @@ std::size_t FormatControl(std::span<const double> x, std::span<const double> y,
                           std::string* out) {
   // A coordinate beyond float32 range is one the simulator's float.Parse cannot read (and one
   // near DBL_MAX would round up to an overflowing literal at kControlDigits): cut there too.
-  const auto writable = [](double v) {
-    return std::isfinite(v) && std::fabs(v) <= std::numeric_limits<float>::max();
-  };
-  std::size_t n = std::min(x.size(), y.size());
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!writable(x[i]) || !writable(y[i])) {
-      n = i;
-      break;
-    }
-  }
+  const std::size_t n = wire::ControlPoints(x, y);
   out->clear();
   // Up to ~17 characters per number plus separators; reserving avoids regrowth.
   out->reserve(40 + 2 * 18 * n);
   const auto append_array = [out, n](std::span<const double> v) {
-    char buf[32];
+    char buf[wire::kMaxNumberChars];
     for (std::size_t i = 0; i < n; ++i) {
       if (i > 0) out->push_back(',');
-      const double value = v[i] == 0.0 ? 0.0 : v[i];  // no "-0"
-      const auto r = std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::general,
-                                   kControlDigits);
-      out->append(buf, r.ptr);
+      out->append(buf, wire::FormatControlNumber(v[i], buf));
     }
   };
   out->append(R"(42["control",{"next_x":[)");

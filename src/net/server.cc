@@ -118,6 +118,22 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void Start() {
     server_->sessions[id_] = weak_from_this();
+    // Replies are answers the simulator waits for: no Nagle delay.
+    tcp::socket& socket = beast::get_lowest_layer(ws_).socket();
+    beast::error_code ec;
+    socket.set_option(tcp::no_delay(true), ec);
+    tcp::no_delay nodelay;
+    if (!ec) socket.get_option(nodelay, ec);
+    if (ec || !nodelay.value()) {
+      spdlog::warn("session {} from {}: TCP_NODELAY not set{}", id_, peer_,
+                   ec ? ": " + ec.message() : std::string());
+    } else {
+      std::lock_guard lock(server_->mutex);
+      ++server_->stats.nodelay_connections;
+    }
+    // One frame per reply (Beast would split replies over its 4096-byte write buffer into
+    // continuation frames, which some Udacity-template programs mishandle).
+    ws_.auto_fragment(false);
     auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
     timeouts.handshake_timeout = std::chrono::milliseconds(
         static_cast<std::int64_t>(server_->options.handshake_timeout * 1000.0));

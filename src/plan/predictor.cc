@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace frenetic::plan {
 namespace {
@@ -15,13 +16,21 @@ constexpr double kRespawnJump = 15.0;
 constexpr double kMaxReadingAge = 0.5;
 // m/s^2: no car of the simulator speeds up faster (traffic tops out near 5).
 constexpr double kMaxCarAccel = 8.0;
+// The traffic's lane-change rule (udacity-sim.md §8.5): faster than 15 mph, and no car within
+// 20 m in s in the target lane.
+constexpr double kGhostMinSpeed = 15.0 / kMphPerMps;  // m/s
+constexpr double kGhostClear = 20.0;                   // m
+constexpr double kGhostLeaderReach = 40.0;  // m: a leader this close ahead is what it brakes for
+constexpr double kGhostOnset = 1.0;         // s: the rule holds this long before the car moves
 
 class TrafficPredictor : public Predictor {
  public:
   TrafficPredictor(std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options,
                    bool manoeuvres)
       : line_(std::move(line)), options_(options), manoeuvres_(manoeuvres) {
-    cars_.reserve(options_.max_cars);
+    cars_.reserve(2 * options_.max_cars);  // room for a ghost per car
+    ghost_seen_.reserve(options_.max_cars);
+    ghost_seen_next_.reserve(options_.max_cars);
     memory_.reserve(options_.max_cars);
   }
 
@@ -67,6 +76,7 @@ class TrafficPredictor : public Predictor {
       if (!manoeuvres_) car.a_s = 0;
       cars_.push_back(car);
     }
+    if (manoeuvres_ && options_.lane_change_ghosts) AddLaneChangeGhosts(now);
   }
 
   std::span<const TrackedCar> cars() const override { return cars_; }
@@ -86,10 +96,11 @@ class TrafficPredictor : public Predictor {
       p.s += c.v_s * t;
     }
     p.d = c.d;
-    if (c.d_target != c.d && c.v_d != 0) {
+    if (c.d_target != c.d && c.v_d != 0 && t > c.lat_delay) {
       const double reach = (c.d_target - c.d) / c.v_d;  // s until the target lane's centre
-      if (t < reach) {
-        p.d = c.d + c.v_d * t;
+      const double moving = t - c.lat_delay;
+      if (moving < reach) {
+        p.d = c.d + c.v_d * moving;
         p.v_d = c.v_d;
       } else {
         p.d = c.d_target;
@@ -101,6 +112,7 @@ class TrafficPredictor : public Predictor {
   void Reset() override {
     cars_.clear();
     memory_.clear();
+    ghost_seen_.clear();
   }
 
  private:
@@ -149,6 +161,47 @@ class TrafficPredictor : public Predictor {
     *m = {id, s, v, now};
   }
 
+  // The second hypothesis of every car ahead that may change lanes by the traffic's own rule
+  // (see PredictorOptions::lane_change_ghosts): braking behind a leader in its lane, faster than
+  // 15 mph, the target lane clear within 20 m. The rule must hold for more than 50 evaluations
+  // (about a second) before the car moves, so the ghost starts its move kGhostOnset after the
+  // car was first seen so, or at once when that was long enough ago.
+  void AddLaneChangeGhosts(double now) {
+    const double w = options_.lane_width;
+    const int n = static_cast<int>(cars_.size());
+    ghost_seen_next_.clear();
+    for (int i = 0; i < n; ++i) {
+      const TrackedCar c = cars_[i];
+      if (!(c.a_s < -options_.brake_threshold) || !(c.v_s > kGhostMinSpeed)) continue;
+      if (!(c.s > kGhostClear) || c.d_target != c.d) continue;  // near or behind, or moving
+      const int lane = static_cast<int>(std::floor(c.d / w));
+      const int target = lane == 1 ? 0 : 1;  // the middle lane's cars only ever go left
+      if (lane < 0 || lane > 2 || target >= options_.num_lanes) continue;
+      const double centre = (target + 0.5) * w;
+      bool clear = true, blocked = false;
+      for (int j = 0; j < n && clear; ++j) {
+        if (j == i) continue;
+        const double ds = cars_[j].s - c.s;
+        clear = !(std::abs(cars_[j].d - centre) <= 2.0) || std::abs(ds) > kGhostClear;
+        blocked = blocked || (ds > 0 && ds < kGhostLeaderReach && std::abs(cars_[j].d - c.d) < 2.0);
+      }
+      if (!clear || !blocked) continue;
+      double since = now;
+      for (const auto& [id, t] : ghost_seen_) {
+        if (id == c.id && std::isfinite(t)) since = t;
+      }
+      ghost_seen_next_.push_back({c.id, since});
+      TrackedCar g = c;
+      g.ghost = true;
+      g.d_target = centre;
+      g.v_d = std::copysign(options_.ghost_lateral_speed, centre - c.d);
+      g.lat_delay = std::isfinite(now - since) ? std::clamp(kGhostOnset - (now - since), 0.0, kGhostOnset)
+                                               : kGhostOnset;
+      cars_.push_back(g);
+    }
+    ghost_seen_.swap(ghost_seen_next_);
+  }
+
   // The centre of the next lane in the direction of a lateral move faster than the threshold,
   // or d itself (no move predicted, or a move away from that centre: wander).
   double LateralTarget(double d, double v_d) const {
@@ -166,6 +219,8 @@ class TrafficPredictor : public Predictor {
   bool manoeuvres_;
   std::vector<TrackedCar> cars_;
   std::vector<Memory> memory_;
+  // Cars that gave a ghost last time, with the time they were first seen so (NaN: unknown).
+  std::vector<std::pair<int, double>> ghost_seen_, ghost_seen_next_;
 };
 
 }  // namespace

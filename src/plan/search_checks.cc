@@ -1,5 +1,6 @@
 #include "plan/search_checks.h"
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 
@@ -49,7 +50,7 @@ bool Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
 StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = ws_.n_steps + 1;
-  const int num_cars = ws_.ctx.num_cars;
+  const int num_cars = std::min(ws_.num_check_cars, 64);  // ghosts too; FirstCollision may drop them
   // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
   const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
   LonNearKey& lk = lon_near_key_[i];

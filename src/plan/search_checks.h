@@ -98,10 +98,11 @@ class Checker {
   // safety margins are scaled by margin_scale (0: bare boxes), except the room kept for a car
   // behind in another lane, scaled by behind_scale: that car does not see the ego until it is
   // in front of it (the simulator's traffic only brakes for a car within 2 m laterally), so
-  // moving into its way is never safe.
+  // moving into its way is never safe. With ghosts false only the real cars count, not the
+  // predictor's lane-change hypotheses (Workspace::num_check_cars).
   template <typename StateAt>
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
-                     int* car_hit = nullptr) const;
+                     int* car_hit = nullptr, bool ghosts = true) const;
 
   // Candidate c's states at the collision-check steps, with the cars within reach of a
   // FirstCollision(..., margin_scale, behind_scale) at each step. Each bundle trajectory is
@@ -161,7 +162,9 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
 
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
-                            int* car_hit) const {
+                            int* car_hit, bool ghosts) const {
+  const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
+  const std::uint64_t cars = num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
   const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
@@ -201,7 +204,7 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
     };
     // Cars in index order either way: the first one hit is the same.
     if constexpr (requires { state_at.Near(j); }) {
-      for (std::uint64_t m = state_at.Near(j); m != 0; m &= m - 1) {
+      for (std::uint64_t m = state_at.Near(j) & cars; m != 0; m &= m - 1) {
         const int c = std::countr_zero(m);
         if (hits(c)) {
           if (car_hit != nullptr) *car_hit = c;
@@ -209,7 +212,7 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
         }
       }
     } else {
-      for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+      for (int c = 0; c < num_cars; ++c) {
         if (hits(c)) {
           if (car_hit != nullptr) *car_hit = c;
           return j;

@@ -89,11 +89,13 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   // squarely in front of it: mid lane change the car may not have seen the ego yet.
   // Predictions are sampled once here: at the scoring samples and at the collision-check
   // steps, t_keep after the observation.
+  // The predictor's ghosts (they follow every real car) go last, for the hard checks only.
   const auto cars = predictor.cars();
-  int nc = 0;
+  int nc = 0, real = 0;
   for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
     const TrackedCar& car = cars[i];
     if (car.s < -cfg.car_length && std::abs(car.d - start.d) < kFollowerLateral) continue;
+    if (!car.ghost) real = nc + 1;
     ws.car_index[nc] = i;
     const Predictor::Prediction at_start = predictor.Predict(i, ws.t_keep);
     ws.car_s0[nc] = start.s + at_start.s;  // at the start instant, in the start's s frame
@@ -115,7 +117,8 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
     }
     ++nc;
   }
-  c.num_cars = nc;
+  c.num_cars = real;
+  ws.num_check_cars = nc;
   // Bounds the collision check's margins (Checker::FirstCollision).
   ++ws.traffic_stamp;
   ws.step_v_max = 0;

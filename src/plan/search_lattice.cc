@@ -11,6 +11,8 @@ namespace {
 
 // m along s: a car in another lane this close is alongside (a lane change must yield to it).
 constexpr double kAlongside = 20.0;
+// m/s: a lane whose limit is within this of the fastest lane's shares the grid's top end speed.
+constexpr double kLaneLimitStep = 0.05;
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -157,13 +159,20 @@ void Lattice::Generate() {
   for (int l = 0; l < cfg_.num_lanes; ++l) {
     reachable[l] = std::abs(ws_.lane_center[l] - start.d) <= 2.5 * cfg_.lane_width;
   }
+  double vmax = 0;
+  for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
   for (int di = 0; di < cfg_.durations; ++di) {
     const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
     for (int vi = 0; vi < cfg_.speeds; ++vi) {
       // Velocity keeping to end speeds from 0 to the fastest lane's limit.
-      double vmax = 0;
-      for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
       AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T));
+    }
+    // ...and to each slower lane's own limit (the outer lanes of a bend, where the XY speed is
+    // s' (1 + kappa d)): the grid's step would otherwise leave such a lane up to a whole step
+    // (2 m/s) below its limit, and the ego driving a bend well under the speed limit.
+    for (int l = 0; l < cfg_.num_lanes && cfg_.lane_limit_speeds; ++l) {
+      if (!reachable[l] || ws_.ctx.lane_speed_limit[l] >= vmax - kLaneLimitStep) continue;
+      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, l, ws_.ctx.lane_speed_limit[l], T));
     }
     if (cfg_.stop) {
       AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start.s_d * T, T));

@@ -30,7 +30,7 @@ bool LeastHarm::Choose(bool* over_budget) {
     }
     const int c = order[r];
     const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
-    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0);
+    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
     clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(cfg_, ws_, steps) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:

@@ -48,6 +48,7 @@ std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
   po.brake_threshold = config.value("prediction.brake_threshold");
   po.brake_horizon = config.value("prediction.brake_horizon");
   po.lateral_threshold = config.value("prediction.lateral_threshold");
+  po.lane_change_ghosts = config.int_value("prediction.lane_change_ghosts") != 0;
   po.lane_width = cfg.lane_width;
   po.num_lanes = cfg.num_lanes;
   return config.int_value("prediction.manoeuvres") != 0

@@ -28,6 +28,7 @@ Settings::Settings(const PlannerConfig& c) {
   replan_min_ticks = c.int_value("continuity.replan_min_ticks");
   replan_deviation = c.value("continuity.replan_deviation");
   speeds = c.int_value("grid.speeds");
+  lane_limit_speeds = c.int_value("grid.lane_limit_speeds") != 0;
   durations = c.int_value("grid.durations");
   min_duration = c.value("grid.min_duration");
   max_duration = c.value("grid.max_duration");

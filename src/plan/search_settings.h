@@ -34,6 +34,7 @@ struct Settings {
   int replan_min_ticks;
   double replan_deviation;
   int speeds, durations;
+  bool lane_limit_speeds;
   double min_duration, max_duration;
   int follow_gaps;
   double follow_d0, follow_tau, follow_tau_step;

@@ -20,7 +20,7 @@ Workspace::Workspace(const Settings& cfg) {
   n_ticks = static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds));
   n_ticks = std::max(n_ticks, cfg.output_points);
   // The lattice's largest bundles (Lattice::Generate), with a little slack.
-  const int max_lon = cfg.speeds * cfg.durations + cfg.durations +
+  const int max_lon = (cfg.speeds + cfg.num_lanes) * cfg.durations + cfg.durations +
                       2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
                       cfg.brake_decels * cfg.brake_targets + 8;
   const int max_lat =

@@ -64,6 +64,9 @@ struct Workspace {
   double lane_nominal[cost::kMaxLanes] = {};  // configured lane centres, m
   double lane_center[cost::kMaxLanes] = {};   // this cycle's (moved off the lane lines), m
   cost::CostContext ctx;
+  // Cars the hard checks test against: ctx.num_cars real ones, then the predictor's lane-change
+  // ghosts (a hypothesis the plan must survive, not traffic the costs should weigh).
+  int num_check_cars = 0;
   // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples
   // ([c * n_samples + k]), where it is at the start instant, its predictor index, and its
   // predicted s, d, speed and lateral speed at the collision-check steps ([c * (n_steps + 1) +

@@ -12,6 +12,7 @@
 
 #include "frenetic/net/protocol.h"
 #include "frenetic/sim/record.h"
+#include "frenetic/wire_precision.h"
 
 namespace frenetic::sim {
 namespace {
@@ -148,12 +149,23 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   plan_ms.reserve(20000);
   int fallbacks = 0, bad_paths = 0;
   std::string telemetry_json;
+  // The planner gets the telemetry as it arrives over the wire and the simulator the path as it
+  // arrives back (wire_precision.h: float32 printed with 7 digits out, 10 digits back, a path
+  // cut before its first unwritable point), so that this drive and the same seed through
+  // `frenetic serve` + `drive --connect` are the same drive.
+  plan::Telemetry received;
+  received.previous_path_x.reserve(256);
+  received.previous_path_y.reserve(256);
+  std::vector<double> path_x, path_y;
+  path_x.reserve(256);
+  path_y.reserve(256);
   while (!ep.done()) {
     const double t_sent = ep.sim().time();
     if (record != nullptr) telemetry_json = net::TelemetryToJson(ep.telemetry());
+    wire::TelemetryAsReceived(ep.telemetry(), &received);
     trace.candidates.clear();
     const auto t0 = std::chrono::steady_clock::now();
-    const plan::PlanResult& result = planner.Plan(ep.telemetry());
+    const plan::PlanResult& result = planner.Plan(received);
     const double ms =
         options.timing
             ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
@@ -163,9 +175,14 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
     if (result.status != plan::PlanStatus::kOk) ++fallbacks;
     const std::size_t first_incident = ep.sim().monitor().log().size();
     const int index = ep.exchanges();
-    if (Status s = ep.Submit(result.x, result.y); !s.ok() && bad_paths++ == 0) {
-      spdlog::warn("{} (the simulator ignores such a path)", s.message());
+    wire::ControlAsReceived(result.x, result.y, &path_x, &path_y);
+    if ((path_x.size() != result.x.size() || path_x.size() != result.y.size()) &&
+        bad_paths++ == 0) {
+      spdlog::warn("the planner returned {} x and {} y values; {} finite points sent, as frenetic "
+                   "serve would (warned once)",
+                   result.x.size(), result.y.size(), path_x.size());
     }
+    (void)ep.Submit(path_x, path_y);  // the wire's path is always one the simulator accepts
     if (record != nullptr) {
       record->WriteExchange(index, t_sent, telemetry_json, result, &trace, ms, ep.sim(),
                             first_incident, ep.last_l_old(), ep.last_l_new());

@@ -105,7 +105,7 @@ void RecordWriter::WriteLine(const std::string& line) {
 }
 
 void RecordWriter::WriteHeader(const Simulator& sim, const std::string& planner_name,
-                               const nlohmann::json& config) {
+                               const nlohmann::json& config, std::string_view connect_url) {
   const World& w = sim.world();
   nlohmann::json centre = nlohmann::json::array();
   const double length = w.line->length();
@@ -131,6 +131,7 @@ void RecordWriter::WriteHeader(const Simulator& sim, const std::string& planner_
                       {"centerline", centre},
                       {"car_length", sc.car_length},
                       {"car_width", sc.car_width}};
+  if (!connect_url.empty()) h["connect"] = connect_url;
   WriteLine(h.dump());
 }
 
@@ -189,6 +190,26 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
       {"refine_cost_after", Finite(s.refine_cost_after)},
       {"points_kept", s.points_kept},
       {"candidates", candidates}};
+  WriteExchangeLine(index, t, telemetry_json, result.x, result.y, plan, sim, first_incident,
+                    l_old, l_new);
+}
+
+void RecordWriter::WriteRemoteExchange(int index, double t, const std::string& telemetry_json,
+                                       std::span<const double> path_x,
+                                       std::span<const double> path_y, std::string_view reply,
+                                       double round_trip_ms, const Simulator& sim,
+                                       std::size_t first_incident, int l_old, int l_new) {
+  const double k = timing_ ? 1.0 : 0.0;
+  const nlohmann::json plan = {{"status", reply}, {"ms_total", k * round_trip_ms}};
+  WriteExchangeLine(index, t, telemetry_json, path_x, path_y, plan, sim, first_incident, l_old,
+                    l_new);
+}
+
+void RecordWriter::WriteExchangeLine(int index, double t, const std::string& telemetry_json,
+                                     std::span<const double> path_x,
+                                     std::span<const double> path_y, const nlohmann::json& plan,
+                                     const Simulator& sim, std::size_t first_incident, int l_old,
+                                     int l_new) {
   const IncidentMonitor& m = sim.monitor();
   const LeaderGap lead = sim.leader();
   nlohmann::json metrics = {
@@ -213,12 +234,12 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
                          {"kind", ToString(inc.kind)}, {"value", inc.value}});
   }
   // 0.1 mm is far below the float32 resolution the simulator parses to; it halves the file.
-  auto rounded = [](const std::vector<double>& v) {
+  auto rounded = [](std::span<const double> v) {
     nlohmann::json a = nlohmann::json::array();
     for (double e : v) a.push_back(std::isfinite(e) ? std::round(e * 1e4) / 1e4 : 0.0);
     return a;
   };
-  nlohmann::json rest = {{"path", {{"x", rounded(result.x)}, {"y", rounded(result.y)}}},
+  nlohmann::json rest = {{"path", {{"x", rounded(path_x)}, {"y", rounded(path_y)}}},
                          {"plan", plan},
                          {"metrics", metrics},
                          {"incidents", incidents}};

@@ -50,7 +50,9 @@ inline std::string TelemetryFrameAt(double x, double y) {
 // Plan() calls from 1, so a reply tells both whose telemetry and which planner produced it.
 class FakePlanner : public plan::Planner {
  public:
-  enum class Mode { kGood, kNaN, kUnequal, kShort };
+  // kLong: kLongPoints points, a reply far larger than Beast's 4096-byte write buffer.
+  enum class Mode { kGood, kNaN, kUnequal, kShort, kLong };
+  static constexpr int kLongPoints = 500;
   explicit FakePlanner(Mode mode = Mode::kGood) : mode_(mode) {}
 
   const plan::PlanResult& Plan(const plan::Telemetry& t) override {
@@ -58,9 +60,11 @@ class FakePlanner : public plan::Planner {
     last_ = t;
     result_.x.clear();
     result_.y.clear();
-    const int n = mode_ == Mode::kShort ? 3 : plan::kMinPathPoints;
+    const int n = mode_ == Mode::kShort  ? 3
+                  : mode_ == Mode::kLong ? kLongPoints
+                                         : plan::kMinPathPoints;
     for (int i = 0; i < n; ++i) {
-      result_.x.push_back(t.x + i);
+      result_.x.push_back(t.x + i * (mode_ == Mode::kLong ? 0.123456789 : 1.0));
       result_.y.push_back(t.y + cycles_);
     }
     if (mode_ == Mode::kNaN) result_.x[10] = std::nan("");

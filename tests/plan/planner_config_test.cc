@@ -21,7 +21,7 @@ TEST(PlannerConfigTest, LoadsTheShippedFile) {
   auto c = PlannerConfig::LoadDefault();
   ASSERT_TRUE(c.ok()) << c.message();
   EXPECT_DOUBLE_EQ(c->budget_ms(), 15);
-  EXPECT_DOUBLE_EQ(*c->Get("limits.max_speed_mph"), 49.5);
+  EXPECT_DOUBLE_EQ(*c->Get("limits.max_speed_mph"), 49.8);
   EXPECT_DOUBLE_EQ(*c->Get("weights.collision"), 10);
   EXPECT_EQ(c->refine_algorithm(), "LN_COBYLA");
   const auto terms = c->cost_terms();

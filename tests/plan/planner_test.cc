@@ -1,6 +1,7 @@
 // Planners on the Udacity map in a small closed loop written here (the simulator's path-trimming
 // rule, 1-3 points consumed per cycle, traffic at constant velocity), plus fuzzing and the
 // no-allocation property of the search planner.
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -166,9 +167,13 @@ class Loop {
   std::vector<double> path_x_, path_y_, ego_d_;
 };
 
+// Closed-loop tests count ticks, not wall time: the wall-clock deadlines are switched off, so
+// a loaded machine cannot cut a cycle and change the drive.
 std::unique_ptr<Planner> Make(const std::string& name,
                               std::shared_ptr<const map::ReferenceLine> line) {
-  auto p = MakePlanner(name, Config(), std::move(line));
+  PlannerConfig config = Config();
+  config.PinDeadlines();
+  auto p = MakePlanner(name, config, std::move(line));
   EXPECT_TRUE(p.ok()) << p.message();
   return p.ok() ? std::move(p.value()) : nullptr;
 }
@@ -301,7 +306,12 @@ TEST(SearchPlannerTest, SplicesSmoothlyAtSpeedOnTheWholeLoop) {
 
 TEST(SearchPlannerTest, SummaryIsFilled) {
   REQUIRE_MAP(line);
-  auto planner = Make("search", line);
+  // Every cycle a full search (no plan reuse), so the cycle looked at is one.
+  PlannerConfig config = Config();
+  ASSERT_TRUE(config.Set("continuity.replan_min_ticks", 1).ok());
+  auto made = MakePlanner("search", config, line);
+  ASSERT_TRUE(made.ok()) << made.message();
+  auto planner = std::move(made.value());
   Loop loop(line, planner.get(), 500, 6.0, 15.0, 6);
   loop.cars.push_back({0, 540, 6.0, 12.0});
   RunFor(loop, 1.0);
@@ -313,7 +323,7 @@ TEST(SearchPlannerTest, SummaryIsFilled) {
   EXPECT_EQ(s.candidates_feasible, 1);
   EXPECT_EQ(s.points_kept, 6);
   EXPECT_EQ(r.x.size(), 100u);
-  ASSERT_EQ(s.winner_costs.size(), 8u);
+  ASSERT_EQ(s.winner_costs.size(), static_cast<size_t>(config.cost_terms().size()));
   EXPECT_EQ(s.winner_costs[0].name, "collision");
   double total = 0;
   for (const auto& c : s.winner_costs) total += c.weight * c.value;
@@ -687,6 +697,77 @@ TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
   cv->Observe(row(19.4, -2.0), 280, 0.1);
   EXPECT_NEAR(cv->Predict(0, 3.0).v, 19.4, 0.05);
   EXPECT_NEAR(cv->Predict(0, 3.0).d, 9.0, 0.05);
+}
+
+// Lane-change ghosts (udacity-sim.md §8.5): a car braking behind a leader, faster than 15 mph,
+// with its target lane clear within 20 m, is also predicted changing lanes (left from the
+// middle lane, to the middle from the outer ones) after the rule's onset; not when the target
+// lane is taken, not without a leader, not within 20 m of the ego.
+TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
+  REQUIRE_MAP(line);
+  PredictorOptions o;
+  o.lane_change_ghosts = true;
+  // Ego at s = 200. Cars given at t = 0 as (s, d, v), all braking at 3 m/s^2 since then,
+  // observed every 0.1 s from `from` to `to`.
+  using Cars = std::vector<std::array<double, 3>>;
+  auto observe = [&](Predictor& pred, const Cars& cars, double from, double to) {
+    for (double t = from; t <= to + 1e-9; t += 0.1) {
+      std::vector<SensorCar> rows;
+      for (size_t i = 0; i < cars.size(); ++i) {
+        const auto [s0, d, v0] = cars[i];
+        const double v = v0 - 3.0 * t, s = s0 + v0 * t - 1.5 * t * t;
+        const map::CartesianPose p = line->ToCartesian(s, d);
+        rows.push_back({static_cast<int>(i), p.x, p.y, v * std::cos(p.heading),
+                        v * std::sin(p.heading), s, d});
+      }
+      pred.Observe(rows, 200, t);
+    }
+  };
+  auto ghosts = [](const Predictor& pred) {
+    int n = 0;
+    for (const TrackedCar& c : pred.cars()) n += c.ghost;
+    return n;
+  };
+  const Cars middle = {{240, 6.0, 15.0}, {255, 6.0, 12.0}};  // braking behind a leader
+  {
+    // A middle-lane car 40 m ahead: a ghost to the left, after the rule's onset.
+    auto pred = MakeManoeuvrePredictor(line, o);
+    observe(*pred, middle, 0.0, 0.1);
+    ASSERT_EQ(ghosts(*pred), 1);
+    const int g = static_cast<int>(pred->cars().size()) - 1;
+    const TrackedCar& ghost = pred->cars()[g];
+    EXPECT_EQ(ghost.id, 0);
+    EXPECT_NEAR(ghost.d_target, 2.0, 1e-9);
+    EXPECT_NEAR(pred->Predict(g, 0.5).d, 6.0, 0.05);  // waits for the onset
+    EXPECT_NEAR(pred->Predict(g, 6.0).d, 2.0, 1e-9);   // then ends in the left lane
+    EXPECT_NEAR(pred->Predict(0, 6.0).d, 6.0, 0.05);   // the car itself stays
+    // Still so a second later: the onset has passed, the move starts at once.
+    observe(*pred, middle, 0.2, 1.2);
+    ASSERT_EQ(ghosts(*pred), 1);
+    EXPECT_LT(pred->Predict(static_cast<int>(pred->cars().size()) - 1, 0.5).d, 6.0 - 0.5);
+    // Switched off: none.
+    o.lane_change_ghosts = false;
+    auto plain = MakeManoeuvrePredictor(line, o);
+    o.lane_change_ghosts = true;
+    observe(*plain, middle, 0.0, 0.1);
+    EXPECT_EQ(ghosts(*plain), 0);
+  }
+  {
+    // A right-lane car: to the middle lane.
+    auto pred = MakeManoeuvrePredictor(line, o);
+    observe(*pred, {{240, 10.0, 15.0}, {255, 10.0, 12.0}}, 0.0, 0.1);
+    ASSERT_EQ(ghosts(*pred), 1);
+    EXPECT_NEAR(pred->cars().back().d_target, 6.0, 1e-9);
+  }
+  auto none = [&](const Cars& cars) {
+    auto pred = MakeManoeuvrePredictor(line, o);
+    observe(*pred, cars, 0.0, 0.1);
+    return ghosts(*pred) == 0;
+  };
+  EXPECT_TRUE(none({{240, 6.0, 15.0}, {255, 6.0, 12.0}, {250, 2.0, 15.0}}));  // left lane taken
+  EXPECT_TRUE(none({{240, 6.0, 15.0}}));                                      // no leader
+  EXPECT_TRUE(none({{215, 6.0, 15.0}, {230, 6.0, 12.0}}));                    // within 20 m
+  EXPECT_TRUE(none({{240, 6.0, 6.0}, {250, 6.0, 4.0}}));                      // under 15 mph
 }
 
 TEST(FeasibilityTest, MeasureWithAPrefixEqualsTheWholeMeasure) {

@@ -2,6 +2,7 @@
 // shipped grid, its boundary conditions, and the following law.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "plan/search_stages_testing.h"
@@ -23,6 +24,13 @@ void PrepareCentred(Stages& st, double speed, double d_d = 0,
   st.Prepare({kS, speed, 0, st.ws.lane_center[1], d_d, 0}, cars);
 }
 
+// The shipped grid alone, without the lane-limit speeds a bend adds (kS is on a gentle bend).
+PlannerConfig GridOnly() {
+  PlannerConfig c = testing::DefaultConfig();
+  EXPECT_TRUE(c.Set("grid.lane_limit_speeds", 0).ok());
+  return c;
+}
+
 int Count(const Workspace& ws, cost::LonKind kind) {
   int n = 0;
   for (const LonTraj& l : ws.lon) n += l.kind == kind;
@@ -31,7 +39,7 @@ int Count(const Workspace& ws, cost::LonKind kind) {
 
 TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
+  Stages st(GridOnly());
   PrepareCentred(st, 20);
   st.lattice.Generate();
   const Workspace& ws = st.ws;
@@ -68,13 +76,13 @@ TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
 
 TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabled) {
   REQUIRE_UDACITY_MAP();
-  Stages slow;
+  Stages slow(GridOnly());
   PrepareCentred(slow, 0.5);
   slow.lattice.Generate();
   EXPECT_EQ(Count(slow.ws, cost::LonKind::kBraking), 0);
   EXPECT_EQ(slow.ws.lon.size(), 78u);
 
-  PlannerConfig config = testing::DefaultConfig();
+  PlannerConfig config = GridOnly();
   ASSERT_TRUE(config.Set("grid.stop", 0).ok());
   Stages no_stop(config);
   PrepareCentred(no_stop, 20);
@@ -97,7 +105,7 @@ TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
 
 TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
+  Stages st(GridOnly());
   const double v_lead = 15;
   PrepareCentred(st, 20, 0, {{kS + 40, 6.0, v_lead}});
   st.lattice.Generate();
@@ -157,6 +165,51 @@ TEST(SearchLatticeTest, MakeLonHitsEachFamilysEndCondition) {
   const LonTraj brake = st.lattice.MakeLon(cost::LonKind::kBraking, -1, 5.0, 2.0);
   EXPECT_DOUBLE_EQ(brake.traj.At(1.0).a, -5.0);
   EXPECT_NEAR(brake.traj.At(2.0).v, 10.0, 1e-12);
+}
+
+// On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets
+// velocity keeping to exactly its own limit, for every duration, paired only with its own lane.
+TEST(SearchLatticeTest, SlowerLanesOfABendGetTheirOwnLimit) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  const Settings& c = st.cfg;
+  double bend = -1;
+  for (double s = 0; s < st.line->length() && bend < 0; s += 25) {
+    st.Prepare({s, 20, 0, 6.0, 0, 0});
+    const double* lim = st.ws.ctx.lane_speed_limit;
+    if (std::max({lim[0], lim[1], lim[2]}) - std::min({lim[0], lim[1], lim[2]}) > 0.5) bend = s;
+  }
+  ASSERT_GE(bend, 0) << "the Udacity loop has bends";
+  st.lattice.Generate();
+  const Workspace& ws = st.ws;
+  const double* lim = ws.ctx.lane_speed_limit;
+  const double vmax = std::max({lim[0], lim[1], lim[2]});
+  int slower = 0;
+  for (int l = 0; l < c.num_lanes; ++l) slower += lim[l] < vmax - 0.05;
+  ASSERT_GT(slower, 0);
+  int bound = 0;
+  for (size_t i = 0; i < ws.lon.size(); ++i) {
+    const LonTraj& l = ws.lon[i];
+    if (l.kind != cost::LonKind::kVelocityKeeping || l.lane < 0) continue;
+    ++bound;
+    EXPECT_LT(lim[l.lane], vmax - 0.05);
+    EXPECT_NEAR(l.traj.poly.V(l.traj.duration), lim[l.lane], 1e-9);
+  }
+  EXPECT_EQ(bound, slower * c.durations);
+  for (size_t k = 0; k < ws.cand_lon.size(); ++k) {
+    const LonTraj& l = ws.lon[ws.cand_lon[k]];
+    if (l.lane >= 0) {
+      EXPECT_EQ(l.lane, ws.lat[ws.cand_lat[k]].lane);
+    }
+  }
+
+  // Switched off, the grid alone.
+  PlannerConfig off = testing::DefaultConfig();
+  ASSERT_TRUE(off.Set("grid.lane_limit_speeds", 0).ok());
+  Stages plain(off);
+  plain.Prepare({bend, 20, 0, 6.0, 0, 0});
+  plain.lattice.Generate();
+  EXPECT_EQ(Count(plain.ws, cost::LonKind::kVelocityKeeping), c.speeds * c.durations);
 }
 
 }  // namespace

@@ -48,8 +48,14 @@ struct ClientStats {
   std::int64_t protocol_errors = 0;  // malformed replies (unequal arrays, NaN, bad JSON)
   std::int64_t ignored_frames = 0;   // pongs, binary and other non-42 frames
   std::string first_protocol_error;  // one line, empty when none
+  // TCP_NODELAY as read back (getsockopt) from the connected socket: the client sets it, so a
+  // frame is not held back by Nagle's algorithm waiting for the server's delayed ACK.
+  bool tcp_nodelay = false;
 };
 
+// Every message goes out as the Unity simulator sends it: one unfragmented, masked text frame,
+// whatever its size (no continuation frames), on a socket with TCP_NODELAY set.
+//
 // Connects to `url` (ws://HOST[:PORT][/PATH], e.g.
 // ws://127.0.0.1:4567/socket.io/?EIO=4&transport=websocket; port 80 when omitted) and runs the
 // exchange until endpoint.Done(), then closes the connection cleanly. Errors: a bad URL, connect

@@ -10,11 +10,12 @@
 
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
+#include "frenetic/wire_precision.h"
 
 namespace frenetic::net {
 
 // The simulator reports speed as |v| (m/s) times this factor (§3.3).
-inline constexpr double kMpsToMph = 2.23693629;
+inline constexpr double kMpsToMph = wire::kMpsToMph;
 
 enum class FrameKind {
   kTelemetry,      // 42["telemetry",{...}] with a usable payload
@@ -45,17 +46,19 @@ ParsedFrame ParseFrame(std::string_view frame);
 // Appends `42["control",{"next_x":[...],"next_y":[...]}]` to *out (cleared first). Only finite
 // numbers are written; both arrays always have the same length: min(x.size(), y.size()) points,
 // cut before the first point with a non-finite coordinate or one beyond float32 range (which
-// the simulator cannot parse). Numbers are written with
-// kControlDigits significant digits (far below the float32 resolution the simulator parses to).
+// the simulator cannot parse): wire::ControlPoints. Numbers are written with kControlDigits
+// significant digits (far below the float32 resolution the simulator parses to):
+// wire::FormatControlNumber. wire::ControlAsReceived gives the parsed result without the text.
 // Returns the number of points written.
-inline constexpr int kControlDigits = 10;
+inline constexpr int kControlDigits = wire::kControlDigits;
 std::size_t FormatControl(std::span<const double> x, std::span<const double> y, std::string* out);
 inline constexpr std::string_view kManualFrame = R"(42["manual",{}])";
 
 // The telemetry as the simulator writes it (field names and order of §3.3, mph, degrees in
 // [0, 360), numbers as float32 with 7 significant digits like .NET float.ToString(), sensor ids
 // as integers), as the JSON object alone and as a whole frame. Non-finite numbers (which the
-// simulator never sends) are written as 0.
+// simulator never sends) are written as 0. Numbers go through wire::FormatTelemetryNumber;
+// wire::TelemetryAsReceived gives what ParseFrame makes of the frame, without the text.
 std::string TelemetryToJson(const plan::Telemetry& telemetry);
 std::string FormatTelemetryFrame(const plan::Telemetry& telemetry);
 inline constexpr std::string_view kNullTelemetryFrame = R"(42["telemetry",null])";

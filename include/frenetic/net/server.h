@@ -5,7 +5,9 @@
 // events, malformed frames) with `42["manual",{}]`. Hostile input (bad JSON, oversize or binary
 // frames, abrupt disconnects) is logged in one line and never crashes the server. A connection
 // silent for 150 s gets a WebSocket ping and is closed after 300 s without any data (Beast's
-// suggested server timeouts), so half-open connections do not pile up.
+// suggested server timeouts), so half-open connections do not pile up. Replies go out as the
+// simulator's own messages do: one unfragmented text frame each, whatever the size, on sockets
+// with TCP_NODELAY set.
 #pragma once
 
 #include <cstddef>
@@ -39,6 +41,9 @@ struct ServerOptions {
 // Counters since the server started (all connections).
 struct ServerStats {
   std::int64_t connections = 0;       // accepted and upgraded
+  // Accepted sockets on which TCP_NODELAY reads back as set (getsockopt); equals the accepted
+  // count unless the option could not be set.
+  std::int64_t nodelay_connections = 0;
   std::int64_t open_connections = 0;
   std::int64_t refused_connections = 0;  // the planner factory failed
   std::int64_t cycles = 0;            // telemetry answered with control

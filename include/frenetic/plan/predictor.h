@@ -25,6 +25,8 @@ struct TrackedCar {
   double a_s = 0;       // m/s^2 along the lane, from the previous reading (0 when unknown)
   double v_d = 0;       // m/s across the lane, right positive
   double d_target = 0;  // m: where a lateral move is predicted to end (= d when none)
+  bool ghost = false;   // a lane change the car may start (PredictorOptions::lane_change_ghosts)
+  double lat_delay = 0;  // s before a predicted lateral move starts
 };
 
 struct PredictorOptions {
@@ -39,6 +41,14 @@ struct PredictorOptions {
   double lateral_threshold = 0.5;  // m/s: a car moving across faster is changing lanes
   double lane_width = 4.0;       // m, lanes [0, w), [w, 2w), ...; a lane change ends at a centre
   int num_lanes = 3;
+  // The simulator's traffic changes lane only while braking behind a leader (udacity-sim.md
+  // §8.5): left from the middle lane, to the middle from the outer ones, when no car (nor the
+  // ego) within 20 m of it in s is in that lane. With this on, every such car faster than
+  // 15 mph also appears as a second car (same id) that starts that move now, so a plan never
+  // counts on the braking car staying in its lane; none is added within 20 m of the ego, where
+  // the rule would not let the car move (the ego could be in the target lane).
+  bool lane_change_ghosts = false;
+  double ghost_lateral_speed = 1.6;  // m/s across, about a lane in 2.5 s
 };
 
 class Predictor {

@@ -81,8 +81,12 @@ struct RunOptions {
   std::function<void(const Episode&)> progress;
 };
 
-// Drives `planner` (Reset first) through one episode. Fails only if the simulator cannot be
-// built or the record cannot be written.
+// Drives `planner` (Reset first) through one episode. The planner sees every telemetry number
+// as a planner behind the wire would (wire::TelemetryAsReceived: float32, 7 significant digits,
+// mph and degrees on the way) and its path reaches the simulator as over the wire
+// (wire::ControlAsReceived: 10 digits, cut before a non-finite point), so the drive equals the
+// same seed driven through `frenetic serve` + `frenetic drive --connect`. Fails only if the
+// simulator cannot be built or the record cannot be written.
 StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scenario& scenario,
                                  std::uint64_t seed, const EpisodeLimits& limits,
                                  plan::Planner& planner, const RunOptions& options);
