@@ -19,6 +19,7 @@ struct ServeArgs {
   std::string map_path;
   std::string planner = "search";
   std::string config_path;
+  bool no_deadlines = false;
   net::ServerOptions server;
 };
 
@@ -42,6 +43,7 @@ int Serve(const ServeArgs& args) {
     std::fprintf(stderr, "frenetic serve: %s\n", config.message().c_str());
     return 2;
   }
+  if (args.no_deadlines) config->PinDeadlines();
   // Shared by every connection's planner; the factory (and so the server) keeps it alive.
   auto shared_config = std::make_shared<const plan::PlannerConfig>(std::move(config).value());
   std::shared_ptr<const map::ReferenceLine> shared_line = *line;
@@ -109,6 +111,12 @@ void RegisterServe(CLI::App& app) {
                   "Largest incoming WebSocket message in bytes; a larger one closes that "
                   "connection (default: 1048576 = 1 MiB; a real telemetry frame is ~2-5 kB)")
       ->check(CLI::Range(std::size_t{1024}, std::size_t{1} << 30));
+  sub->add_flag("--no-deadlines", args->no_deadlines,
+                "Switch the planner's wall-clock deadlines (budget_ms, refine.budget_ms) off, as "
+                "frenetic drive does, so every cycle searches and refines in full however long it "
+                "takes: replies then depend only on the telemetry, and a `drive --connect` gives "
+                "the in-process drive's report. Default: off - deadlines apply, as the real "
+                "simulator needs");
   sub->add_flag("--answer-ping", args->server.answer_ping,
                 "Answer the simulator's engine.io ping \"2\" with \"3\" (not needed; default: "
                 "ignore it, as the starter server does)");

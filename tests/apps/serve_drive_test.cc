@@ -73,22 +73,8 @@ class ServerProcess {
 };
 
 // The planner's deadlines are wall-clock: on a loaded machine two drives could differ because
-// of them alone. Both sides of the comparison use the default config with the deadline at its
-// maximum and refinement (which has its own time budget) off, so only the wire differs.
-std::string DeterministicConfig() {
-  std::ifstream in(std::string(FRENETIC_SOURCE_DIR) + "/config/planner.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = std::regex_replace(text.str(), std::regex(R"(\nbudget_ms: [0-9.]+)"),
-                                        "\nbudget_ms: 200");
-  yaml = std::regex_replace(yaml, std::regex(R"(\n  enabled: 1)"), "\n  enabled: 0");
-  EXPECT_NE(yaml.find("\nbudget_ms: 200"), std::string::npos);
-  EXPECT_NE(yaml.find("\n  enabled: 0"), std::string::npos);
-  const std::string path = ::testing::TempDir() + "/serve_drive_planner.yaml";
-  std::ofstream(path) << yaml;
-  return path;
-}
-
+// of them alone. `serve --no-deadlines` switches them off as `drive` does, so both sides run the
+// shipped configuration in full (refinement included) and only the wire differs.
 // The in-process drive rounds every telemetry number and every path point as the wire does
 // (wire_precision.h), so the same seed gives the same drive through `serve` + `drive --connect`:
 // the whole report is equal except what cannot be: planning times (round trips over the wire),
@@ -96,8 +82,7 @@ std::string DeterministicConfig() {
 // over the wire: manual replies).
 TEST(ServeDrive, NetworkDriveEqualsInProcessDrive) {
   if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
-  const std::string config = DeterministicConfig();
-  ServerProcess server("--map " + UdacityMap() + " --config " + config +
+  ServerProcess server("--map " + UdacityMap() + " --no-deadlines" +
                        " --status-interval 1000");
   ASSERT_GT(server.port(), 0) << "serve did not print its port";
   const std::string url =
@@ -105,7 +90,7 @@ TEST(ServeDrive, NetworkDriveEqualsInProcessDrive) {
   for (const char* latency : {"lockstep", "random"}) {
     for (int seed = 1; seed <= 5; ++seed) {
       SCOPED_TRACE(std::string(latency) + " seed " + std::to_string(seed));
-      const std::string common = "drive --map " + UdacityMap() + " --config " + config +
+      const std::string common = "drive --map " + UdacityMap() +
                                  " --scenario udacity --seconds 30 --json --latency " + latency +
                                  " --seed " + std::to_string(seed);
       CommandResult remote = RunFrenetic(common + " --connect '" + url + "'");
@@ -137,14 +122,13 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
 // internals, and `frenetic report` makes the page from it.
 TEST(ServeDrive, RemoteDriveIsRecordedAndReported) {
   if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
-  const std::string config = DeterministicConfig();
-  ServerProcess server("--map " + UdacityMap() + " --config " + config +
+  ServerProcess server("--map " + UdacityMap() + " --no-deadlines" +
                        " --status-interval 1000");
   ASSERT_GT(server.port(), 0) << "serve did not print its port";
   const std::string url =
       "ws://127.0.0.1:" + std::to_string(server.port()) + "/socket.io/?EIO=4&transport=websocket";
   const std::string dir = ::testing::TempDir();
-  const std::string common = "drive --map " + UdacityMap() + " --config " + config +
+  const std::string common = "drive --map " + UdacityMap() +
                              " --seconds 10 --seed 3 --latency random --no-timing --json";
   CommandResult remote =
       RunFrenetic(common + " --connect '" + url + "' --record " + dir + "/remote.jsonl");

@@ -21,6 +21,7 @@
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
 #include "plan/search_planner.h"
+#include "plan/search_stages_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../common/malloc_counter.h"
 
@@ -31,17 +32,7 @@ namespace {
 
 constexpr double kMph = 0.44704;
 
-std::shared_ptr<const map::ReferenceLine> UdacityLine() {
-  static std::shared_ptr<const map::ReferenceLine> line = [] {
-    std::shared_ptr<const map::ReferenceLine> l;
-    auto track = map::LoadTrack(FRENETIC_SHARED_DIR "/data/highway_map.csv");
-    if (!track.ok()) return l;
-    auto fit = map::ReferenceLine::Fit(*track);
-    if (fit.ok()) l = *fit;
-    return l;
-  }();
-  return line;
-}
+std::shared_ptr<const map::ReferenceLine> UdacityLine() { return search::testing::UdacityLine(); }
 
 #define REQUIRE_MAP(line)                                                                \
   auto line = UdacityLine();                                                             \
