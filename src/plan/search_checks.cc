@@ -86,9 +86,9 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
           lat_dd_.data() + k * w, ws_.collision_step, near_.data()};
 }
 
-void Checker::FillTicks(const traj::FrenetTrajectory& tr) {
+void Checker::FillTicks(const traj::FrenetTrajectory& tr, double t0) {
   for (int i = 1; i <= ws_.n_ticks; ++i) {
-    const traj::FrenetState st = tr.At(i * kTickSeconds);
+    const traj::FrenetState st = tr.At(t0 + i * kTickSeconds);
     ws_.tk_s[i] = st.s;
     ws_.tk_sd[i] = st.s_d;
     ws_.tk_sdd[i] = st.s_dd;

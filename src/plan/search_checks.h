@@ -71,8 +71,9 @@ class Checker {
   // of ws and the ticks ws.tk_*.
   Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws);
 
-  // Samples a trajectory at every tick of the check horizon into ws.tk_* [1, n_ticks].
-  void FillTicks(const traj::FrenetTrajectory& tr);
+  // Samples a trajectory at every tick of the check horizon, t0 + i ticks (s), into ws.tk_*
+  // [1, n_ticks].
+  void FillTicks(const traj::FrenetTrajectory& tr, double t0 = 0);
   // The XY path's part common to every candidate of the cycle, the driven history then the
   // kept points (oldest first), measured once.
   void SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n, const double* kept_x,

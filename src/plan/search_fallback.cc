@@ -8,17 +8,9 @@
 
 namespace frenetic::plan::search {
 
-bool ContinuePrevious(Workspace& ws, const Checker& checker) {
+bool ContinuePrevious(Workspace& ws, Checker& checker) {
   if (!ws.have_prev_traj) return false;
-  for (int i = 1; i <= ws.n_ticks; ++i) {
-    const traj::FrenetState st = ws.prev_traj.At(ws.prev_elapsed + i * kTickSeconds);
-    ws.tk_s[i] = st.s;
-    ws.tk_sd[i] = st.s_d;
-    ws.tk_sdd[i] = st.s_dd;
-    ws.tk_d[i] = st.d;
-    ws.tk_dd[i] = st.d_d;
-    ws.tk_ddd[i] = st.d_dd;
-  }
+  checker.FillTicks(ws.prev_traj, ws.prev_elapsed);
   if (checker.Collides()) return false;
   ws.prev_base = ws.prev_elapsed;  // the next cycle's elapsed time counts from this start
   return true;

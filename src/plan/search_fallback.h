@@ -11,7 +11,7 @@ namespace frenetic::plan::search {
 // Samples last cycle's winner (ws.prev_traj) from the current start on into ws.tk_*; false
 // when there is none or it now collides. The XY limits were checked on it when it won. On
 // success the next cycle's elapsed time on it counts from this start (ws.prev_base).
-bool ContinuePrevious(Workspace& ws, const Checker& checker);
+bool ContinuePrevious(Workspace& ws, Checker& checker);
 
 // Keep-lane braking into ws.tk_*, at a jerk-limited constant deceleration integrated tick by
 // tick back to the current lane's centre; it never exceeds the limits. The first of three
