@@ -9,6 +9,7 @@
 
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
+#include "plan/predictor_options.h"
 #include "plan/search_planner.h"
 
 namespace frenetic::plan {
@@ -32,12 +33,7 @@ class BaselinePlanner : public Planner {
     points_ = std::max(kMinPathPoints, config.int_value("baseline.path_points"));
     lane_width_ = config.value("road.lane_width");
     num_lanes_ = config.int_value("road.num_lanes");
-    PredictorOptions po;
-    po.range = config.value("prediction.range");
-    po.d_min = config.value("prediction.d_min");
-    po.d_max = config.value("prediction.d_max");
-    po.max_speed = config.value("prediction.max_speed");
-    po.spike_ratio = config.value("prediction.spike_ratio");
+    PredictorOptions po = BasicPredictorOptions(config);
     predictor_ = MakeConstantVelocityPredictor(line_, po);
     Reset();
   }

@@ -12,6 +12,7 @@
 
 #include "frenetic/plan/predictor.h"
 #include "frenetic/traj/frenet.h"
+#include "plan/predictor_options.h"
 #include "plan/search_checks.h"
 #include "plan/search_context.h"
 #include "plan/search_continuity.h"
@@ -39,12 +40,7 @@ double SteadyMs() {
 std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
                                          std::shared_ptr<const map::ReferenceLine> line,
                                          const search::Settings& cfg) {
-  PredictorOptions po;
-  po.range = config.value("prediction.range");
-  po.d_min = config.value("prediction.d_min");
-  po.d_max = config.value("prediction.d_max");
-  po.max_speed = config.value("prediction.max_speed");
-  po.spike_ratio = config.value("prediction.spike_ratio");
+  PredictorOptions po = BasicPredictorOptions(config);
   po.brake_threshold = config.value("prediction.brake_threshold");
   po.brake_horizon = config.value("prediction.brake_horizon");
   po.lateral_threshold = config.value("prediction.lateral_threshold");

@@ -75,6 +75,13 @@ class ServerProcess {
 // The planner's deadlines are wall-clock: on a loaded machine two drives could differ because
 // of them alone. `serve --no-deadlines` switches them off as `drive` does, so both sides run the
 // shipped configuration in full (refinement included) and only the wire differs.
+std::string DeterministicServeArgs() {
+  return "--map " + UdacityMap() + " --no-deadlines --status-interval 1000";
+}
+std::string ClientUrl(int port) {
+  return "ws://127.0.0.1:" + std::to_string(port) + "/socket.io/?EIO=4&transport=websocket";
+}
+
 // The in-process drive rounds every telemetry number and every path point as the wire does
 // (wire_precision.h), so the same seed gives the same drive through `serve` + `drive --connect`:
 // the whole report is equal except what cannot be: planning times (round trips over the wire),
@@ -82,11 +89,9 @@ class ServerProcess {
 // over the wire: manual replies).
 TEST(ServeDrive, NetworkDriveEqualsInProcessDrive) {
   if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
-  ServerProcess server("--map " + UdacityMap() + " --no-deadlines" +
-                       " --status-interval 1000");
+  ServerProcess server(DeterministicServeArgs());
   ASSERT_GT(server.port(), 0) << "serve did not print its port";
-  const std::string url =
-      "ws://127.0.0.1:" + std::to_string(server.port()) + "/socket.io/?EIO=4&transport=websocket";
+  const std::string url = ClientUrl(server.port());
   for (const char* latency : {"lockstep", "random"}) {
     for (int seed = 1; seed <= 5; ++seed) {
       SCOPED_TRACE(std::string(latency) + " seed " + std::to_string(seed));
@@ -122,11 +127,9 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
 // internals, and `frenetic report` makes the page from it.
 TEST(ServeDrive, RemoteDriveIsRecordedAndReported) {
   if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
-  ServerProcess server("--map " + UdacityMap() + " --no-deadlines" +
-                       " --status-interval 1000");
+  ServerProcess server(DeterministicServeArgs());
   ASSERT_GT(server.port(), 0) << "serve did not print its port";
-  const std::string url =
-      "ws://127.0.0.1:" + std::to_string(server.port()) + "/socket.io/?EIO=4&transport=websocket";
+  const std::string url = ClientUrl(server.port());
   const std::string dir = ::testing::TempDir();
   const std::string common = "drive --map " + UdacityMap() +
                              " --seconds 10 --seed 3 --latency random --no-timing --json";
