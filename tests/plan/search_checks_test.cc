@@ -126,11 +126,17 @@ TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
   EXPECT_TRUE(st.checker.Collides());
   st.WriteTicks(kS, 8, 6.0, [](double) { return 0.0; });
   EXPECT_FALSE(st.checker.Collides());
-  // Cutting into a lane 10 m in front of a car there: bare boxes clear, but the room behind
-  // (kept even at margin scale 0) is not.
-  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - 10, 2.0, 20}});
+  // Cutting into a lane in front of a car there at the same speed, half the room behind
+  // (margin_behind) away: bare boxes clear, but the room behind (kept even at margin scale 0)
+  // is not. A metre beyond the room it is.
+  const double tight = st.cfg.car_length + 0.5 * st.cfg.margin_behind;
+  ASSERT_GT(0.5 * st.cfg.margin_behind, 1.0);
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - tight, 2.0, 20}});
   EXPECT_LT(st.checker.FirstCollision(steady(kS, 20, 2.0), 0.0, 1.0), none);
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 0.0, 0.0), none);
+  const double roomy = st.cfg.car_length + st.cfg.margin_behind + 1.0;
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - roomy, 2.0, 20}});
+  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 0.0, 1.0), none);
   // The same car in the ego's own lane at the start is its follower's business.
   st.Prepare({kS, 20, 0, 2.0, 0, 0}, {{kS - 10, 2.0, 20}});
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 1.0, 1.0), none);
