@@ -196,7 +196,7 @@ TEST(PlannerFactoryTest, NamesAndErrors) {
   EXPECT_NE(bad.message().find("teleport"), std::string::npos);
 }
 
-TEST(SearchPlannerTest, FromStandstillReaches45MphWithinLimitsMeasuredLikeTheSimulator) {
+TEST(SearchPlannerTest, FromStandstillReaches45MphInUnder5point5SecondsWithinLimits) {
   REQUIRE_MAP(line);
   auto planner = Make("search", line);
   ASSERT_NE(planner, nullptr);
@@ -211,6 +211,9 @@ TEST(SearchPlannerTest, FromStandstillReaches45MphWithinLimitsMeasuredLikeTheSim
   }
   RecordProperty("seconds_to_45mph", std::to_string(reached));
   EXPECT_GT(reached, 0) << "never reached 45 mph in 15 s";
+  // Progress outweighs comfort (the jerk and acceleration limits are hard checks): with the
+  // comfort terms at weight 1 the ego took 6.9 s.
+  EXPECT_LT(reached, 5.5);
   for (int phase = 0; phase < 10; ++phase) {
     const XyMeasure m = MeasureLikeSimulator(loop.driven_x_, loop.driven_y_, phase);
     EXPECT_LT(m.max_speed, 50 * kMph) << "phase " << phase;
