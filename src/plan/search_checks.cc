@@ -28,6 +28,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   near_.assign(w, 0);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
+  verdicts_.resize(ws_.order.capacity());
 }
 
 
@@ -86,6 +87,19 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
           lat_dd_.data() + k * w, ws_.collision_step, near_.data()};
 }
 
+Checker::Rows Checker::StepRows(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = ws_.n_steps + 1;
+  // A bundle sampled anew here has no reach tests yet (traffic_stamp is never 0 in a cycle).
+  if (SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_)) {
+    lon_near_key_[i].stamp = 0;
+  }
+  if (SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_)) {
+    lat_near_stamp_[k] = 0;
+  }
+  return {lon_s_.data() + i * w, lat_d_.data() + k * w};
+}
+
 void Checker::FillTicks(const traj::FrenetTrajectory& tr, double t0) {
   for (int i = 1; i <= ws_.n_ticks; ++i) {
     const traj::FrenetState st = tr.At(t0 + i * kTickSeconds);
@@ -111,6 +125,23 @@ void Checker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n
   }
   first_new_ = n;
   xy_.SetPrefix(chk_x_.data(), chk_y_.data(), n);
+  ++prefix_stamp_;
+}
+
+double Checker::CandidateViolation(int c, Reject* reason) {
+  const traj::FrenetTrajectory tr = ws_.Candidate(c);
+  Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
+  if (v != nullptr && v->prefix_stamp == prefix_stamp_ && v->straddle == ws_.straddle_at_start &&
+      std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
+    if (reason != nullptr) *reason = v->why;
+    return v->worst;
+  }
+  FillTicks(tr);
+  Reject why = Reject::kCount;
+  const double worst = Violation(&why);
+  if (reason != nullptr) *reason = why;
+  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst};
+  return worst;
 }
 
 int Checker::BuildXyPath() {

@@ -84,6 +84,12 @@ class Checker {
   // (the least-harm choice may drop it: a collision is worse). NaN counts as a violation.
   double Violation(Reject* reason, bool lane_line = true);
 
+  // Candidate c's Violation(reason) (lane-line timer included) after FillTicks of it,
+  // remembered for its trajectory until the next SetXyPrefix: the least-harm choice asks again
+  // about candidates the lazy check has measured. A remembered verdict leaves ws.tk_* as they
+  // are (not c's ticks then).
+  double CandidateViolation(int c, Reject* reason);
+
   // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
   bool Collides() const {
     return FirstCollision(
@@ -111,6 +117,14 @@ class Checker {
   // once per cycle's traffic (ws.traffic_stamp) and scales, so the many candidates that share
   // it do not evaluate its polynomial or visit every car again. Valid until the next call.
   StepStates StepsOf(int c, double margin_scale = 1.0, double behind_scale = 1.0);
+
+  // Candidate c's s and d at the collision-check steps (rows [0, n_steps], the same values as
+  // StepsOf's), without the reach tests; sampled like StepsOf, and valid as long as its rows.
+  struct Rows {
+    const double* s;
+    const double* d;
+  };
+  Rows StepRows(int c);
 
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
   // away can collide (+inf when the margins cannot be bounded).
@@ -145,6 +159,18 @@ class Checker {
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
+  // CandidateViolation's verdicts per candidate index, with what they were measured for: the
+  // trajectory, the XY prefix (prefix_stamp_, counted by SetXyPrefix) and the start's
+  // lane-line count.
+  struct Verdict {
+    traj::FrenetTrajectory tr;
+    std::uint64_t prefix_stamp = 0;
+    int straddle = 0;
+    Reject why = Reject::kCount;
+    double worst = 0;
+  };
+  std::vector<Verdict> verdicts_;
+  std::uint64_t prefix_stamp_ = 1;
 };
 
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=

@@ -283,9 +283,8 @@ class SearchPlanner : public Planner {
               hit * ws_.collision_step * kTickSeconds);
         continue;
       }
-      checker_.FillTicks(ws_.Candidate(c));
       Reject why = Reject::kCount;
-      if (checker_.Violation(&why) > 0) {
+      if (checker_.CandidateViolation(c, &why) > 0) {
         ++sum.rejections[static_cast<int>(why)];
         Trace(r, false, static_cast<int>(why));
         continue;
