@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "frenetic/plan/planner.h"
 #include "plan/search_scoring.h"
@@ -16,9 +17,86 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const
     : cfg_(cfg), ws_(ws), checker_(checker), clock_(clock) {
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
+  bound_.reserve(ws_.order.capacity());
+  heap_.reserve(ws_.order.capacity());
 }
 
 bool LeastHarm::Choose(bool* over_budget) {
+  const int best = BestClear(over_budget);
+  if (best >= 0) {
+    ws_.TakeWinner(best);
+    return true;
+  }
+  return !*over_budget && ChooseByRanking(over_budget);
+}
+
+// In harm order the collision-free candidates come first, by clearance, then cost: when one
+// of them is feasible the winner is the feasible collision-free one with the most clearance
+// (then the least cost, then the smallest index), a maximum found without ranking the others.
+// The candidates are visited by an upper bound of their clearance, the minimum over a few
+// steps only (a minimum over fewer separations is never smaller), best first, so that the
+// visit ends once no bound can reach the best clearance found; the clearance itself stops as
+// soon as it falls below that, and only a candidate that would rank before the best one is
+// tested for collision, then for feasibility.
+int LeastHarm::BestClear(bool* over_budget) {
+  const std::vector<int>& order = ws_.order;
+  const int n = static_cast<int>(order.size());
+  const int n_steps = ws_.n_steps;
+  // The bound's steps: the first ones (where every candidate is still near the start, and the
+  // clearance is often smallest) and a few spread over the horizon.
+  const int probe[8] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+  bound_.resize(ws_.cand_cost.size());
+  heap_.resize(n);
+  for (int r = 0; r < n; ++r) {
+    const int c = order[r];
+    const Checker::Rows rows = checker_.StepRows(c);
+    double b = 1e9;
+    for (int car = 0; car < ws_.ctx.num_cars; ++car) {
+      const double* cs = ws_.step_s.data() + car * (n_steps + 1);
+      const double* cd = ws_.step_d.data() + car * (n_steps + 1);
+      for (const int j : probe) {
+        if (j < 1 || j > n_steps) continue;
+        const double sep = std::max(std::abs(cs[j] - rows.s[j]) - cfg_.car_length,
+                                    std::abs(cd[j] - rows.d[j]) - cfg_.car_width);
+        b = sep < b ? sep : b;
+      }
+    }
+    bound_[c] = b;
+    heap_[r] = c;
+  }
+  // Largest bound first, then the smallest index (any order gives the same maximum; this one
+  // is deterministic).
+  const auto lower = [this](int a, int b) {
+    return bound_[a] < bound_[b] || (bound_[a] == bound_[b] && a > b);
+  };
+  std::make_heap(heap_.begin(), heap_.end(), lower);
+  int best = -1;
+  double best_clr = 0;
+  for (int k = 0; !heap_.empty(); ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const int c = heap_.front();
+    if (best >= 0 && bound_[c] < best_clr) break;
+    std::pop_heap(heap_.begin(), heap_.end(), lower);
+    heap_.pop_back();
+    const Checker::Rows rows = checker_.StepRows(c);
+    const double floor = best >= 0 ? best_clr : -std::numeric_limits<double>::infinity();
+    const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, floor);
+    if (best >= 0 && (clr < best_clr || (clr == best_clr && !Cheaper(ws_, c, best)))) continue;
+    if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+        n_steps) {
+      continue;
+    }
+    if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+    best = c;
+    best_clr = clr;
+  }
+  return best;
+}
+
+bool LeastHarm::ChooseByRanking(bool* over_budget) {
   std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   first_hit_.resize(n);
@@ -49,8 +127,12 @@ bool LeastHarm::Choose(bool* over_budget) {
         return false;
       }
       const int c = order[r];
-      checker_.FillTicks(ws_.Candidate(c));
-      if (checker_.Violation(nullptr, lane_line) > 0) continue;
+      if (lane_line) {
+        if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+      } else {
+        checker_.FillTicks(ws_.Candidate(c));
+        if (checker_.Violation(nullptr, false) > 0) continue;
+      }
       ws_.TakeWinner(c);
       return true;
     }

@@ -63,25 +63,58 @@ inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepSt
   return worst;
 }
 
+// ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
+// `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
+// minimum, car by car: the order does not change a minimum that ignores NaN.
+inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const double* s,
+                             const double* d, double floor) {
+  const int n_steps = ws.n_steps;
+  double worst = 1e9;
+  for (int c = 0; c < ws.ctx.num_cars; ++c) {
+    const double* cs = ws.step_s.data() + c * (n_steps + 1);
+    const double* cd = ws.step_d.data() + c * (n_steps + 1);
+    double row = 1e9;
+    for (int j = 1; j <= n_steps; ++j) {
+      const double sep =
+          std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
+      row = sep < row ? sep : row;
+    }
+    worst = row < worst ? row : worst;
+    if (worst < floor) break;
+  }
+  return worst;
+}
+
 class LeastHarm {
  public:
   // `ws`, `checker` and `clock` must outlive this; sized for ws's largest candidate set.
   LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock);
 
-  // Ranks the scored candidates ws.order by harm (latest contact, then most clearance, then
-  // cost; ws.order is left in that order) and makes the first feasible one the winner, else
-  // the first feasible but for the lane-line timer. False when none is even that, or when the
-  // deadline (85% of budget_ms) cut it short: then *over_budget is set.
+  // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
+  // contact, then most clearance, then cost), the first feasible one, else the first feasible
+  // but for the lane-line timer. Every ws.cand_cost must be exact. When a collision-free
+  // candidate is feasible only the ones that could rank first are examined and ws.order is left
+  // as it is; else every candidate is ranked and ws.order is left in harm order. False when
+  // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
+  // short: then *over_budget is set.
   bool Choose(bool* over_budget);
 
  private:
+  // The first feasible collision-free candidate in harm order, -1 when there is none (or the
+  // deadline cut it short: then *over_budget is set).
+  int BestClear(bool* over_budget);
+  // The whole ranking: every candidate's contact and clearance, ws.order sorted by harm.
+  bool ChooseByRanking(bool* over_budget);
+
   const Settings& cfg_;
   Workspace& ws_;
   Checker& checker_;
   const CycleClock& clock_;
-  // Per candidate: first collision step and clearance on bare boxes.
+  // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking), and an
+  // upper bound of the clearance (BestClear).
   std::vector<int> first_hit_;
-  std::vector<double> clearance_;
+  std::vector<double> clearance_, bound_;
+  std::vector<int> heap_;  // BestClear's candidates, a heap by bound
 };
 
 }  // namespace frenetic::plan::search

@@ -67,10 +67,25 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   ASSERT_TRUE(st.least_harm.Choose(&over_budget));
   EXPECT_FALSE(over_budget);
   EXPECT_EQ(st.ws.winner_index, 2);
-  EXPECT_EQ(st.ws.order[0], 2);
-  EXPECT_EQ(st.ws.order[1], 1);
-  EXPECT_EQ(st.ws.order[2], 0) << "the collision last";
-  EXPECT_EQ(st.ws.sorted, 3);
+  // Without the roomiest one, the next in room; without both, the collision.
+  SetCandidates(st, {{20, 3.0, 1.0}, {10, 4.0, 2.0}});
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 1);
+  SetCandidates(st, {{20, 3.0, 1.0}});
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 0);
+  EXPECT_EQ(st.ws.sorted, 1) << "every candidate collides: the whole ranking";
+}
+
+TEST(SearchLeastHarmTest, EqualClearanceGoesToTheLowerCost) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
+  // The same trajectory twice: the same clearance, the cost decides, then the index.
+  SetCandidates(st, {{10, 3.0, 3.0}, {10, 4.0, 2.0}, {10, 3.0, 1.0}, {10, 3.0, 1.0}});
+  bool over_budget = false;
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 2);
 }
 
 TEST(SearchLeastHarmTest, TakesTheLatestContactWhenAllCollideAndCostBreaksTies) {
