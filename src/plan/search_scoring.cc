@@ -23,6 +23,7 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   pos_.reserve(cap);
   pending_.reserve(cap);
   ready_.reserve(cap);
+  resolved_.assign(cap, 1);
 }
 
 cost::CostInput Scorer::InputFor(int i, int j) const {
@@ -52,6 +53,8 @@ bool Scorer::Score() {
   ws_.order.resize(n);
   bound_.resize(n);
   pos_.resize(n);
+  if (resolved_.size() < static_cast<std::size_t>(n)) resolved_.resize(n);
+  std::fill(resolved_.begin(), resolved_.begin() + n, 0);
   ws_.sorted = 0;
   pending_.clear();
   ready_.clear();
@@ -73,7 +76,14 @@ bool Scorer::Score() {
   return scored == n;
 }
 
+double Scorer::ExactCost(int c) {
+  if (c < static_cast<int>(resolved_.size())) Resolve(c);
+  return ws_.cand_cost[c];
+}
+
 void Scorer::Resolve(int c) {
+  if (resolved_[c]) return;
+  resolved_[c] = 1;
   const double v = costs_.Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
 }
