@@ -195,6 +195,10 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
   const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
+    // No car within reach at this step: nothing to test (and no square root to take).
+    if constexpr (requires { state_at.Near(j); }) {
+      if ((state_at.Near(j) & cars) == 0) continue;
+    }
     const traj::FrenetState st = state_at(j * ws_.collision_step);
     const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
     const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);

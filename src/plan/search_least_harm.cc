@@ -13,8 +13,9 @@ double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTra
   return ClearanceAt(cfg, ws, [&](int i) { return tr.At(i * kTickSeconds); });
 }
 
-LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock)
-    : cfg_(cfg), ws_(ws), checker_(checker), clock_(clock) {
+LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+                     const CycleClock& clock)
+    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
   bound_.reserve(ws_.order.capacity());
@@ -84,12 +85,17 @@ int LeastHarm::BestClear(bool* over_budget) {
     const Checker::Rows rows = checker_.StepRows(c);
     const double floor = best >= 0 ? best_clr : -std::numeric_limits<double>::infinity();
     const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, floor);
-    if (best >= 0 && (clr < best_clr || (clr == best_clr && !Cheaper(ws_, c, best)))) continue;
+    if (best >= 0 && clr < best_clr) continue;
+    if (best >= 0 && clr == best_clr) {  // the cost decides (both exact), then the index
+      scorer_.ExactCost(c);
+      if (!Cheaper(ws_, c, best)) continue;
+    }
     if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
         n_steps) {
       continue;
     }
     if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+    scorer_.ExactCost(c);
     best = c;
     best_clr = clr;
   }
@@ -97,6 +103,10 @@ int LeastHarm::BestClear(bool* over_budget) {
 }
 
 bool LeastHarm::ChooseByRanking(bool* over_budget) {
+  if (!scorer_.ResolveAll()) {
+    *over_budget = true;
+    return false;
+  }
   std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   first_hit_.resize(n);

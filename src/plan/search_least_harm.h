@@ -11,6 +11,7 @@
 
 #include "frenetic/traj/frenet.h"
 #include "plan/search_checks.h"
+#include "plan/search_scoring.h"
 #include "plan/search_settings.h"
 #include "plan/search_workspace.h"
 
@@ -87,12 +88,15 @@ inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const dou
 
 class LeastHarm {
  public:
-  // `ws`, `checker` and `clock` must outlive this; sized for ws's largest candidate set.
-  LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock);
+  // `ws`, `scorer`, `checker` and `clock` must outlive this; sized for ws's largest candidate
+  // set.
+  LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+            const CycleClock& clock);
 
   // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
   // contact, then most clearance, then cost), the first feasible one, else the first feasible
-  // but for the lane-line timer. Every ws.cand_cost must be exact. When a collision-free
+  // but for the lane-line timer. Costs are made exact as the ranking needs them
+  // (Scorer::ExactCost; all of them for the whole ranking). When a collision-free
   // candidate is feasible only the ones that could rank first are examined and ws.order is left
   // as it is; else every candidate is ranked and ws.order is left in harm order. False when
   // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
@@ -108,6 +112,7 @@ class LeastHarm {
 
   const Settings& cfg_;
   Workspace& ws_;
+  Scorer& scorer_;
   Checker& checker_;
   const CycleClock& clock_;
   // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking), and an

@@ -28,6 +28,9 @@ namespace frenetic::plan {
 namespace {
 
 using search::Finite;
+
+// CheckLazily tests the rest of the candidates at once after this many ranks at least.
+constexpr int kCheckRestMin = 64;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
 
@@ -65,10 +68,13 @@ class SearchPlanner : public Planner {
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
         checker_(cfg_, *line_, ws_),
-        least_harm_(cfg_, ws_, checker_, timer_),
+        least_harm_(cfg_, ws_, scorer_, checker_, timer_),
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
+    hit_step_.assign(ws_.order.capacity(), 0);
+    hit_car_.assign(ws_.order.capacity(), -1);
+    free_.reserve(ws_.order.capacity());
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -181,8 +187,6 @@ class SearchPlanner : public Planner {
       const double t_check = Elapsed();
       bool check_cut = false;
       found = CheckLazily(&check_cut);
-      // The least-harm choice ranks every candidate: every cost must be exact first.
-      if (!found && !check_cut && !scorer_.ResolveAll()) check_cut = true;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut);
       if (check_cut) {
         over_budget = true;
@@ -259,13 +263,26 @@ class SearchPlanner : public Planner {
   // Checks the scored candidates in cost order, sorting lazily, until one passes: the
   // Frenet-only collision test first, then the hard limits. False when none passed or the
   // deadline (85% of budget_ms) cut it short (then *over_budget is set).
+  // After the first quarter of the candidates (and the traced ones) have failed, the rest are
+  // tested at once, in any order (CheckRest): when none of them passes either, the cycle ends
+  // without the exact cost of every candidate that the walk in cost order would need.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
+    const int rest_at = std::max({kCheckRestMin, n / 4, trace_ != nullptr ? trace_max_ : 0});
+    bool tested = false;  // the collisions of ranks >= rest_at are in hit_step_, hit_car_
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
+      }
+      if (r == rest_at) {
+        bool cut = false;
+        tested = true;
+        if (!CheckRest(r, &cut)) {
+          if (cut) *over_budget = true;
+          return false;
+        }
       }
       if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
         *over_budget = true;
@@ -275,8 +292,9 @@ class SearchPlanner : public Planner {
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
       // conversion for the many candidates that run into traffic.
-      int hit_car = -1;
-      const int hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+      int hit_car = tested ? hit_car_[c] : -1;
+      const int hit = tested ? hit_step_[c]
+                             : checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
       if (hit <= ws_.n_steps) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
@@ -299,6 +317,44 @@ class SearchPlanner : public Planner {
         Trace(rr, false, -1);
       }
       return true;
+    }
+    return false;
+  }
+
+  // Tests every candidate of ranks [r0, n) for collision, then the collision-free ones for the
+  // hard limits in cost order until one passes: true then (the walk in cost order goes on, and
+  // stops at it). Otherwise every one of them counts as checked and rejected, as the walk would
+  // have counted them, and false (*cut set when the deadline cut it short).
+  bool CheckRest(int r0, bool* cut) {
+    const int n = static_cast<int>(ws_.order.size());
+    free_.clear();
+    for (int k = r0; k < n; ++k) {
+      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+        *cut = true;
+        return false;
+      }
+      const int c = ws_.order[k];
+      hit_car_[c] = -1;
+      hit_step_[c] = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car_[c]);
+      if (hit_step_[c] > ws_.n_steps) free_.push_back(c);
+    }
+    for (const int c : free_) scorer_.ExactCost(c);
+    std::sort(free_.begin(), free_.end(),
+              [this](int a, int b) { return search::Cheaper(ws_, a, b); });
+    for (int k = 0; k < static_cast<int>(free_.size()); ++k) {
+      if ((k & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
+        *cut = true;
+        return false;
+      }
+      if (checker_.CandidateViolation(free_[k], nullptr) <= 0) return true;
+    }
+    PlanSummary& sum = result_.summary;
+    for (int k = r0; k < n; ++k) {
+      const int c = ws_.order[k];
+      ++sum.candidates_checked;
+      Reject why = Reject::kCollision;
+      if (hit_step_[c] > ws_.n_steps) checker_.CandidateViolation(c, &why);
+      ++sum.rejections[static_cast<int>(why)];
     }
     return false;
   }
@@ -376,6 +432,9 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
+  // CheckRest: per candidate, the first collision step (n_steps + 1: none) and the car hit; the
+  // collision-free candidates.
+  std::vector<int> hit_step_, hit_car_, free_;
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
