@@ -29,6 +29,29 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
+  const std::size_t wt = ws_.n_ticks + 1;
+  for (auto [rows, n] : {std::pair{&lon_ticks_, n_lon}, std::pair{&lat_ticks_, n_lat}}) {
+    rows->key.resize(n);
+    rows->have.assign(n, 0);
+    for (auto* v : {&rows->p, &rows->v, &rows->a}) v->assign(n * wt, 0.0);
+  }
+  lon_centre_.resize(n_lon * wt);
+}
+
+bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
+                          std::vector<map::CentrePoint>* centre) {
+  if (rows.have[i] && std::memcmp(&rows.key[i], &tr, sizeof(tr)) == 0) return false;
+  const int w = ws_.n_ticks + 1;
+  for (int t = 1; t <= ws_.n_ticks; ++t) {
+    const traj::State1d st = tr.At(0.0 + t * kTickSeconds);  // FillTicks' time, t0 = 0
+    rows.p[i * w + t] = st.p;
+    rows.v[i * w + t] = st.v;
+    rows.a[i * w + t] = st.a;
+    if (centre != nullptr) (*centre)[i * w + t] = line_.Centre(st.p);
+  }
+  std::memcpy(&rows.key[i], &tr, sizeof(tr));
+  rows.have[i] = 1;
+  return true;
 }
 
 
@@ -136,25 +159,46 @@ double Checker::CandidateViolation(int c, Reject* reason) {
     if (reason != nullptr) *reason = v->why;
     return v->worst;
   }
-  FillTicks(tr);
+  // FillTicks' values, from the bundles' rows: the candidates of a bundle share its ticks and
+  // the centre line there.
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  SampleTicks(tr.lon, i, lon_ticks_, &lon_centre_);
+  SampleTicks(tr.lat, k, lat_ticks_, nullptr);
+  const int w = ws_.n_ticks + 1;
+  const std::size_t bytes = ws_.n_ticks * sizeof(double);
+  std::memcpy(&ws_.tk_s[1], &lon_ticks_.p[i * w + 1], bytes);
+  std::memcpy(&ws_.tk_sd[1], &lon_ticks_.v[i * w + 1], bytes);
+  std::memcpy(&ws_.tk_sdd[1], &lon_ticks_.a[i * w + 1], bytes);
+  std::memcpy(&ws_.tk_d[1], &lat_ticks_.p[k * w + 1], bytes);
+  std::memcpy(&ws_.tk_dd[1], &lat_ticks_.v[k * w + 1], bytes);
+  std::memcpy(&ws_.tk_ddd[1], &lat_ticks_.a[k * w + 1], bytes);
   Reject why = Reject::kCount;
-  const double worst = Violation(&why);
+  const double worst = Measure(&why, true, &lon_centre_[i * w]);
   if (reason != nullptr) *reason = why;
   if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst};
   return worst;
 }
 
-int Checker::BuildXyPath() {
+int Checker::BuildXyPath(const map::CentrePoint* centre) {
   int n = first_new_;
   for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
-    const map::CartesianPose p = line_.ToCartesian(ws_.tk_s[i], ws_.tk_d[i]);
-    chk_x_[n] = p.x;
-    chk_y_[n] = p.y;
+    if (centre != nullptr) {
+      chk_x_[n] = centre[i].OffsetX(ws_.tk_d[i]);
+      chk_y_[n] = centre[i].OffsetY(ws_.tk_d[i]);
+    } else {
+      const map::CartesianPose p = line_.ToCartesian(ws_.tk_s[i], ws_.tk_d[i]);
+      chk_x_[n] = p.x;
+      chk_y_[n] = p.y;
+    }
   }
   return n;
 }
 
 double Checker::Violation(Reject* reason, bool lane_line) {
+  return Measure(reason, lane_line, nullptr);
+}
+
+double Checker::Measure(Reject* reason, bool lane_line, const map::CentrePoint* centre) {
   const int n_ticks = ws_.n_ticks;
   const std::vector<double>& tk_s = ws_.tk_s;
   const std::vector<double>& tk_d = ws_.tk_d;
@@ -196,7 +240,7 @@ double Checker::Violation(Reject* reason, bool lane_line) {
     if (reason != nullptr) *reason = why;
     return worst;
   }
-  const int n = BuildXyPath();
+  const int n = BuildXyPath(centre);
   const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
   take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);

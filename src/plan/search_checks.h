@@ -136,8 +136,21 @@ class Checker {
   bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
                    std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
 
-  // Appends the ticks to the XY prefix; returns the path length.
-  int BuildXyPath();
+  // Appends the ticks to the XY prefix (centre: the centre line at tk_s, or null); returns the
+  // path length.
+  int BuildXyPath(const map::CentrePoint* centre);
+  // Violation, with the centre line at tk_s when known (CandidateViolation).
+  double Measure(Reject* reason, bool lane_line, const map::CentrePoint* centre);
+  // Bundle trajectory `tr` (slot i) at every tick [1, n_ticks], FillTicks' values, in the rows
+  // of p / v / a (and the centre line at p when centre is not null) unless kept; true when
+  // sampled anew.
+  struct TickRows {
+    std::vector<traj::Trajectory1d> key;
+    std::vector<char> have;
+    std::vector<double> p, v, a;
+  };
+  bool SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
+                   std::vector<map::CentrePoint>* centre);
 
   const Settings& cfg_;
   const map::ReferenceLine& line_;
@@ -170,6 +183,9 @@ class Checker {
     double worst = 0;
   };
   std::vector<Verdict> verdicts_;
+  // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
+  TickRows lon_ticks_, lat_ticks_;
+  std::vector<map::CentrePoint> lon_centre_;
   std::uint64_t prefix_stamp_ = 1;
 };
 
