@@ -29,6 +29,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
+  last_hit_.assign(n_lon, LastHit{});
   const std::size_t wt = ws_.n_ticks + 1;
   for (auto [rows, n] : {std::pair{&lon_ticks_, n_lon}, std::pair{&lat_ticks_, n_lat}}) {
     rows->key.resize(n);
@@ -121,6 +122,26 @@ Checker::Rows Checker::StepRows(int c) {
     lat_near_stamp_[k] = 0;
   }
   return {lon_s_.data() + i * w, lat_d_.data() + k * w};
+}
+
+bool Checker::CandidateCollides(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = ws_.n_steps + 1;
+  LastHit& last = last_hit_[i];
+  if (last.stamp == ws_.traffic_stamp) {
+    // A hit there is one FirstCollision finds too, at that step at the latest (the car passes
+    // the same reach tests).
+    StepRows(c);
+    const int j = last.step;
+    const traj::FrenetState st{lon_s_[i * w + j], lon_sd_[i * w + j], 0.0,
+                               lat_d_[k * w + j], lat_dd_[k * w + j], 0.0};
+    if (HitsAt(EgoAt(st, 1.0, 1.0), j, last.car, 1.0, 1.0)) return true;
+  }
+  int car = -1;
+  const int hit = FirstCollision(StepsOf(c), 1.0, 1.0, &car);
+  if (hit > ws_.n_steps) return false;
+  last = {ws_.traffic_stamp, hit, car};
+  return true;
 }
 
 void Checker::FillTicks(const traj::FrenetTrajectory& tr, double t0) {

@@ -126,11 +126,22 @@ class Checker {
   };
   Rows StepRows(int c);
 
+  // Whether candidate c collides with the inflated boxes: FirstCollision(StepsOf(c)) <=
+  // n_steps, the same answer, but the step and car that the last colliding candidate of its
+  // lon bundle hit are tried first (the candidates of a bundle mostly run into the same car at
+  // the same step), which spares the scan of the steps before.
+  bool CandidateCollides(int c);
+
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
   // away can collide (+inf when the margins cannot be bounded).
   double ReachS(double s_d, double margin_scale, double behind_scale) const;
 
  private:
+  // FirstCollision at one step: the ego there, and whether car c collides with it.
+  struct StepEgo;
+  StepEgo EgoAt(const traj::FrenetState& st, double margin_scale, double behind_scale) const;
+  bool HitsAt(const StepEgo& e, int j, int c, double margin_scale, double behind_scale) const;
+
   // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept; true
   // when sampled anew.
   bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
@@ -183,6 +194,12 @@ class Checker {
     double worst = 0;
   };
   std::vector<Verdict> verdicts_;
+  // CandidateCollides: per lon slot, the last step and car hit, and the traffic they were for.
+  struct LastHit {
+    std::uint64_t stamp = 0;
+    int step = 0, car = 0;
+  };
+  std::vector<LastHit> last_hit_;
   // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
   TickRows lon_ticks_, lat_ticks_;
   std::vector<map::CentrePoint> lon_centre_;
@@ -203,64 +220,78 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
   return 8 + widest;
 }
 
+// FirstCollision's ego at one step.
+struct Checker::StepEgo {
+  traj::OrientedBox box;
+  double s_d = 0;          // the state's s'
+  double dir_s, dir_d;     // unit heading (s', d') with s' at least 0.5
+  double reach_s;          // ReachS
+};
+
+inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
+                                       double behind_scale) const {
+  const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
+  const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.car_length, 0.5 * cfg_.car_width}, st.s_d,
+          vs * inv, vd * inv, ReachS(st.s_d, margin_scale, behind_scale)};
+}
+
+inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
+                            double behind_scale) const {
+  const traj::OrientedBox& ego = e.box;
+  const int at = c * (ws_.n_steps + 1) + j;
+  const double cs = ws_.step_s[at], cd = ws_.step_d[at];
+  if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > e.reach_s) return false;
+  // A car behind in another lane than the start's is one the ego would cut in front of:
+  // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
+  // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
+  // A car ahead needs room to brake behind it: headway_min at the ego's speed.
+  const bool behind_other_lane =
+      cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
+  // A car behind in another lane needs room to react and brake when it closes in.
+  const double closing = std::max(0.0, ws_.step_v[at] - e.s_d);
+  // The headway to a car ahead is kept in full while the ego is in its lane and tapers
+  // to margin_s as the ego moves out of it (pulling out from behind a car is how a
+  // lane change starts).
+  const double inside = std::clamp(
+      (cfg_.car_width - std::abs(cd - ego.cy)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
+  const double margin =
+      cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d)
+      : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
+                          : margin_scale * cfg_.margin_s;
+  if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
+  // The car's heading from its predicted velocity (a lane change turns it).
+  const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
+  const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+  const traj::OrientedBox car{cs, cd, 0.0, ego.half_length + margin,
+                              ego.half_width + margin_scale * cfg_.margin_d};
+  return traj::Overlap(ego, e.dir_s, e.dir_d, car, cv * cinv, cvd * cinv);
+}
+
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit, bool ghosts) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
   const std::uint64_t cars = num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
-  const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
     // No car within reach at this step: nothing to test (and no square root to take).
     if constexpr (requires { state_at.Near(j); }) {
       if ((state_at.Near(j) & cars) == 0) continue;
     }
-    const traj::FrenetState st = state_at(j * ws_.collision_step);
-    const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
-    const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
-    const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
-    const double reach_s = ReachS(st.s_d, margin_scale, behind_scale);
-    // Whether car c collides at step j.
-    const auto hits = [&](int c) {
-      const int at = c * (n_steps + 1) + j;
-      const double cs = ws_.step_s[at], cd = ws_.step_d[at];
-      if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > reach_s) return false;
-      // A car behind in another lane than the start's is one the ego would cut in front of:
-      // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
-      // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
-      // A car ahead needs room to brake behind it: headway_min at the ego's speed.
-      const bool behind_other_lane =
-          cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
-      // A car behind in another lane needs room to react and brake when it closes in.
-      const double closing = std::max(0.0, ws_.step_v[at] - st.s_d);
-      // The headway to a car ahead is kept in full while the ego is in its lane and tapers
-      // to margin_s as the ego moves out of it (pulling out from behind a car is how a
-      // lane change starts).
-      const double inside = std::clamp(
-          (cfg_.car_width - std::abs(cd - st.d)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
-      const double margin =
-          cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * st.s_d)
-          : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
-                              : margin_scale * cfg_.margin_s;
-      if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
-      // The car's heading from its predicted velocity (a lane change turns it).
-      const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
-      const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
-      const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
-      return traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv);
-    };
+    const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
     // Cars in index order either way: the first one hit is the same.
     if constexpr (requires { state_at.Near(j); }) {
       for (std::uint64_t m = state_at.Near(j) & cars; m != 0; m &= m - 1) {
         const int c = std::countr_zero(m);
-        if (hits(c)) {
+        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
           if (car_hit != nullptr) *car_hit = c;
           return j;
         }
       }
     } else {
       for (int c = 0; c < num_cars; ++c) {
-        if (hits(c)) {
+        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
           if (car_hit != nullptr) *car_hit = c;
           return j;
         }

@@ -72,8 +72,7 @@ class SearchPlanner : public Planner {
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
-    hit_step_.assign(ws_.order.capacity(), 0);
-    hit_car_.assign(ws_.order.capacity(), -1);
+    collides_.assign(ws_.order.capacity(), 0);
     free_.reserve(ws_.order.capacity());
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
@@ -270,7 +269,7 @@ class SearchPlanner : public Planner {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
     const int rest_at = std::max({kCheckRestMin, n / 4, trace_ != nullptr ? trace_max_ : 0});
-    bool tested = false;  // the collisions of ranks >= rest_at are in hit_step_, hit_car_
+    bool tested = false;  // the collisions of ranks >= rest_at are in collides_
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
@@ -292,9 +291,15 @@ class SearchPlanner : public Planner {
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
       // conversion for the many candidates that run into traffic.
-      int hit_car = tested ? hit_car_[c] : -1;
-      const int hit = tested ? hit_step_[c]
-                             : checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+      // Past the traced ranks, whether it collides is all the walk needs.
+      int hit_car = -1, hit = ws_.n_steps + 1;
+      if (tested) {
+        hit = collides_[c] ? 1 : hit;
+      } else if (trace_ != nullptr && r < trace_max_) {
+        hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+      } else {
+        hit = checker_.CandidateCollides(c) ? 1 : hit;
+      }
       if (hit <= ws_.n_steps) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
@@ -334,9 +339,8 @@ class SearchPlanner : public Planner {
         return false;
       }
       const int c = ws_.order[k];
-      hit_car_[c] = -1;
-      hit_step_[c] = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car_[c]);
-      if (hit_step_[c] > ws_.n_steps) free_.push_back(c);
+      collides_[c] = checker_.CandidateCollides(c);
+      if (!collides_[c]) free_.push_back(c);
     }
     for (const int c : free_) scorer_.ExactCost(c);
     std::sort(free_.begin(), free_.end(),
@@ -353,7 +357,7 @@ class SearchPlanner : public Planner {
       const int c = ws_.order[k];
       ++sum.candidates_checked;
       Reject why = Reject::kCollision;
-      if (hit_step_[c] > ws_.n_steps) checker_.CandidateViolation(c, &why);
+      if (!collides_[c]) checker_.CandidateViolation(c, &why);
       ++sum.rejections[static_cast<int>(why)];
     }
     return false;
@@ -432,9 +436,9 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
-  // CheckRest: per candidate, the first collision step (n_steps + 1: none) and the car hit; the
-  // collision-free candidates.
-  std::vector<int> hit_step_, hit_car_, free_;
+  // CheckRest: per candidate, whether it collides; the collision-free candidates.
+  std::vector<char> collides_;
+  std::vector<int> free_;
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
