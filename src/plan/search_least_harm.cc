@@ -20,6 +20,10 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   clearance_.reserve(ws_.order.capacity());
   bound_.reserve(ws_.order.capacity());
   heap_.reserve(ws_.order.capacity());
+  lon_done_.reserve(ws_.lon.capacity());
+  lat_done_.reserve(ws_.lat.capacity());
+  lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
+  lat_sep_.assign(ws_.lat.capacity() * kProbes * kMaxCars, 0.0);
 }
 
 bool LeastHarm::Choose(bool* over_budget) {
@@ -43,26 +47,44 @@ int LeastHarm::BestClear(bool* over_budget) {
   const std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   const int n_steps = ws_.n_steps;
+  const int num_cars = ws_.ctx.num_cars;
+  if (n_steps < 1) return -1;  // nothing to bound: the whole ranking
   // The bound's steps: the first ones (where every candidate is still near the start, and the
   // clearance is often smallest) and a few spread over the horizon.
-  const int probe[8] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+  const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+  // The two parts of each separation at those steps, per bundle (computed at its first
+  // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
+  const int row = kProbes * num_cars;
+  lon_done_.assign(ws_.lon.size(), 0);
+  lat_done_.assign(ws_.lat.size(), 0);
+  const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
+                        double* out) {
+    for (int q = 0; q < kProbes; ++q) {
+      const int j = std::clamp(probe[q], 1, n_steps);
+      for (int car = 0; car < num_cars; ++car) {
+        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
+      }
+    }
+  };
   bound_.resize(ws_.cand_cost.size());
   heap_.resize(n);
   for (int r = 0; r < n; ++r) {
     const int c = order[r];
-    const Checker::Rows rows = checker_.StepRows(c);
-    double b = 1e9;
-    for (int car = 0; car < ws_.ctx.num_cars; ++car) {
-      const double* cs = ws_.step_s.data() + car * (n_steps + 1);
-      const double* cd = ws_.step_d.data() + car * (n_steps + 1);
-      for (const int j : probe) {
-        if (j < 1 || j > n_steps) continue;
-        const double sep = std::max(std::abs(cs[j] - rows.s[j]) - cfg_.car_length,
-                                    std::abs(cd[j] - rows.d[j]) - cfg_.car_width);
-        b = sep < b ? sep : b;
-      }
+    const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+    if (!lon_done_[i] || !lat_done_[k]) {
+      const Checker::Rows rows = checker_.StepRows(c);
+      if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
+      if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
+      lon_done_[i] = lat_done_[k] = 1;
     }
-    bound_[c] = b;
+    const double* a = &lon_sep_[i * row];
+    const double* b = &lat_sep_[k * row];
+    double bound = 1e9;
+    for (int q = 0; q < row; ++q) {
+      const double sep = std::max(a[q], b[q]);
+      bound = sep < bound ? sep : bound;
+    }
+    bound_[c] = bound;
     heap_[r] = c;
   }
   // Largest bound first, then the smallest index (any order gives the same maximum; this one

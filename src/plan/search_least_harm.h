@@ -120,6 +120,10 @@ class LeastHarm {
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
+  // BestClear's bound: its steps, and the separations' parts there per bundle.
+  static constexpr int kProbes = 8;
+  std::vector<char> lon_done_, lat_done_;
+  std::vector<double> lon_sep_, lat_sep_;
 };
 
 }  // namespace frenetic::plan::search
