@@ -29,7 +29,8 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
-  last_hit_.assign(n_lon, LastHit{});
+  last_hit_.assign(2 * n_lon, LastHit{});
+  lat_last_hit_.assign(n_lat, LastHit{});
   const std::size_t wt = ws_.n_ticks + 1;
   for (auto [rows, n] : {std::pair{&lon_ticks_, n_lon}, std::pair{&lat_ticks_, n_lat}}) {
     rows->key.resize(n);
@@ -127,20 +128,27 @@ Checker::Rows Checker::StepRows(int c) {
 bool Checker::CandidateCollides(int c) {
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = ws_.n_steps + 1;
-  LastHit& last = last_hit_[i];
-  if (last.stamp == ws_.traffic_stamp) {
-    // A hit there is one FirstCollision finds too, at that step at the latest (the car passes
-    // the same reach tests).
-    StepRows(c);
-    const int j = last.step;
+  // A hit at a remembered step and car is one FirstCollision finds too, at that step at the
+  // latest (the car passes the same reach tests): the lon bundle's last two, its lat bundle's
+  // last one.
+  LastHit* const hints[3] = {&last_hit_[2 * i], &last_hit_[2 * i + 1], &lat_last_hit_[k]};
+  bool sampled = false;
+  for (const LastHit* h : hints) {
+    if (h->stamp != ws_.traffic_stamp) continue;
+    if (!sampled) StepRows(c);
+    sampled = true;
+    const int j = h->step;
     const traj::FrenetState st{lon_s_[i * w + j], lon_sd_[i * w + j], 0.0,
                                lat_d_[k * w + j], lat_dd_[k * w + j], 0.0};
-    if (HitsAt(EgoAt(st, 1.0, 1.0), j, last.car, 1.0, 1.0)) return true;
+    if (HitsAt(EgoAt(st, 1.0, 1.0), j, h->car, 1.0, 1.0)) return true;
   }
   int car = -1;
   const int hit = FirstCollision(StepsOf(c), 1.0, 1.0, &car);
   if (hit > ws_.n_steps) return false;
-  last = {ws_.traffic_stamp, hit, car};
+  const LastHit now{ws_.traffic_stamp, hit, car};
+  last_hit_[2 * i + 1] = last_hit_[2 * i];
+  last_hit_[2 * i] = now;
+  lat_last_hit_[k] = now;
   return true;
 }
 

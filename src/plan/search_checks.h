@@ -199,7 +199,8 @@ class Checker {
     std::uint64_t stamp = 0;
     int step = 0, car = 0;
   };
-  std::vector<LastHit> last_hit_;
+  std::vector<LastHit> last_hit_;      // two per lon slot, the latest first
+  std::vector<LastHit> lat_last_hit_;  // one per lat slot
   // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
   TickRows lon_ticks_, lat_ticks_;
   std::vector<map::CentrePoint> lon_centre_;
