@@ -22,6 +22,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   heap_.reserve(ws_.order.capacity());
   lon_done_.reserve(ws_.lon.capacity());
   lat_done_.reserve(ws_.lat.capacity());
+  sep_.assign(kProbes * kMaxCars, 0.0);
   lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
   lat_sep_.assign(ws_.lat.capacity() * kProbes * kMaxCars, 0.0);
 }
@@ -79,12 +80,8 @@ int LeastHarm::BestClear(bool* over_budget) {
     }
     const double* a = &lon_sep_[i * row];
     const double* b = &lat_sep_[k * row];
-    double bound = 1e9;
-    for (int q = 0; q < row; ++q) {
-      const double sep = std::max(a[q], b[q]);
-      bound = sep < bound ? sep : bound;
-    }
-    bound_[c] = bound;
+    for (int q = 0; q < row; ++q) sep_[q] = std::max(a[q], b[q]);
+    bound_[c] = MinOf(sep_.data(), row);
     heap_[r] = c;
   }
   // Largest bound first, then the smallest index (any order gives the same maximum; this one

@@ -64,22 +64,43 @@ inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepSt
   return worst;
 }
 
+// The smallest of v[0, n), ignoring NaN (1e9 when none is smaller): four running minima, so
+// that the comparisons do not wait for each other; the order does not change a minimum that
+// ignores NaN (and no value here is -0).
+inline double MinOf(const double* v, int n) {
+  double m[4] = {1e9, 1e9, 1e9, 1e9};
+  int q = 0;
+  for (; q + 4 <= n; q += 4) {
+    for (int u = 0; u < 4; ++u) m[u] = v[q + u] < m[u] ? v[q + u] : m[u];
+  }
+  for (; q < n; ++q) m[0] = v[q] < m[0] ? v[q] : m[0];
+  const double a = m[1] < m[0] ? m[1] : m[0], b = m[3] < m[2] ? m[3] : m[2];
+  return b < a ? b : a;
+}
+
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
 // `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
 // minimum, car by car: the order does not change a minimum that ignores NaN.
 inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const double* s,
                              const double* d, double floor) {
+  constexpr int kMaxSteps = 256;
   const int n_steps = ws.n_steps;
+  if (n_steps >= kMaxSteps) {
+    return ClearanceAt(cfg, ws, [s, d, &ws](int i) {
+      const int j = i / ws.collision_step;
+      return traj::FrenetState{s[j], 0.0, 0.0, d[j], 0.0, 0.0};
+    });
+  }
+  double sep[kMaxSteps];
   double worst = 1e9;
   for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
-    double row = 1e9;
     for (int j = 1; j <= n_steps; ++j) {
-      const double sep =
+      sep[j - 1] =
           std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
-      row = sep < row ? sep : row;
     }
+    const double row = MinOf(sep, n_steps);
     worst = row < worst ? row : worst;
     if (worst < floor) break;
   }
@@ -123,7 +144,7 @@ class LeastHarm {
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;
   std::vector<char> lon_done_, lat_done_;
-  std::vector<double> lon_sep_, lat_sep_;
+  std::vector<double> lon_sep_, lat_sep_, sep_;
 };
 
 }  // namespace frenetic::plan::search
