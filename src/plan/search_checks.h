@@ -127,9 +127,9 @@ class Checker {
   Rows StepRows(int c);
 
   // Whether candidate c collides with the inflated boxes: FirstCollision(StepsOf(c)) <=
-  // n_steps, the same answer, but the step and car that the last colliding candidate of its
-  // lon bundle hit are tried first (the candidates of a bundle mostly run into the same car at
-  // the same step), which spares the scan of the steps before.
+  // n_steps, the same answer, but the steps and cars that the last colliding candidates of its
+  // bundles hit are tried first (the candidates of a bundle mostly run into the same car at
+  // about the same step), which spares the scan of the steps before.
   bool CandidateCollides(int c);
 
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther

@@ -333,12 +333,17 @@ class SearchPlanner : public Planner {
   bool CheckRest(int r0, bool* cut) {
     const int n = static_cast<int>(ws_.order.size());
     free_.clear();
-    for (int k = r0; k < n; ++k) {
-      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+    // In index order, which is by lon bundle: CandidateCollides' hints are then the bundle's
+    // neighbours' hits.
+    const int all = static_cast<int>(ws_.cand_cost.size());
+    std::fill(collides_.begin(), collides_.begin() + all, 0);
+    for (int k = r0; k < n; ++k) collides_[ws_.order[k]] = kUntested;
+    for (int c = 0, k = 0; c < all; ++c) {
+      if (collides_[c] != kUntested) continue;
+      if ((++k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return false;
       }
-      const int c = ws_.order[k];
       collides_[c] = checker_.CandidateCollides(c);
       if (!collides_[c]) free_.push_back(c);
     }
@@ -438,6 +443,7 @@ class SearchPlanner : public Planner {
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
   // CheckRest: per candidate, whether it collides; the collision-free candidates.
   std::vector<char> collides_;
+  static constexpr char kUntested = 2;
   std::vector<int> free_;
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
