@@ -99,6 +99,9 @@ class Scorer {
   std::vector<double> bound_;
   std::vector<int> pos_, pending_, ready_;
   std::vector<char> resolved_;  // per candidate: ws.cand_cost is exact
+  // Per candidate, the cheap terms' values Score() computed for its bound ([c * terms + t]):
+  // Resolve() evaluates only the expensive ones.
+  std::vector<double> cheap_;
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;
 };
 
