@@ -230,14 +230,10 @@ double Checker::CandidateViolation(int c, Reject* reason) {
 int Checker::BuildXyPath(const map::CentrePoint* centre) {
   int n = first_new_;
   for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
-    if (centre != nullptr) {
-      chk_x_[n] = centre[i].OffsetX(ws_.tk_d[i]);
-      chk_y_[n] = centre[i].OffsetY(ws_.tk_d[i]);
-    } else {
-      const map::CartesianPose p = line_.ToCartesian(ws_.tk_s[i], ws_.tk_d[i]);
-      chk_x_[n] = p.x;
-      chk_y_[n] = p.y;
-    }
+    // ToCartesian's x and y without its heading and curvature.
+    const map::CentrePoint p = centre != nullptr ? centre[i] : line_.Centre(ws_.tk_s[i]);
+    chk_x_[n] = p.OffsetX(ws_.tk_d[i]);
+    chk_y_[n] = p.OffsetY(ws_.tk_d[i]);
   }
   return n;
 }
