@@ -199,6 +199,34 @@ void Checker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n
   ++prefix_stamp_;
 }
 
+Checker::ReadRange Checker::ReadBetween(const double* s, const double* d, int prev, int i) const {
+  const double d_lo = std::min(d[prev], d[i]), d_hi = std::max(d[prev], d[i]);
+  const map::ReferenceLine::OffsetRange r =
+      line_.ChordOffset(std::min(s[prev], s[i]), std::max(s[prev], s[i]), 0.5 * (d_lo + d_hi));
+  return {d_lo + r.lo, d_hi + r.hi};
+}
+
+bool Checker::CandidateBreaksLaneLine(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  SampleTicks(ws_.lon[i].traj, i, lon_ticks_, &lon_centre_);
+  SampleTicks(ws_.lat[k].traj, k, lat_ticks_, nullptr);
+  const int w = ws_.n_ticks + 1;
+  const double* s = &lon_ticks_.p[i * w];
+  const double* d = &lat_ticks_.p[k * w];
+  // Measure's count, stopped as soon as it is over the limit.
+  const int n_ticks = ws_.n_ticks;
+  int straddle = ws_.straddle_at_start;
+  if (straddle > kMaxStraddleTicks) return true;
+  for (int prev = 1, t = std::min(5, n_ticks); n_ticks >= 1;
+       prev = t, t = std::min(t + 5, n_ticks)) {
+    const ReadRange read = ReadBetween(s, d, prev, t);
+    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (t - prev) + (prev == 1) : 0;
+    if (straddle > kMaxStraddleTicks) return true;
+    if (t == n_ticks) break;
+  }
+  return straddle > 0;  // still astride at the end
+}
+
 double Checker::CandidateViolation(int c, Reject* reason) {
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
   Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
@@ -263,13 +291,10 @@ double Checker::Measure(Reject* reason, bool lane_line, const map::CentrePoint* 
   for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ws_.tk_sd[i]);
   for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
        prev = i, i = std::min(i + 5, n_ticks)) {
-    const double d_lo = std::min(tk_d[prev], tk_d[i]), d_hi = std::max(tk_d[prev], tk_d[i]);
-    const map::ReferenceLine::OffsetRange r = line_.ChordOffset(
-        std::min(tk_s[prev], tk_s[i]), std::max(tk_s[prev], tk_s[i]), 0.5 * (d_lo + d_hi));
-    dmin = std::min(dmin, d_lo + r.lo);
-    dmax = std::max(dmax, d_hi + r.hi);
-    straddle =
-        StraddlesRead(cfg_, d_lo + r.lo, d_hi + r.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+    const ReadRange read = ReadBetween(tk_s.data(), tk_d.data(), prev, i);
+    dmin = std::min(dmin, read.lo);
+    dmax = std::max(dmax, read.hi);
+    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
     worst_straddle = std::max(worst_straddle, straddle);
     if (i == n_ticks) break;
   }

@@ -90,6 +90,11 @@ class Checker {
   // are (not c's ticks then).
   double CandidateViolation(int c, Reject* reason);
 
+  // Whether candidate c's ticks break the lane-line timer (Violation's lane-line term > 0, so
+  // CandidateViolation > 0): the same count, stopped once it is over the limit, on the
+  // bundles' ticks.
+  bool CandidateBreaksLaneLine(int c);
+
   // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
   bool Collides() const {
     return FirstCollision(
@@ -146,6 +151,13 @@ class Checker {
   // when sampled anew.
   bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
                    std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
+
+  // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the
+  // simulator may read it there.
+  struct ReadRange {
+    double lo, hi;
+  };
+  ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
 
   // Appends the ticks to the XY prefix (centre: the centre line at tk_s, or null); returns the
   // path length.

@@ -136,8 +136,9 @@ class LeastHarm {
   Scorer& scorer_;
   Checker& checker_;
   const CycleClock& clock_;
-  // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking), and an
-  // upper bound of the clearance (BestClear).
+  // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
+  // BestClear measured them already), and an upper bound of the clearance (BestClear).
+  std::vector<char> known_;
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
