@@ -264,8 +264,8 @@ ReferenceLine::OffsetRange ReferenceLine::ChordOffset(double s_from, double s_to
   const double w = d / kChordD1;
   r.lo = std::numeric_limits<double>::infinity();
   r.hi = -r.lo;
-  for (int j = 0; j < count; ++j) {
-    const int i = (first + j) % m.n;
+  // first is in [0, n] and count <= n: one wrap at most (no division per sample).
+  for (int j = 0, i = first % m.n; j < count; ++j, i = i + 1 == m.n ? 0 : i + 1) {
     const double off = m.chord0[i] + (m.chord1[i] - m.chord0[i]) * w;
     r.lo = std::min(r.lo, off);
     r.hi = std::max(r.hi, off);
