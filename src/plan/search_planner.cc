@@ -28,11 +28,11 @@ namespace frenetic::plan {
 namespace {
 
 using search::Finite;
+using traj::FrenetState;
+using traj::FrenetTrajectory;
 
 // CheckLazily tests the rest of the candidates at once after this many ranks at least.
 constexpr int kCheckRestMin = 64;
-using traj::FrenetState;
-using traj::FrenetTrajectory;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
