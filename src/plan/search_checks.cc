@@ -56,7 +56,6 @@ bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
   return true;
 }
 
-
 bool Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
                           std::vector<traj::Trajectory1d>& key, std::vector<char>& have,
                           std::vector<double>& p, std::vector<double>& v) {
@@ -146,8 +145,8 @@ bool Checker::CandidateCollides(int c) {
   // a neighbour's is found sooner); any hit answers.
   const StepStates steps = StepsOf(c);
   const int n_steps = ws_.n_steps;
-  const std::uint64_t cars = ws_.num_check_cars >= 64 ? ~std::uint64_t{0}
-                                                      : (std::uint64_t{1} << ws_.num_check_cars) - 1;
+  const std::uint64_t cars =
+      ws_.num_check_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << ws_.num_check_cars) - 1;
   const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;
   int hit = 0, car = -1;
   for (int q = 0; q < n_steps && hit == 0; ++q) {
@@ -241,39 +240,34 @@ double Checker::CandidateViolation(int c, Reject* reason) {
   SampleTicks(tr.lon, i, lon_ticks_, &lon_centre_);
   SampleTicks(tr.lat, k, lat_ticks_, nullptr);
   const int w = ws_.n_ticks + 1;
-  const std::size_t bytes = ws_.n_ticks * sizeof(double);
-  std::memcpy(&ws_.tk_s[1], &lon_ticks_.p[i * w + 1], bytes);
-  std::memcpy(&ws_.tk_sd[1], &lon_ticks_.v[i * w + 1], bytes);
-  std::memcpy(&ws_.tk_sdd[1], &lon_ticks_.a[i * w + 1], bytes);
-  std::memcpy(&ws_.tk_d[1], &lat_ticks_.p[k * w + 1], bytes);
-  std::memcpy(&ws_.tk_dd[1], &lat_ticks_.v[k * w + 1], bytes);
-  std::memcpy(&ws_.tk_ddd[1], &lat_ticks_.a[k * w + 1], bytes);
   Reject why = Reject::kCount;
-  const double worst = Measure(&why, true, &lon_centre_[i * w]);
+  const double worst = Measure(
+      &why, true,
+      {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], &lon_centre_[i * w]});
   if (reason != nullptr) *reason = why;
   if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst};
   return worst;
 }
 
-int Checker::BuildXyPath(const map::CentrePoint* centre) {
+int Checker::BuildXyPath(const Ticks& ticks) {
   int n = first_new_;
   for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
     // ToCartesian's x and y without its heading and curvature.
-    const map::CentrePoint p = centre != nullptr ? centre[i] : line_.Centre(ws_.tk_s[i]);
-    chk_x_[n] = p.OffsetX(ws_.tk_d[i]);
-    chk_y_[n] = p.OffsetY(ws_.tk_d[i]);
+    const map::CentrePoint p = ticks.centre != nullptr ? ticks.centre[i] : line_.Centre(ticks.s[i]);
+    chk_x_[n] = p.OffsetX(ticks.d[i]);
+    chk_y_[n] = p.OffsetY(ticks.d[i]);
   }
   return n;
 }
 
 double Checker::Violation(Reject* reason, bool lane_line) {
-  return Measure(reason, lane_line, nullptr);
+  return Measure(reason, lane_line, {ws_.tk_s.data(), ws_.tk_sd.data(), ws_.tk_d.data(), nullptr});
 }
 
-double Checker::Measure(Reject* reason, bool lane_line, const map::CentrePoint* centre) {
+double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks) {
   const int n_ticks = ws_.n_ticks;
-  const std::vector<double>& tk_s = ws_.tk_s;
-  const std::vector<double>& tk_d = ws_.tk_d;
+  const double* tk_s = ticks.s;
+  const double* tk_d = ticks.d;
   double worst = -1e9;
   Reject why = Reject::kCount;
   auto take = [&](double v, Reject r) {
@@ -288,10 +282,10 @@ double Checker::Measure(Reject* reason, bool lane_line, const map::CentrePoint* 
   // a line; a trajectory still astride at its end would stay there.
   double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
   int straddle = ws_.straddle_at_start, worst_straddle = straddle;
-  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ws_.tk_sd[i]);
+  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ticks.sd[i]);
   for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
        prev = i, i = std::min(i + 5, n_ticks)) {
-    const ReadRange read = ReadBetween(tk_s.data(), tk_d.data(), prev, i);
+    const ReadRange read = ReadBetween(tk_s, tk_d, prev, i);
     dmin = std::min(dmin, read.lo);
     dmax = std::max(dmax, read.hi);
     straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
@@ -309,7 +303,7 @@ double Checker::Measure(Reject* reason, bool lane_line, const map::CentrePoint* 
     if (reason != nullptr) *reason = why;
     return worst;
   }
-  const int n = BuildXyPath(centre);
+  const int n = BuildXyPath(ticks);
   const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
   take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);

@@ -86,8 +86,8 @@ class Checker {
 
   // Candidate c's Violation(reason) (lane-line timer included) after FillTicks of it,
   // remembered for its trajectory until the next SetXyPrefix: the least-harm choice asks again
-  // about candidates the lazy check has measured. A remembered verdict leaves ws.tk_* as they
-  // are (not c's ticks then).
+  // about candidates the lazy check has measured. Measured on its bundles' ticks: ws.tk_* are
+  // left as they are.
   double CandidateViolation(int c, Reject* reason);
 
   // Whether candidate c's ticks break the lane-line timer (Violation's lane-line term > 0, so
@@ -159,11 +159,16 @@ class Checker {
   };
   ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
 
-  // Appends the ticks to the XY prefix (centre: the centre line at tk_s, or null); returns the
-  // path length.
-  int BuildXyPath(const map::CentrePoint* centre);
-  // Violation, with the centre line at tk_s when known (CandidateViolation).
-  double Measure(Reject* reason, bool lane_line, const map::CentrePoint* centre);
+  // What Violation reads of the ticks [1, n_ticks]: s, s', d, and the centre line at s when
+  // known (null: from the line).
+  struct Ticks {
+    const double *s, *sd, *d;
+    const map::CentrePoint* centre;
+  };
+  // Appends the ticks to the XY prefix; returns the path length.
+  int BuildXyPath(const Ticks& ticks);
+  // Violation of `ticks` (ws.tk_*, or a candidate's bundle rows).
+  double Measure(Reject* reason, bool lane_line, const Ticks& ticks);
   // Bundle trajectory `tr` (slot i) at every tick [1, n_ticks], FillTicks' values, in the rows
   // of p / v / a (and the centre line at p when centre is not null) unless kept; true when
   // sampled anew.
@@ -236,9 +241,9 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
 // FirstCollision's ego at one step.
 struct Checker::StepEgo {
   traj::OrientedBox box;
-  double s_d = 0;          // the state's s'
-  double dir_s, dir_d;     // unit heading (s', d') with s' at least 0.5
-  double reach_s;          // ReachS
+  double s_d = 0;       // the state's s'
+  double dir_s, dir_d;  // unit heading (s', d') with s' at least 0.5
+  double reach_s;       // ReachS
 };
 
 inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
@@ -285,7 +290,8 @@ template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit, bool ghosts) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
-  const std::uint64_t cars = num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
+  const std::uint64_t cars =
+      num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
     // No car within reach at this step: nothing to test (and no square root to take).

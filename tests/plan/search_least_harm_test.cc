@@ -167,7 +167,9 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
     const bool ok = st.least_harm.Choose(&over_budget);
     EXPECT_FALSE(over_budget);
     EXPECT_EQ(ok, expected >= 0) << "scene " << scene;
-    if (ok) EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    if (ok) {
+      EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    }
     chosen += ok;
   }
   EXPECT_GT(chosen, 12);
