@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "frenetic/plan/predictor.h"
@@ -73,7 +74,7 @@ class SearchPlanner : public Planner {
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
     collides_.assign(ws_.order.capacity(), 0);
-    free_.reserve(ws_.order.capacity());
+    rest_.reserve(ws_.order.capacity());
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -263,8 +264,8 @@ class SearchPlanner : public Planner {
   // Frenet-only collision test first, then the hard limits. False when none passed or the
   // deadline (85% of budget_ms) cut it short (then *over_budget is set).
   // After the first quarter of the candidates (and the traced ones) have failed, the rest are
-  // tested at once, in any order (CheckRest): when none of them passes either, the cycle ends
-  // without the exact cost of every candidate that the walk in cost order would need.
+  // tested at once, by their cost bound (CheckRest): when none of them passes either, the cycle
+  // ends without the exact cost of every candidate that the walk in cost order would need.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
@@ -293,7 +294,7 @@ class SearchPlanner : public Planner {
       // conversion for the many candidates that run into traffic.
       // Past the traced ranks, whether it collides is all the walk needs.
       int hit_car = -1, hit = ws_.n_steps + 1;
-      if (tested) {
+      if (tested && collides_[c] != kUntested) {
         hit = collides_[c] ? 1 : hit;
       } else if (trace_ != nullptr && r < trace_max_) {
         hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
@@ -326,37 +327,40 @@ class SearchPlanner : public Planner {
     return false;
   }
 
-  // Tests every candidate of ranks [r0, n) for collision, then the collision-free ones for the
-  // hard limits in cost order until one passes: true then (the walk in cost order goes on, and
-  // stops at it). Otherwise every one of them counts as checked and rejected, as the walk would
-  // have counted them, and false (*cut set when the deadline cut it short).
+  // Tests the candidates of ranks [r0, n) by their cost bound, cheapest first: for collision,
+  // then a collision-free one for the hard limits when it is cheaper than the cheapest that
+  // passed so far, until no bound is left below that one's cost (no later candidate can rank
+  // before it). True when one passed (the walk in cost order goes on, and stops at it; the
+  // candidates not reached are marked kUntested). Otherwise every one of them counts as checked
+  // and rejected, as the walk would have counted them, and false (*cut set when the deadline
+  // cut it short).
   bool CheckRest(int r0, bool* cut) {
     const int n = static_cast<int>(ws_.order.size());
-    free_.clear();
-    // In index order, which is by lon bundle: CandidateCollides' hints are then the bundle's
-    // neighbours' hits.
-    const int all = static_cast<int>(ws_.cand_cost.size());
-    std::fill(collides_.begin(), collides_.begin() + all, 0);
-    for (int k = r0; k < n; ++k) collides_[ws_.order[k]] = kUntested;
-    for (int c = 0, k = 0; c < all; ++c) {
-      if (collides_[c] != kUntested) continue;
-      if ((++k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+    rest_.clear();
+    for (int k = r0; k < n; ++k) {
+      const int c = ws_.order[k];
+      collides_[c] = kUntested;
+      rest_.push_back({scorer_.Bound(c), c});
+    }
+    std::sort(rest_.begin(), rest_.end());  // smallest bound, then index, first
+    int best = -1;  // the cheapest candidate that passed
+    for (int k = 0; k < static_cast<int>(rest_.size()); ++k) {
+      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return false;
+      }
+      const int c = rest_[k].second;
+      if (best >= 0) {
+        const double bc = rest_[k].first, cost = ws_.cand_cost[best];
+        if (bc > cost || (bc == cost && c > best)) return true;
       }
       collides_[c] = checker_.CandidateCollides(c);
-      if (!collides_[c]) free_.push_back(c);
+      if (collides_[c]) continue;
+      scorer_.ExactCost(c);
+      if (best >= 0 && !search::Cheaper(ws_, c, best)) continue;
+      if (checker_.CandidateViolation(c, nullptr) <= 0) best = c;
     }
-    for (const int c : free_) scorer_.ExactCost(c);
-    std::sort(free_.begin(), free_.end(),
-              [this](int a, int b) { return search::Cheaper(ws_, a, b); });
-    for (int k = 0; k < static_cast<int>(free_.size()); ++k) {
-      if ((k & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
-        *cut = true;
-        return false;
-      }
-      if (checker_.CandidateViolation(free_[k], nullptr) <= 0) return true;
-    }
+    if (best >= 0) return true;
     PlanSummary& sum = result_.summary;
     for (int k = r0; k < n; ++k) {
       const int c = ws_.order[k];
@@ -441,10 +445,10 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
-  // CheckRest: per candidate, whether it collides; the collision-free candidates.
+  // CheckRest: per candidate, whether it collides (or kUntested); its candidates by bound.
   std::vector<char> collides_;
   static constexpr char kUntested = 2;
-  std::vector<int> free_;
+  std::vector<std::pair<double, int>> rest_;
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)

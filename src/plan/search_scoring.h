@@ -64,6 +64,8 @@ class Scorer {
   // Candidate c's exact cost (ws.cand_cost[c]), evaluated now if Score() left only its bound;
   // the lazy sort's result is unchanged. Costs set without Score() are taken as exact.
   double ExactCost(int c);
+  // Candidate c's lower bound from Score(): its exact cost is never below it.
+  double Bound(int c) const { return bound_[c]; }
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
   cost::CostInput InputFor(int i, int j) const;
