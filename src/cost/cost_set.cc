@@ -58,12 +58,24 @@ double CostSet::Evaluate(const CostContext& ctx, const CostInput& in, double* pe
   return total;
 }
 
-double CostSet::LowerBound(const CostContext& ctx, const CostInput& in) const {
+double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* cheap) const {
   // Evaluate's sum, term for term, with 0 in place of the expensive terms' values.
   double total = 0;
   const int n = size();
   for (int i = 0; i < n; ++i) {
     const double v = terms_[i]->Expensive() ? 0.0 : terms_[i]->Evaluate(ctx, in);
+    if (cheap != nullptr) cheap[i] = v;
+    total += weights_[i] * v;
+  }
+  return total;
+}
+
+double CostSet::EvaluateWithCheap(const CostContext& ctx, const CostInput& in,
+                                  const double* cheap) const {
+  double total = 0;
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    const double v = terms_[i]->Expensive() ? terms_[i]->Evaluate(ctx, in) : cheap[i];
     total += weights_[i] * v;
   }
   return total;

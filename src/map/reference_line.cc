@@ -199,20 +199,14 @@ CartesianPose ReferenceLine::ToCartesian(double s, double d) const {
   const double t = sigma - i;
   const Hermite h = HermiteAt(t);
   const double st = m.step;
-  const double x =
-      h.h00 * m.x[i] + h.h10 * st * m.tx[i] + h.h01 * m.x[i + 1] + h.h11 * st * m.tx[i + 1];
-  const double y =
-      h.h00 * m.y[i] + h.h10 * st * m.ty[i] + h.h01 * m.y[i + 1] + h.h11 * st * m.ty[i + 1];
-  const double th =
-      h.h00 * m.th[i] + h.h10 * st * m.k[i] + h.h01 * m.th[i + 1] + h.h11 * st * m.k[i + 1];
+  double th;
+  const CentrePoint cp = m.CentreAt(i, h, &th);
   const double k =
       h.h00 * m.k[i] + h.h10 * st * m.dk[i] + h.h01 * m.k[i + 1] + h.h11 * st * m.dk[i + 1];
-  double c, sn;
-  m.CosSin(i, th, &c, &sn);
   if (!std::isfinite(d)) d = 0;
   CartesianPose p;
-  p.x = x + d * sn;  // right normal (sin, -cos)
-  p.y = y - d * c;
+  p.x = cp.OffsetX(d);  // right normal (sin, -cos)
+  p.y = cp.OffsetY(d);
   p.heading = WrapAngle(th);
   // Offset curve C + d n with n the right normal: dn/ds = kappa t, so its speed is 1 + kappa d and
   // its curvature kappa / (1 + kappa d). Beyond the centre of curvature the offset curve has a
@@ -221,6 +215,15 @@ CartesianPose ReferenceLine::ToCartesian(double s, double d) const {
   if (std::abs(denom) < 1e-6) denom = std::copysign(1e-6, denom);
   p.kappa = k / denom;
   return p;
+}
+
+CentrePoint ReferenceLine::Centre(double s) const {
+  const Impl& m = *impl_;
+  const double sigma = WrapS(s) * m.inv_step;
+  int i = static_cast<int>(sigma);
+  if (i >= m.n) i = m.n - 1;
+  double th;
+  return m.CentreAt(i, HermiteAt(sigma - i), &th);
 }
 
 FrenetPoint ReferenceLine::ToFrenet(double x, double y) const {
@@ -261,8 +264,8 @@ ReferenceLine::OffsetRange ReferenceLine::ChordOffset(double s_from, double s_to
   const double w = d / kChordD1;
   r.lo = std::numeric_limits<double>::infinity();
   r.hi = -r.lo;
-  for (int j = 0; j < count; ++j) {
-    const int i = (first + j) % m.n;
+  // first is in [0, n] and count <= n: one wrap at most (no division per sample).
+  for (int j = 0, i = first % m.n; j < count; ++j, i = i + 1 == m.n ? 0 : i + 1) {
     const double off = m.chord0[i] + (m.chord1[i] - m.chord0[i]) * w;
     r.lo = std::min(r.lo, off);
     r.hi = std::max(r.hi, off);

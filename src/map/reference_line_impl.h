@@ -72,6 +72,18 @@ struct ReferenceLine::Impl {
     *s = ty[i] * ca + tx[i] * sa;
   }
 
+  // Position and direction at segment i with the Hermite weights h (ToCartesian, Centre), and
+  // the heading.
+  CentrePoint CentreAt(int i, const Hermite& h, double* heading) const {
+    const double st = step;
+    CentrePoint p;
+    p.x = h.h00 * x[i] + h.h10 * st * tx[i] + h.h01 * x[i + 1] + h.h11 * st * tx[i + 1];
+    p.y = h.h00 * y[i] + h.h10 * st * ty[i] + h.h01 * y[i + 1] + h.h11 * st * ty[i + 1];
+    *heading = h.h00 * th[i] + h.h10 * st * k[i] + h.h01 * th[i + 1] + h.h11 * st * k[i + 1];
+    CosSin(i, *heading, &p.cos, &p.sin);
+    return p;
+  }
+
   // Position, heading (with its cos and sin) and curvature at segment i, local t, plus their
   // derivatives w.r.t. s.
   struct Eval {

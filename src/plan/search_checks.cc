@@ -28,8 +28,33 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   near_.assign(w, 0);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
+  verdicts_.resize(ws_.order.capacity());
+  last_hit_.assign(2 * n_lon, LastHit{});
+  lat_last_hit_.assign(n_lat, LastHit{});
+  const std::size_t wt = ws_.n_ticks + 1;
+  for (auto [rows, n] : {std::pair{&lon_ticks_, n_lon}, std::pair{&lat_ticks_, n_lat}}) {
+    rows->key.resize(n);
+    rows->have.assign(n, 0);
+    for (auto* v : {&rows->p, &rows->v, &rows->a}) v->assign(n * wt, 0.0);
+  }
+  lon_centre_.resize(n_lon * wt);
 }
 
+bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
+                          std::vector<map::CentrePoint>* centre) {
+  if (rows.have[i] && std::memcmp(&rows.key[i], &tr, sizeof(tr)) == 0) return false;
+  const int w = ws_.n_ticks + 1;
+  for (int t = 1; t <= ws_.n_ticks; ++t) {
+    const traj::State1d st = tr.At(0.0 + t * kTickSeconds);  // FillTicks' time, t0 = 0
+    rows.p[i * w + t] = st.p;
+    rows.v[i * w + t] = st.v;
+    rows.a[i * w + t] = st.a;
+    if (centre != nullptr) (*centre)[i * w + t] = line_.Centre(st.p);
+  }
+  std::memcpy(&rows.key[i], &tr, sizeof(tr));
+  rows.have[i] = 1;
+  return true;
+}
 
 bool Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
                           std::vector<traj::Trajectory1d>& key, std::vector<char>& have,
@@ -86,6 +111,65 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
           lat_dd_.data() + k * w, ws_.collision_step, near_.data()};
 }
 
+Checker::Rows Checker::StepRows(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = ws_.n_steps + 1;
+  // A bundle sampled anew here has no reach tests yet (traffic_stamp is never 0 in a cycle).
+  if (SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_)) {
+    lon_near_key_[i].stamp = 0;
+  }
+  if (SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_)) {
+    lat_near_stamp_[k] = 0;
+  }
+  return {lon_s_.data() + i * w, lat_d_.data() + k * w};
+}
+
+bool Checker::CandidateCollides(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = ws_.n_steps + 1;
+  // A hit at a remembered step and car is one FirstCollision finds too, at that step at the
+  // latest (the car passes the same reach tests): the lon bundle's last two, its lat bundle's
+  // last one.
+  LastHit* const hints[3] = {&last_hit_[2 * i], &last_hit_[2 * i + 1], &lat_last_hit_[k]};
+  bool sampled = false;
+  for (const LastHit* h : hints) {
+    if (h->stamp != ws_.traffic_stamp) continue;
+    if (!sampled) StepRows(c);
+    sampled = true;
+    const int j = h->step;
+    const traj::FrenetState st{lon_s_[i * w + j], lon_sd_[i * w + j], 0.0,
+                               lat_d_[k * w + j], lat_dd_[k * w + j], 0.0};
+    if (HitsAt(EgoAt(st, 1.0, 1.0), j, h->car, 1.0, 1.0)) return true;
+  }
+  // Every step then, from the first hint's on (a collision mostly lasts a few steps: one near
+  // a neighbour's is found sooner); any hit answers.
+  const StepStates steps = StepsOf(c);
+  const int n_steps = ws_.n_steps;
+  const std::uint64_t cars =
+      ws_.num_check_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << ws_.num_check_cars) - 1;
+  const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;
+  int hit = 0, car = -1;
+  for (int q = 0; q < n_steps && hit == 0; ++q) {
+    const int j = (from - 1 + q) % n_steps + 1;
+    const std::uint64_t near = steps.Near(j) & cars;
+    if (near == 0) continue;
+    const StepEgo ego = EgoAt(steps(j * ws_.collision_step), 1.0, 1.0);
+    for (std::uint64_t m = near; m != 0; m &= m - 1) {
+      if (HitsAt(ego, j, std::countr_zero(m), 1.0, 1.0)) {
+        hit = j;
+        car = std::countr_zero(m);
+        break;
+      }
+    }
+  }
+  if (hit == 0) return false;
+  const LastHit now{ws_.traffic_stamp, hit, car};
+  last_hit_[2 * i + 1] = last_hit_[2 * i];
+  last_hit_[2 * i] = now;
+  lat_last_hit_[k] = now;
+  return true;
+}
+
 void Checker::FillTicks(const traj::FrenetTrajectory& tr, double t0) {
   for (int i = 1; i <= ws_.n_ticks; ++i) {
     const traj::FrenetState st = tr.At(t0 + i * kTickSeconds);
@@ -111,22 +195,79 @@ void Checker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n
   }
   first_new_ = n;
   xy_.SetPrefix(chk_x_.data(), chk_y_.data(), n);
+  ++prefix_stamp_;
 }
 
-int Checker::BuildXyPath() {
+Checker::ReadRange Checker::ReadBetween(const double* s, const double* d, int prev, int i) const {
+  const double d_lo = std::min(d[prev], d[i]), d_hi = std::max(d[prev], d[i]);
+  const map::ReferenceLine::OffsetRange r =
+      line_.ChordOffset(std::min(s[prev], s[i]), std::max(s[prev], s[i]), 0.5 * (d_lo + d_hi));
+  return {d_lo + r.lo, d_hi + r.hi};
+}
+
+bool Checker::CandidateBreaksLaneLine(int c) {
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  SampleTicks(ws_.lon[i].traj, i, lon_ticks_, &lon_centre_);
+  SampleTicks(ws_.lat[k].traj, k, lat_ticks_, nullptr);
+  const int w = ws_.n_ticks + 1;
+  const double* s = &lon_ticks_.p[i * w];
+  const double* d = &lat_ticks_.p[k * w];
+  // Measure's count, stopped as soon as it is over the limit.
+  const int n_ticks = ws_.n_ticks;
+  int straddle = ws_.straddle_at_start;
+  if (straddle > kMaxStraddleTicks) return true;
+  for (int prev = 1, t = std::min(5, n_ticks); n_ticks >= 1;
+       prev = t, t = std::min(t + 5, n_ticks)) {
+    const ReadRange read = ReadBetween(s, d, prev, t);
+    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (t - prev) + (prev == 1) : 0;
+    if (straddle > kMaxStraddleTicks) return true;
+    if (t == n_ticks) break;
+  }
+  return straddle > 0;  // still astride at the end
+}
+
+double Checker::CandidateViolation(int c, Reject* reason) {
+  const traj::FrenetTrajectory tr = ws_.Candidate(c);
+  Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
+  if (v != nullptr && v->prefix_stamp == prefix_stamp_ && v->straddle == ws_.straddle_at_start &&
+      std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
+    if (reason != nullptr) *reason = v->why;
+    return v->worst;
+  }
+  // FillTicks' values, from the bundles' rows: the candidates of a bundle share its ticks and
+  // the centre line there.
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  SampleTicks(tr.lon, i, lon_ticks_, &lon_centre_);
+  SampleTicks(tr.lat, k, lat_ticks_, nullptr);
+  const int w = ws_.n_ticks + 1;
+  Reject why = Reject::kCount;
+  const double worst = Measure(
+      &why, true,
+      {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], &lon_centre_[i * w]});
+  if (reason != nullptr) *reason = why;
+  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst};
+  return worst;
+}
+
+int Checker::BuildXyPath(const Ticks& ticks) {
   int n = first_new_;
   for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
-    const map::CartesianPose p = line_.ToCartesian(ws_.tk_s[i], ws_.tk_d[i]);
-    chk_x_[n] = p.x;
-    chk_y_[n] = p.y;
+    // ToCartesian's x and y without its heading and curvature.
+    const map::CentrePoint p = ticks.centre != nullptr ? ticks.centre[i] : line_.Centre(ticks.s[i]);
+    chk_x_[n] = p.OffsetX(ticks.d[i]);
+    chk_y_[n] = p.OffsetY(ticks.d[i]);
   }
   return n;
 }
 
 double Checker::Violation(Reject* reason, bool lane_line) {
+  return Measure(reason, lane_line, {ws_.tk_s.data(), ws_.tk_sd.data(), ws_.tk_d.data(), nullptr});
+}
+
+double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks) {
   const int n_ticks = ws_.n_ticks;
-  const std::vector<double>& tk_s = ws_.tk_s;
-  const std::vector<double>& tk_d = ws_.tk_d;
+  const double* tk_s = ticks.s;
+  const double* tk_d = ticks.d;
   double worst = -1e9;
   Reject why = Reject::kCount;
   auto take = [&](double v, Reject r) {
@@ -141,16 +282,13 @@ double Checker::Violation(Reject* reason, bool lane_line) {
   // a line; a trajectory still astride at its end would stay there.
   double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
   int straddle = ws_.straddle_at_start, worst_straddle = straddle;
-  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ws_.tk_sd[i]);
+  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ticks.sd[i]);
   for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
        prev = i, i = std::min(i + 5, n_ticks)) {
-    const double d_lo = std::min(tk_d[prev], tk_d[i]), d_hi = std::max(tk_d[prev], tk_d[i]);
-    const map::ReferenceLine::OffsetRange r = line_.ChordOffset(
-        std::min(tk_s[prev], tk_s[i]), std::max(tk_s[prev], tk_s[i]), 0.5 * (d_lo + d_hi));
-    dmin = std::min(dmin, d_lo + r.lo);
-    dmax = std::max(dmax, d_hi + r.hi);
-    straddle =
-        StraddlesRead(cfg_, d_lo + r.lo, d_hi + r.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+    const ReadRange read = ReadBetween(tk_s, tk_d, prev, i);
+    dmin = std::min(dmin, read.lo);
+    dmax = std::max(dmax, read.hi);
+    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
     worst_straddle = std::max(worst_straddle, straddle);
     if (i == n_ticks) break;
   }
@@ -165,7 +303,7 @@ double Checker::Violation(Reject* reason, bool lane_line) {
     if (reason != nullptr) *reason = why;
     return worst;
   }
-  const int n = BuildXyPath();
+  const int n = BuildXyPath(ticks);
   const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
   take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);

@@ -84,6 +84,17 @@ class Checker {
   // (the least-harm choice may drop it: a collision is worse). NaN counts as a violation.
   double Violation(Reject* reason, bool lane_line = true);
 
+  // Candidate c's Violation(reason) (lane-line timer included) after FillTicks of it,
+  // remembered for its trajectory until the next SetXyPrefix: the least-harm choice asks again
+  // about candidates the lazy check has measured. Measured on its bundles' ticks: ws.tk_* are
+  // left as they are.
+  double CandidateViolation(int c, Reject* reason);
+
+  // Whether candidate c's ticks break the lane-line timer (Violation's lane-line term > 0, so
+  // CandidateViolation > 0): the same count, stopped once it is over the limit, on the
+  // bundles' ticks.
+  bool CandidateBreaksLaneLine(int c);
+
   // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
   bool Collides() const {
     return FirstCollision(
@@ -112,18 +123,62 @@ class Checker {
   // it do not evaluate its polynomial or visit every car again. Valid until the next call.
   StepStates StepsOf(int c, double margin_scale = 1.0, double behind_scale = 1.0);
 
+  // Candidate c's s and d at the collision-check steps (rows [0, n_steps], the same values as
+  // StepsOf's), without the reach tests; sampled like StepsOf, and valid as long as its rows.
+  struct Rows {
+    const double* s;
+    const double* d;
+  };
+  Rows StepRows(int c);
+
+  // Whether candidate c collides with the inflated boxes: FirstCollision(StepsOf(c)) <=
+  // n_steps, the same answer, but the steps and cars that the last colliding candidates of its
+  // bundles hit are tried first (the candidates of a bundle mostly run into the same car at
+  // about the same step), which spares the scan of the steps before.
+  bool CandidateCollides(int c);
+
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
   // away can collide (+inf when the margins cannot be bounded).
   double ReachS(double s_d, double margin_scale, double behind_scale) const;
 
  private:
+  // FirstCollision at one step: the ego there, and whether car c collides with it.
+  struct StepEgo;
+  StepEgo EgoAt(const traj::FrenetState& st, double margin_scale, double behind_scale) const;
+  bool HitsAt(const StepEgo& e, int j, int c, double margin_scale, double behind_scale) const;
+
   // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept; true
   // when sampled anew.
   bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
                    std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
 
+  // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the
+  // simulator may read it there.
+  struct ReadRange {
+    double lo, hi;
+  };
+  ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
+
+  // What Violation reads of the ticks [1, n_ticks]: s, s', d, and the centre line at s when
+  // known (null: from the line).
+  struct Ticks {
+    const double *s, *sd, *d;
+    const map::CentrePoint* centre;
+  };
   // Appends the ticks to the XY prefix; returns the path length.
-  int BuildXyPath();
+  int BuildXyPath(const Ticks& ticks);
+  // Violation of `ticks` (ws.tk_*, or a candidate's bundle rows).
+  double Measure(Reject* reason, bool lane_line, const Ticks& ticks);
+  // Bundle trajectory `tr` (slot i) at every tick [1, n_ticks], FillTicks' values, in the rows
+  // of p / v / a (and the centre line at p when centre is not null) unless kept; true when
+  // sampled anew.
+  struct TickRows {
+    std::vector<traj::Trajectory1d> key;
+    std::vector<char> have;
+    std::vector<double> p, v, a;
+  };
+  bool SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
+                   std::vector<map::CentrePoint>* centre);
 
   const Settings& cfg_;
   const map::ReferenceLine& line_;
@@ -145,6 +200,28 @@ class Checker {
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
+  // CandidateViolation's verdicts per candidate index, with what they were measured for: the
+  // trajectory, the XY prefix (prefix_stamp_, counted by SetXyPrefix) and the start's
+  // lane-line count.
+  struct Verdict {
+    traj::FrenetTrajectory tr;
+    std::uint64_t prefix_stamp = 0;
+    int straddle = 0;
+    Reject why = Reject::kCount;
+    double worst = 0;
+  };
+  std::vector<Verdict> verdicts_;
+  // CandidateCollides: per lon slot, the last step and car hit, and the traffic they were for.
+  struct LastHit {
+    std::uint64_t stamp = 0;
+    int step = 0, car = 0;
+  };
+  std::vector<LastHit> last_hit_;      // two per lon slot, the latest first
+  std::vector<LastHit> lat_last_hit_;  // one per lat slot
+  // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
+  TickRows lon_ticks_, lat_ticks_;
+  std::vector<map::CentrePoint> lon_centre_;
+  std::uint64_t prefix_stamp_ = 1;
 };
 
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=
@@ -161,60 +238,79 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
   return 8 + widest;
 }
 
+// FirstCollision's ego at one step.
+struct Checker::StepEgo {
+  traj::OrientedBox box;
+  double s_d = 0;       // the state's s'
+  double dir_s, dir_d;  // unit heading (s', d') with s' at least 0.5
+  double reach_s;       // ReachS
+};
+
+inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
+                                       double behind_scale) const {
+  const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
+  const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.car_length, 0.5 * cfg_.car_width}, st.s_d,
+          vs * inv, vd * inv, ReachS(st.s_d, margin_scale, behind_scale)};
+}
+
+inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
+                            double behind_scale) const {
+  const traj::OrientedBox& ego = e.box;
+  const int at = c * (ws_.n_steps + 1) + j;
+  const double cs = ws_.step_s[at], cd = ws_.step_d[at];
+  if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > e.reach_s) return false;
+  // A car behind in another lane than the start's is one the ego would cut in front of:
+  // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
+  // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
+  // A car ahead needs room to brake behind it: headway_min at the ego's speed.
+  const bool behind_other_lane =
+      cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
+  // A car behind in another lane needs room to react and brake when it closes in.
+  const double closing = std::max(0.0, ws_.step_v[at] - e.s_d);
+  // The headway to a car ahead is kept in full while the ego is in its lane and tapers
+  // to margin_s as the ego moves out of it (pulling out from behind a car is how a
+  // lane change starts).
+  const double inside = std::clamp(
+      (cfg_.car_width - std::abs(cd - ego.cy)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
+  const double margin =
+      cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d)
+      : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
+                          : margin_scale * cfg_.margin_s;
+  if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
+  // The car's heading from its predicted velocity (a lane change turns it).
+  const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
+  const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+  const traj::OrientedBox car{cs, cd, 0.0, ego.half_length + margin,
+                              ego.half_width + margin_scale * cfg_.margin_d};
+  return traj::Overlap(ego, e.dir_s, e.dir_d, car, cv * cinv, cvd * cinv);
+}
+
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit, bool ghosts) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
-  const std::uint64_t cars = num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
-  const double hl = 0.5 * cfg_.car_length, hw = 0.5 * cfg_.car_width;
+  const std::uint64_t cars =
+      num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
-    const traj::FrenetState st = state_at(j * ws_.collision_step);
-    const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
-    const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
-    const traj::OrientedBox ego{st.s, st.d, 0.0, hl, hw};
-    const double reach_s = ReachS(st.s_d, margin_scale, behind_scale);
-    // Whether car c collides at step j.
-    const auto hits = [&](int c) {
-      const int at = c * (n_steps + 1) + j;
-      const double cs = ws_.step_s[at], cd = ws_.step_d[at];
-      if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > reach_s) return false;
-      // A car behind in another lane than the start's is one the ego would cut in front of:
-      // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
-      // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
-      // A car ahead needs room to brake behind it: headway_min at the ego's speed.
-      const bool behind_other_lane =
-          cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
-      // A car behind in another lane needs room to react and brake when it closes in.
-      const double closing = std::max(0.0, ws_.step_v[at] - st.s_d);
-      // The headway to a car ahead is kept in full while the ego is in its lane and tapers
-      // to margin_s as the ego moves out of it (pulling out from behind a car is how a
-      // lane change starts).
-      const double inside = std::clamp(
-          (cfg_.car_width - std::abs(cd - st.d)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
-      const double margin =
-          cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * st.s_d)
-          : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
-                              : margin_scale * cfg_.margin_s;
-      if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
-      // The car's heading from its predicted velocity (a lane change turns it).
-      const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
-      const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
-      const traj::OrientedBox car{cs, cd, 0.0, hl + margin, hw + margin_scale * cfg_.margin_d};
-      return traj::Overlap(ego, vs * inv, vd * inv, car, cv * cinv, cvd * cinv);
-    };
+    // No car within reach at this step: nothing to test (and no square root to take).
+    if constexpr (requires { state_at.Near(j); }) {
+      if ((state_at.Near(j) & cars) == 0) continue;
+    }
+    const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
     // Cars in index order either way: the first one hit is the same.
     if constexpr (requires { state_at.Near(j); }) {
       for (std::uint64_t m = state_at.Near(j) & cars; m != 0; m &= m - 1) {
         const int c = std::countr_zero(m);
-        if (hits(c)) {
+        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
           if (car_hit != nullptr) *car_hit = c;
           return j;
         }
       }
     } else {
       for (int c = 0; c < num_cars; ++c) {
-        if (hits(c)) {
+        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
           if (car_hit != nullptr) *car_hit = c;
           return j;
         }

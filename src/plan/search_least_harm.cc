@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "frenetic/plan/planner.h"
 #include "plan/search_scoring.h"
@@ -12,13 +13,119 @@ double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTra
   return ClearanceAt(cfg, ws, [&](int i) { return tr.At(i * kTickSeconds); });
 }
 
-LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock)
-    : cfg_(cfg), ws_(ws), checker_(checker), clock_(clock) {
+LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+                     const CycleClock& clock)
+    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
+  bound_.reserve(ws_.order.capacity());
+  heap_.reserve(ws_.order.capacity());
+  lon_done_.reserve(ws_.lon.capacity());
+  lat_done_.reserve(ws_.lat.capacity());
+  sep_.assign(kProbes * kMaxCars, 0.0);
+  lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
+  lat_sep_.assign(ws_.lat.capacity() * kProbes * kMaxCars, 0.0);
 }
 
 bool LeastHarm::Choose(bool* over_budget) {
+  const int best = BestClear(over_budget);
+  if (best >= 0) {
+    ws_.TakeWinner(best);
+    return true;
+  }
+  return !*over_budget && ChooseByRanking(over_budget);
+}
+
+// In harm order the collision-free candidates come first, by clearance, then cost: when one
+// of them is feasible the winner is the feasible collision-free one with the most clearance
+// (then the least cost, then the smallest index), a maximum found without ranking the others.
+// The candidates are visited by an upper bound of their clearance, the minimum over a few
+// steps only (a minimum over fewer separations is never smaller), best first, so that the
+// visit ends once no bound can reach the best clearance found; the clearance itself stops as
+// soon as it falls below that, and only a candidate that would rank before the best one is
+// tested for collision, then for feasibility.
+int LeastHarm::BestClear(bool* over_budget) {
+  const std::vector<int>& order = ws_.order;
+  const int n = static_cast<int>(order.size());
+  const int n_steps = ws_.n_steps;
+  const int num_cars = ws_.ctx.num_cars;
+  if (n_steps < 1) return -1;  // nothing to bound: the whole ranking
+  // The bound's steps: the first ones (where every candidate is still near the start, and the
+  // clearance is often smallest) and a few spread over the horizon.
+  const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+  // The two parts of each separation at those steps, per bundle (computed at its first
+  // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
+  const int row = kProbes * num_cars;
+  lon_done_.assign(ws_.lon.size(), 0);
+  lat_done_.assign(ws_.lat.size(), 0);
+  const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
+                        double* out) {
+    for (int q = 0; q < kProbes; ++q) {
+      const int j = std::clamp(probe[q], 1, n_steps);
+      for (int car = 0; car < num_cars; ++car) {
+        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
+      }
+    }
+  };
+  bound_.resize(ws_.cand_cost.size());
+  heap_.resize(n);
+  for (int r = 0; r < n; ++r) {
+    const int c = order[r];
+    const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+    if (!lon_done_[i] || !lat_done_[k]) {
+      const Checker::Rows rows = checker_.StepRows(c);
+      if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
+      if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
+      lon_done_[i] = lat_done_[k] = 1;
+    }
+    const double* a = &lon_sep_[i * row];
+    const double* b = &lat_sep_[k * row];
+    for (int q = 0; q < row; ++q) sep_[q] = std::max(a[q], b[q]);
+    bound_[c] = MinOf(sep_.data(), row);
+    heap_[r] = c;
+  }
+  // Largest bound first, then the smallest index (any order gives the same maximum; this one
+  // is deterministic).
+  const auto lower = [this](int a, int b) {
+    return bound_[a] < bound_[b] || (bound_[a] == bound_[b] && a > b);
+  };
+  std::make_heap(heap_.begin(), heap_.end(), lower);
+  int best = -1;
+  double best_clr = 0;
+  for (int k = 0; !heap_.empty(); ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const int c = heap_.front();
+    if (best >= 0 && bound_[c] < best_clr) break;
+    std::pop_heap(heap_.begin(), heap_.end(), lower);
+    heap_.pop_back();
+    const Checker::Rows rows = checker_.StepRows(c);
+    const double floor = best >= 0 ? best_clr : -std::numeric_limits<double>::infinity();
+    const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, floor);
+    if (best >= 0 && clr < best_clr) continue;
+    if (best >= 0 && clr == best_clr) {  // the cost decides (both exact), then the index
+      scorer_.ExactCost(c);
+      if (!Cheaper(ws_, c, best)) continue;
+    }
+    if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+        n_steps) {
+      continue;
+    }
+    if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+    scorer_.ExactCost(c);
+    best = c;
+    best_clr = clr;
+  }
+  return best;
+}
+
+bool LeastHarm::ChooseByRanking(bool* over_budget) {
+  if (!scorer_.ResolveAll()) {
+    *over_budget = true;
+    return false;
+  }
   std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   first_hit_.resize(n);
@@ -49,8 +156,12 @@ bool LeastHarm::Choose(bool* over_budget) {
         return false;
       }
       const int c = order[r];
-      checker_.FillTicks(ws_.Candidate(c));
-      if (checker_.Violation(nullptr, lane_line) > 0) continue;
+      if (lane_line) {
+        if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+      } else {
+        checker_.FillTicks(ws_.Candidate(c));
+        if (checker_.Violation(nullptr, false) > 0) continue;
+      }
       ws_.TakeWinner(c);
       return true;
     }

@@ -11,6 +11,7 @@
 
 #include "frenetic/traj/frenet.h"
 #include "plan/search_checks.h"
+#include "plan/search_scoring.h"
 #include "plan/search_settings.h"
 #include "plan/search_workspace.h"
 
@@ -63,25 +64,88 @@ inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepSt
   return worst;
 }
 
+// The smallest of v[0, n), ignoring NaN (1e9 when none is smaller): four running minima, so
+// that the comparisons do not wait for each other; the order does not change a minimum that
+// ignores NaN (and no value here is -0).
+inline double MinOf(const double* v, int n) {
+  double m[4] = {1e9, 1e9, 1e9, 1e9};
+  int q = 0;
+  for (; q + 4 <= n; q += 4) {
+    for (int u = 0; u < 4; ++u) m[u] = v[q + u] < m[u] ? v[q + u] : m[u];
+  }
+  for (; q < n; ++q) m[0] = v[q] < m[0] ? v[q] : m[0];
+  const double a = m[1] < m[0] ? m[1] : m[0], b = m[3] < m[2] ? m[3] : m[2];
+  return b < a ? b : a;
+}
+
+// ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
+// `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
+// minimum, car by car: the order does not change a minimum that ignores NaN.
+inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const double* s,
+                             const double* d, double floor) {
+  constexpr int kMaxSteps = 256;
+  const int n_steps = ws.n_steps;
+  if (n_steps >= kMaxSteps) {
+    return ClearanceAt(cfg, ws, [s, d, &ws](int i) {
+      const int j = i / ws.collision_step;
+      return traj::FrenetState{s[j], 0.0, 0.0, d[j], 0.0, 0.0};
+    });
+  }
+  double sep[kMaxSteps];
+  double worst = 1e9;
+  for (int c = 0; c < ws.ctx.num_cars; ++c) {
+    const double* cs = ws.step_s.data() + c * (n_steps + 1);
+    const double* cd = ws.step_d.data() + c * (n_steps + 1);
+    for (int j = 1; j <= n_steps; ++j) {
+      sep[j - 1] =
+          std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
+    }
+    const double row = MinOf(sep, n_steps);
+    worst = row < worst ? row : worst;
+    if (worst < floor) break;
+  }
+  return worst;
+}
+
 class LeastHarm {
  public:
-  // `ws`, `checker` and `clock` must outlive this; sized for ws's largest candidate set.
-  LeastHarm(const Settings& cfg, Workspace& ws, Checker& checker, const CycleClock& clock);
+  // `ws`, `scorer`, `checker` and `clock` must outlive this; sized for ws's largest candidate
+  // set.
+  LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+            const CycleClock& clock);
 
-  // Ranks the scored candidates ws.order by harm (latest contact, then most clearance, then
-  // cost; ws.order is left in that order) and makes the first feasible one the winner, else
-  // the first feasible but for the lane-line timer. False when none is even that, or when the
-  // deadline (85% of budget_ms) cut it short: then *over_budget is set.
+  // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
+  // contact, then most clearance, then cost), the first feasible one, else the first feasible
+  // but for the lane-line timer. Costs are made exact as the ranking needs them
+  // (Scorer::ExactCost; all of them for the whole ranking). When a collision-free
+  // candidate is feasible only the ones that could rank first are examined and ws.order is left
+  // as it is; else every candidate is ranked and ws.order is left in harm order. False when
+  // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
+  // short: then *over_budget is set.
   bool Choose(bool* over_budget);
 
  private:
+  // The first feasible collision-free candidate in harm order, -1 when there is none (or the
+  // deadline cut it short: then *over_budget is set).
+  int BestClear(bool* over_budget);
+  // The whole ranking: every candidate's contact and clearance, ws.order sorted by harm.
+  bool ChooseByRanking(bool* over_budget);
+
   const Settings& cfg_;
   Workspace& ws_;
+  Scorer& scorer_;
   Checker& checker_;
   const CycleClock& clock_;
-  // Per candidate: first collision step and clearance on bare boxes.
+  // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
+  // BestClear measured them already), and an upper bound of the clearance (BestClear).
+  std::vector<char> known_;
   std::vector<int> first_hit_;
-  std::vector<double> clearance_;
+  std::vector<double> clearance_, bound_;
+  std::vector<int> heap_;  // BestClear's candidates, a heap by bound
+  // BestClear's bound: its steps, and the separations' parts there per bundle.
+  static constexpr int kProbes = 8;
+  std::vector<char> lon_done_, lat_done_;
+  std::vector<double> lon_sep_, lat_sep_, sep_;
 };
 
 }  // namespace frenetic::plan::search

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "frenetic/plan/predictor.h"
@@ -30,6 +31,9 @@ namespace {
 using search::Finite;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
+
+// CheckLazily tests the rest of the candidates at once after this many ranks at least.
+constexpr int kCheckRestMin = 64;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -65,10 +69,12 @@ class SearchPlanner : public Planner {
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
         checker_(cfg_, *line_, ws_),
-        least_harm_(cfg_, ws_, checker_, timer_),
+        least_harm_(cfg_, ws_, scorer_, checker_, timer_),
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
+    collides_.assign(ws_.order.capacity(), 0);
+    rest_.reserve(ws_.order.capacity());
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -181,8 +187,6 @@ class SearchPlanner : public Planner {
       const double t_check = Elapsed();
       bool check_cut = false;
       found = CheckLazily(&check_cut);
-      // The least-harm choice ranks every candidate: every cost must be exact first.
-      if (!found && !check_cut && !scorer_.ResolveAll()) check_cut = true;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut);
       if (check_cut) {
         over_budget = true;
@@ -259,13 +263,26 @@ class SearchPlanner : public Planner {
   // Checks the scored candidates in cost order, sorting lazily, until one passes: the
   // Frenet-only collision test first, then the hard limits. False when none passed or the
   // deadline (85% of budget_ms) cut it short (then *over_budget is set).
+  // After the first quarter of the candidates (and the traced ones) have failed, the rest are
+  // tested at once, by their cost bound (CheckRest): when none of them passes either, the cycle
+  // ends without the exact cost of every candidate that the walk in cost order would need.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
+    const int rest_at = std::max({kCheckRestMin, n / 4, trace_ != nullptr ? trace_max_ : 0});
+    bool tested = false;  // the collisions of ranks >= rest_at are in collides_
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return false;
+      }
+      if (r == rest_at) {
+        bool cut = false;
+        tested = true;
+        if (!CheckRest(r, &cut)) {
+          if (cut) *over_budget = true;
+          return false;
+        }
       }
       if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
         *over_budget = true;
@@ -275,17 +292,23 @@ class SearchPlanner : public Planner {
       ++sum.candidates_checked;
       // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
       // conversion for the many candidates that run into traffic.
-      int hit_car = -1;
-      const int hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+      // Past the traced ranks, whether it collides is all the walk needs.
+      int hit_car = -1, hit = ws_.n_steps + 1;
+      if (tested && collides_[c] != kUntested) {
+        hit = collides_[c] ? 1 : hit;
+      } else if (trace_ != nullptr && r < trace_max_) {
+        hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+      } else {
+        hit = checker_.CandidateCollides(c) ? 1 : hit;
+      }
       if (hit <= ws_.n_steps) {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
               hit * ws_.collision_step * kTickSeconds);
         continue;
       }
-      checker_.FillTicks(ws_.Candidate(c));
       Reject why = Reject::kCount;
-      if (checker_.Violation(&why) > 0) {
+      if (checker_.CandidateViolation(c, &why) > 0) {
         ++sum.rejections[static_cast<int>(why)];
         Trace(r, false, static_cast<int>(why));
         continue;
@@ -300,6 +323,51 @@ class SearchPlanner : public Planner {
         Trace(rr, false, -1);
       }
       return true;
+    }
+    return false;
+  }
+
+  // Tests the candidates of ranks [r0, n) by their cost bound, cheapest first: for collision,
+  // then a collision-free one for the hard limits when it is cheaper than the cheapest that
+  // passed so far, until no bound is left below that one's cost (no later candidate can rank
+  // before it). True when one passed (the walk in cost order goes on, and stops at it; the
+  // candidates not reached are marked kUntested). Otherwise every one of them counts as checked
+  // and rejected, as the walk would have counted them, and false (*cut set when the deadline
+  // cut it short).
+  bool CheckRest(int r0, bool* cut) {
+    const int n = static_cast<int>(ws_.order.size());
+    rest_.clear();
+    for (int k = r0; k < n; ++k) {
+      const int c = ws_.order[k];
+      collides_[c] = kUntested;
+      rest_.push_back({scorer_.Bound(c), c});
+    }
+    std::sort(rest_.begin(), rest_.end());  // smallest bound, then index, first
+    int best = -1;  // the cheapest candidate that passed
+    for (int k = 0; k < static_cast<int>(rest_.size()); ++k) {
+      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+        *cut = true;
+        return false;
+      }
+      const int c = rest_[k].second;
+      if (best >= 0) {
+        const double bc = rest_[k].first, cost = ws_.cand_cost[best];
+        if (bc > cost || (bc == cost && c > best)) return true;
+      }
+      collides_[c] = checker_.CandidateCollides(c);
+      if (collides_[c]) continue;
+      scorer_.ExactCost(c);
+      if (best >= 0 && !search::Cheaper(ws_, c, best)) continue;
+      if (checker_.CandidateViolation(c, nullptr) <= 0) best = c;
+    }
+    if (best >= 0) return true;
+    PlanSummary& sum = result_.summary;
+    for (int k = r0; k < n; ++k) {
+      const int c = ws_.order[k];
+      ++sum.candidates_checked;
+      Reject why = Reject::kCollision;
+      if (!collides_[c]) checker_.CandidateViolation(c, &why);
+      ++sum.rejections[static_cast<int>(why)];
     }
     return false;
   }
@@ -377,6 +445,10 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
+  // CheckRest: per candidate, whether it collides (or kUntested); its candidates by bound.
+  std::vector<char> collides_;
+  static constexpr char kUntested = 2;
+  std::vector<std::pair<double, int>> rest_;
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)

@@ -23,6 +23,8 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   pos_.reserve(cap);
   pending_.reserve(cap);
   ready_.reserve(cap);
+  resolved_.assign(cap, 1);
+  cheap_.assign(cap * costs_.size(), 0.0);
 }
 
 cost::CostInput Scorer::InputFor(int i, int j) const {
@@ -52,6 +54,11 @@ bool Scorer::Score() {
   ws_.order.resize(n);
   bound_.resize(n);
   pos_.resize(n);
+  if (resolved_.size() < static_cast<std::size_t>(n)) resolved_.resize(n);
+  if (cheap_.size() < static_cast<std::size_t>(n) * costs_.size()) {
+    cheap_.resize(static_cast<std::size_t>(n) * costs_.size());
+  }
+  std::fill(resolved_.begin(), resolved_.begin() + n, 0);
   ws_.sorted = 0;
   pending_.clear();
   ready_.clear();
@@ -62,7 +69,8 @@ bool Scorer::Score() {
       break;
     }
     // Resolve() makes the cost 1e300 when it is not finite: never below this bound.
-    const double b = costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
+    const double b = costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+                                       &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
     bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
     ws_.order[c] = c;
     pos_[c] = c;
@@ -73,8 +81,16 @@ bool Scorer::Score() {
   return scored == n;
 }
 
+double Scorer::ExactCost(int c) {
+  if (c < static_cast<int>(resolved_.size())) Resolve(c);
+  return ws_.cand_cost[c];
+}
+
 void Scorer::Resolve(int c) {
-  const double v = costs_.Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
+  if (resolved_[c]) return;
+  resolved_[c] = 1;
+  const double v = costs_.EvaluateWithCheap(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+                                            &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
 }
 

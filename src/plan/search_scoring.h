@@ -61,6 +61,11 @@ class Scorer {
   // Makes every ws.cand_cost exact (for an order over all candidates). False when the deadline
   // (85% of budget_ms, the checks' share) stopped it early.
   bool ResolveAll();
+  // Candidate c's exact cost (ws.cand_cost[c]), evaluated now if Score() left only its bound;
+  // the lazy sort's result is unchanged. Costs set without Score() are taken as exact.
+  double ExactCost(int c);
+  // Candidate c's lower bound from Score(): its exact cost is never below it.
+  double Bound(int c) const { return bound_[c]; }
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
   cost::CostInput InputFor(int i, int j) const;
@@ -95,6 +100,10 @@ class Scorer {
   // heap by cost, then index). Sized once (capacity of ws.order).
   std::vector<double> bound_;
   std::vector<int> pos_, pending_, ready_;
+  std::vector<char> resolved_;  // per candidate: ws.cand_cost is exact
+  // Per candidate, the cheap terms' values Score() computed for its bound ([c * terms + t]):
+  // Resolve() evaluates only the expensive ones.
+  std::vector<double> cheap_;
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;
 };
 

@@ -2,6 +2,10 @@
 // before less, the latest contact when all collide, the cost order last, and never infeasible.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+#include <vector>
+
 #include "plan/search_stages_testing.h"
 
 namespace frenetic::plan::search {
@@ -67,10 +71,25 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   ASSERT_TRUE(st.least_harm.Choose(&over_budget));
   EXPECT_FALSE(over_budget);
   EXPECT_EQ(st.ws.winner_index, 2);
-  EXPECT_EQ(st.ws.order[0], 2);
-  EXPECT_EQ(st.ws.order[1], 1);
-  EXPECT_EQ(st.ws.order[2], 0) << "the collision last";
-  EXPECT_EQ(st.ws.sorted, 3);
+  // Without the roomiest one, the next in room; without both, the collision.
+  SetCandidates(st, {{20, 3.0, 1.0}, {10, 4.0, 2.0}});
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 1);
+  SetCandidates(st, {{20, 3.0, 1.0}});
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 0);
+  EXPECT_EQ(st.ws.sorted, 1) << "every candidate collides: the whole ranking";
+}
+
+TEST(SearchLeastHarmTest, EqualClearanceGoesToTheLowerCost) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
+  // The same trajectory twice: the same clearance, the cost decides, then the index.
+  SetCandidates(st, {{10, 3.0, 3.0}, {10, 4.0, 2.0}, {10, 3.0, 1.0}, {10, 3.0, 1.0}});
+  bool over_budget = false;
+  ASSERT_TRUE(st.least_harm.Choose(&over_budget));
+  EXPECT_EQ(st.ws.winner_index, 2);
 }
 
 TEST(SearchLeastHarmTest, TakesTheLatestContactWhenAllCollideAndCostBreaksTies) {
@@ -95,6 +114,65 @@ TEST(SearchLeastHarmTest, NeverTakesAnInfeasibleCandidate) {
   bool over_budget = false;
   EXPECT_FALSE(st.least_harm.Choose(&over_budget));
   EXPECT_FALSE(over_budget);
+}
+
+// The whole ranking as the search planner once did it: every candidate's contact and
+// clearance, sorted, then the first feasible one with the lane-line timer, else without.
+int ReferenceChoice(Stages& st) {
+  Workspace& ws = st.ws;
+  std::vector<int> order = ws.order;
+  std::vector<int> hit(ws.cand_cost.size());
+  std::vector<double> room(ws.cand_cost.size());
+  for (const int c : order) {
+    const StepStates steps = st.checker.StepsOf(c, 0.0, 1.0);
+    hit[c] = st.checker.FirstCollision(steps, 0.0, 1.0, nullptr, false);
+    room[c] = hit[c] > ws.n_steps ? ClearanceAt(st.cfg, ws, steps) : 0.0;
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    if (hit[a] != hit[b]) return hit[a] > hit[b];
+    if (room[a] != room[b]) return room[a] > room[b];
+    return Cheaper(ws, a, b);
+  });
+  for (const bool lane_line : {true, false}) {
+    for (const int c : order) {
+      st.checker.FillTicks(ws.Candidate(c));
+      if (st.checker.Violation(nullptr, lane_line) <= 0) return c;
+    }
+  }
+  return -1;
+}
+
+TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0);
+  int chosen = 0;
+  for (int scene = 0; scene < 24; ++scene) {
+    // Traffic in every lane around the ego, denser scene by scene; the ego at various speeds
+    // and offsets, and with the lane-line count near and past its limit.
+    std::vector<SceneCar> cars;
+    for (int k = 0; k < 3 + scene / 2; ++k) {
+      cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
+    }
+    const double d0 = st.ws.lane_center[1] + (scene % 4 == 3 ? 1.6 : 0.0);
+    Start(st, cars);
+    st.Prepare({kS, 8.0 + scene % 12, 0, d0, 0, 0}, cars);
+    st.ws.straddle_at_start = scene % 4 == 3 ? 100 + 10 * (scene % 5) : 0;
+    st.lattice.Generate();
+    ASSERT_TRUE(st.scorer.Score());
+    ASSERT_TRUE(st.scorer.ResolveAll());
+    const int expected = ReferenceChoice(st);
+    bool over_budget = false;
+    const bool ok = st.least_harm.Choose(&over_budget);
+    EXPECT_FALSE(over_budget);
+    EXPECT_EQ(ok, expected >= 0) << "scene " << scene;
+    if (ok) {
+      EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    }
+    chosen += ok;
+  }
+  EXPECT_GT(chosen, 12);
 }
 
 }  // namespace

@@ -67,7 +67,7 @@ struct Stages {
         lattice(cfg, *predictor, ws),
         scorer(cfg, *costs, ws, clock),
         checker(cfg, *line, ws),
-        least_harm(cfg, ws, checker, clock),
+        least_harm(cfg, ws, scorer, checker, clock),
         refiner(cfg, config.refine_algorithm(), ws, lattice, scorer, checker, clock),
         continuity(cfg, *line, ws, clock) {}
 

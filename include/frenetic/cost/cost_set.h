@@ -38,7 +38,12 @@ class CostSet {
   // in) (terms and weights are >= 0, and rounded addition and multiplication are monotone), so a
   // candidate whose bound is above another's exact total cannot rank before it. NaN when a
   // cheap term is NaN (Evaluate is then NaN too). Does not allocate.
-  double LowerBound(const CostContext& ctx, const CostInput& in) const;
+  // When cheap is not null it receives the unweighted value of each term that is not
+  // Expensive() (0 for those that are; size() entries).
+  double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr) const;
+  // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
+  // Expensive() terms are evaluated; the same sum, term for term. Does not allocate.
+  double EvaluateWithCheap(const CostContext& ctx, const CostInput& in, const double* cheap) const;
 
  private:
   CostSet() = default;

@@ -6,6 +6,7 @@
 // (the map's s is taken relative to waypoint 0's s).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -26,6 +27,15 @@ struct CartesianPose {
   // outer side with the larger radius). Kept finite (|1 + kappa0 d| >= 1e-6) past the centre of
   // curvature.
   double kappa = 0;
+};
+
+// The centre line's point at some s and the unit vector along it: ToCartesian's (s, d) is
+// (x + d sin, y - d cos), with d = 0 when not finite (Offset).
+struct CentrePoint {
+  double x = 0, y = 0;  // m
+  double cos = 0, sin = 0;
+  double OffsetX(double d) const { return x + (std::isfinite(d) ? d : 0.0) * sin; }
+  double OffsetY(double d) const { return y - (std::isfinite(d) ? d : 0.0) * cos; }
 };
 
 // One sample of the centre line (d = 0).
@@ -57,6 +67,9 @@ class ReferenceLine {
   // Pose of the point at (s, d): x, y, heading of the road there and curvature of the offset
   // curve. Any finite s is wrapped. Never fails.
   CartesianPose ToCartesian(double s, double d) const;
+  // The centre line's point at s for ToCartesian's x and y at any d (the same arithmetic): for
+  // many points that share s.
+  CentrePoint Centre(double s) const;
   // Projection of (x, y) onto the line (Newton steps), robust at the seam and far from the road:
   // the nearest point of the line, s in [0, length()). Exact inverse of ToCartesian (same
   // interpolants). With a hint the search walks from s_hint (~1 us; falls back to the global
