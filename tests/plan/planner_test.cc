@@ -399,7 +399,10 @@ TEST(SearchPlannerTest, DeadlineStopsScoringSkipsRefinementAndSaysSo) {
   EXPECT_EQ(pinned.status, PlanStatus::kOk);
   EXPECT_EQ(pinned.stage, PlanSummary::Stage::kNone);
   EXPECT_EQ(pinned.scored, pinned.generated);
-  EXPECT_EQ(pinned.refine_iterations, free.refine_iterations);
+  // It ran: as far as in the free run at least (that one's 2 ms cap is real time, and a loaded
+  // machine, e.g. under the sanitizers, may stop it a few iterations short; pinned has none).
+  EXPECT_GT(pinned.refine_iterations, 0);
+  EXPECT_GE(pinned.refine_iterations, free.refine_iterations);
 }
 
 TEST(PlannerConfigTest, SettingAPinnedDeadlineSwitchesItBackOn) {
