@@ -205,27 +205,6 @@ Checker::ReadRange Checker::ReadBetween(const double* s, const double* d, int pr
   return {d_lo + r.lo, d_hi + r.hi};
 }
 
-bool Checker::CandidateBreaksLaneLine(int c) {
-  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
-  SampleTicks(ws_.lon[i].traj, i, lon_ticks_, &lon_centre_);
-  SampleTicks(ws_.lat[k].traj, k, lat_ticks_, nullptr);
-  const int w = ws_.n_ticks + 1;
-  const double* s = &lon_ticks_.p[i * w];
-  const double* d = &lat_ticks_.p[k * w];
-  // Measure's count, stopped as soon as it is over the limit.
-  const int n_ticks = ws_.n_ticks;
-  int straddle = ws_.straddle_at_start;
-  if (straddle > kMaxStraddleTicks) return true;
-  for (int prev = 1, t = std::min(5, n_ticks); n_ticks >= 1;
-       prev = t, t = std::min(t + 5, n_ticks)) {
-    const ReadRange read = ReadBetween(s, d, prev, t);
-    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (t - prev) + (prev == 1) : 0;
-    if (straddle > kMaxStraddleTicks) return true;
-    if (t == n_ticks) break;
-  }
-  return straddle > 0;  // still astride at the end
-}
-
 double Checker::CandidateViolation(int c, Reject* reason) {
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
   Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;

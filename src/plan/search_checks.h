@@ -90,11 +90,6 @@ class Checker {
   // left as they are.
   double CandidateViolation(int c, Reject* reason);
 
-  // Whether candidate c's ticks break the lane-line timer (Violation's lane-line term > 0, so
-  // CandidateViolation > 0): the same count, stopped once it is over the limit, on the
-  // bundles' ticks.
-  bool CandidateBreaksLaneLine(int c);
-
   // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
   bool Collides() const {
     return FirstCollision(

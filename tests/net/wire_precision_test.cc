@@ -110,27 +110,28 @@ std::vector<double> Pick(std::mt19937_64& rng, std::size_t n, const std::vector<
 }
 
 plan::Telemetry RandomTelemetry(std::mt19937_64& rng, const std::vector<double>& pool) {
+  const auto any = [&] { return pool[rng() % pool.size()]; };
   plan::Telemetry t;
-  t.x = pool[rng() % pool.size()];
-  t.y = pool[rng() % pool.size()];
-  t.yaw = pool[rng() % pool.size()];
-  t.speed = pool[rng() % pool.size()];
-  t.s = pool[rng() % pool.size()];
-  t.d = pool[rng() % pool.size()];
-  t.end_path_s = pool[rng() % pool.size()];
-  t.end_path_d = pool[rng() % pool.size()];
+  t.x = any();
+  t.y = any();
+  t.yaw = any();
+  t.speed = any();
+  t.s = any();
+  t.d = any();
+  t.end_path_s = any();
+  t.end_path_d = any();
   const std::size_t n = rng() % 60;
   t.previous_path_x = Pick(rng, n, pool);
   t.previous_path_y = Pick(rng, rng() % 8 == 0 ? rng() % 60 : n, pool);  // sometimes unequal
   t.sensor_fusion.resize(rng() % 14);
   for (plan::SensorCar& c : t.sensor_fusion) {
     c.id = static_cast<int>(rng() % 12);
-    c.x = pool[rng() % pool.size()];
-    c.y = pool[rng() % pool.size()];
-    c.vx = pool[rng() % pool.size()];
-    c.vy = pool[rng() % pool.size()];
-    c.s = pool[rng() % pool.size()];
-    c.d = pool[rng() % pool.size()];
+    c.x = any();
+    c.y = any();
+    c.vx = any();
+    c.vy = any();
+    c.s = any();
+    c.d = any();
   }
   return t;
 }
