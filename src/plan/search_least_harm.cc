@@ -16,8 +16,10 @@ double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTra
 LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
                      const CycleClock& clock)
     : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
+  known_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
+  contact_.reserve(ws_.order.capacity());
   bound_.reserve(ws_.order.capacity());
   heap_.reserve(ws_.order.capacity());
   lon_done_.reserve(ws_.lon.capacity());
@@ -28,12 +30,14 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
 }
 
 bool LeastHarm::Choose(bool* over_budget) {
-  const int best = BestClear(over_budget);
+  bool all_known = false;
+  int best = BestClear(over_budget, &all_known);
+  if (best < 0 && all_known && !*over_budget) best = LatestContact(over_budget);
   if (best >= 0) {
     ws_.TakeWinner(best);
     return true;
   }
-  return !*over_budget && ChooseByRanking(over_budget);
+  return !*over_budget && ChooseByRanking(over_budget, all_known);
 }
 
 // In harm order the collision-free candidates come first, by clearance, then cost: when one
@@ -44,12 +48,16 @@ bool LeastHarm::Choose(bool* over_budget) {
 // visit ends once no bound can reach the best clearance found; the clearance itself stops as
 // soon as it falls below that, and only a candidate that would rank before the best one is
 // tested for collision, then for feasibility.
-int LeastHarm::BestClear(bool* over_budget) {
+int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
   const std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   const int n_steps = ws_.n_steps;
   const int num_cars = ws_.ctx.num_cars;
+  *all_known = false;
   if (n_steps < 1) return -1;  // nothing to bound: the whole ranking
+  known_.assign(n, 0);
+  first_hit_.resize(n);
+  clearance_.resize(n);
   // The bound's steps: the first ones (where every candidate is still near the start, and the
   // clearance is often smallest) and a few spread over the horizon.
   const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
@@ -101,11 +109,27 @@ int LeastHarm::BestClear(bool* over_budget) {
     if (best >= 0 && bound_[c] < best_clr) break;
     std::pop_heap(heap_.begin(), heap_.end(), lower);
     heap_.pop_back();
+    if (best < 0) {
+      // Nothing to beat yet: whether it collides first (most do, and then its clearance is
+      // not needed: the ranking counts it as 0), and what ChooseByRanking would measure.
+      first_hit_[c] = checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr,
+                                              false);
+      clearance_[c] = 0.0;
+      known_[c] = 1;
+      if (first_hit_[c] <= n_steps) continue;
+      const Checker::Rows rows = checker_.StepRows(c);
+      clearance_[c] = ClearanceAbove(cfg_, ws_, rows.s, rows.d,
+                                     -std::numeric_limits<double>::infinity());
+      if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+      scorer_.ExactCost(c);
+      best = c;
+      best_clr = clearance_[c];
+      continue;
+    }
     const Checker::Rows rows = checker_.StepRows(c);
-    const double floor = best >= 0 ? best_clr : -std::numeric_limits<double>::infinity();
-    const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, floor);
-    if (best >= 0 && clr < best_clr) continue;
-    if (best >= 0 && clr == best_clr) {  // the cost decides (both exact), then the index
+    const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, best_clr);
+    if (clr < best_clr) continue;
+    if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
       if (!Cheaper(ws_, c, best)) continue;
     }
@@ -118,16 +142,55 @@ int LeastHarm::BestClear(bool* over_budget) {
     best = c;
     best_clr = clr;
   }
+  // With no winner every candidate was visited before the best one was found.
+  *all_known = best < 0;
   return best;
 }
 
-bool LeastHarm::ChooseByRanking(bool* over_budget) {
+// No collision-free candidate is feasible (BestClear visited them all): in harm order the
+// colliding ones come next, latest contact first, and at equal contact their clearance is 0,
+// so the cost decides. The contact groups are taken latest first; in each, the candidates by
+// cost bound, feasible ones only, until no bound is below the cheapest feasible one's cost.
+int LeastHarm::LatestContact(bool* over_budget) {
+  const std::vector<int>& order = ws_.order;
+  const int n = static_cast<int>(order.size());
+  contact_.clear();
+  for (int r = 0; r < n; ++r) {
+    const int c = order[r];
+    if (first_hit_[c] <= ws_.n_steps) contact_.push_back({-first_hit_[c], scorer_.Bound(c), c});
+  }
+  std::sort(contact_.begin(), contact_.end());  // latest contact, then smallest bound, index
+  int best = -1;
+  for (int k = 0; k < static_cast<int>(contact_.size()); ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const auto& [neg_hit, bound, c] = contact_[k];
+    if (best >= 0) {
+      if (neg_hit != -first_hit_[best]) break;  // an earlier contact: the best one stands
+      const double cost = ws_.cand_cost[best];
+      if (bound > cost || (bound == cost && c > best)) {
+        // No cheaper one in this group: skip to the next group's end (the loop breaks there).
+        continue;
+      }
+    }
+    scorer_.ExactCost(c);
+    if (best >= 0 && !Cheaper(ws_, c, best)) continue;
+    if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+    best = c;
+  }
+  return best;
+}
+
+bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
   if (!scorer_.ResolveAll()) {
     *over_budget = true;
     return false;
   }
   std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
+  if (!all_known) known_.assign(n, 0);
   first_hit_.resize(n);
   clearance_.resize(n);
   for (int r = 0; r < n; ++r) {
@@ -136,6 +199,7 @@ bool LeastHarm::ChooseByRanking(bool* over_budget) {
       return false;
     }
     const int c = order[r];
+    if (known_[c]) continue;
     const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
     first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
     clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(cfg_, ws_, steps) : 0.0;
@@ -148,8 +212,10 @@ bool LeastHarm::ChooseByRanking(bool* over_budget) {
     return Cheaper(ws_, a, b);
   });
   ws_.sorted = n;
-  // Feasible first; then ignoring the lane-line timer (an incident, but not a crash).
+  // Feasible first (none is when every candidate was known: LatestContact found none); then
+  // ignoring the lane-line timer (an incident, but not a crash).
   for (const bool lane_line : {true, false}) {
+    if (lane_line && all_known) continue;
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <vector>
 
 #include "frenetic/traj/frenet.h"
@@ -117,19 +118,25 @@ class LeastHarm {
   // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
   // contact, then most clearance, then cost), the first feasible one, else the first feasible
   // but for the lane-line timer. Costs are made exact as the ranking needs them
-  // (Scorer::ExactCost; all of them for the whole ranking). When a collision-free
-  // candidate is feasible only the ones that could rank first are examined and ws.order is left
-  // as it is; else every candidate is ranked and ws.order is left in harm order. False when
+  // (Scorer::ExactCost; all of them for the whole ranking). When a candidate is feasible only
+  // the ones that could rank before it are examined and ws.order is left as it is; else every
+  // candidate is ranked and ws.order is left in harm order. False when
   // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
   // short: then *over_budget is set.
   bool Choose(bool* over_budget);
 
  private:
   // The first feasible collision-free candidate in harm order, -1 when there is none (or the
-  // deadline cut it short: then *over_budget is set).
-  int BestClear(bool* over_budget);
-  // The whole ranking: every candidate's contact and clearance, ws.order sorted by harm.
-  bool ChooseByRanking(bool* over_budget);
+  // deadline cut it short: then *over_budget is set). *all_known: none is, and every
+  // candidate's contact and clearance are in first_hit_ and clearance_.
+  int BestClear(bool* over_budget, bool* all_known);
+  // After BestClear found none with every candidate known: the first feasible colliding
+  // candidate in harm order, -1 when there is none (or the deadline cut it short).
+  int LatestContact(bool* over_budget);
+  // The whole ranking: every candidate's contact and clearance (unless all_known), ws.order
+  // sorted by harm, the first feasible one (unless all_known: none is), else the first
+  // feasible but for the lane-line timer.
+  bool ChooseByRanking(bool* over_budget, bool all_known);
 
   const Settings& cfg_;
   Workspace& ws_;
@@ -141,6 +148,8 @@ class LeastHarm {
   std::vector<char> known_;
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;
+  // LatestContact's colliding candidates: minus the contact step, cost bound, index.
+  std::vector<std::tuple<int, double, int>> contact_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;

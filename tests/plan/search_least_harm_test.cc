@@ -78,7 +78,7 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   SetCandidates(st, {{20, 3.0, 1.0}});
   ASSERT_TRUE(st.least_harm.Choose(&over_budget));
   EXPECT_EQ(st.ws.winner_index, 0);
-  EXPECT_EQ(st.ws.sorted, 1) << "every candidate collides: the whole ranking";
+  EXPECT_EQ(st.ws.sorted, 0) << "a feasible colliding one is found without the whole ranking";
 }
 
 TEST(SearchLeastHarmTest, EqualClearanceGoesToTheLowerCost) {
@@ -101,8 +101,6 @@ TEST(SearchLeastHarmTest, TakesTheLatestContactWhenAllCollideAndCostBreaksTies) 
   bool over_budget = false;
   ASSERT_TRUE(st.least_harm.Choose(&over_budget));
   EXPECT_EQ(st.ws.winner_index, 2) << "identical trajectories: the cheaper one";
-  EXPECT_EQ(st.ws.order[1], 1);
-  EXPECT_EQ(st.ws.order[2], 0);
 }
 
 TEST(SearchLeastHarmTest, NeverTakesAnInfeasibleCandidate) {
@@ -161,10 +159,15 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
     st.ws.straddle_at_start = scene % 4 == 3 ? 100 + 10 * (scene % 5) : 0;
     st.lattice.Generate();
     ASSERT_TRUE(st.scorer.Score());
-    ASSERT_TRUE(st.scorer.ResolveAll());
-    const int expected = ReferenceChoice(st);
+    // Every other scene, Choose makes the costs exact itself, as far as it needs them.
+    const bool lazy = scene % 2 == 1;
+    if (!lazy) {
+      ASSERT_TRUE(st.scorer.ResolveAll());
+    }
     bool over_budget = false;
     const bool ok = st.least_harm.Choose(&over_budget);
+    ASSERT_TRUE(st.scorer.ResolveAll());
+    const int expected = ReferenceChoice(st);
     EXPECT_FALSE(over_budget);
     EXPECT_EQ(ok, expected >= 0) << "scene " << scene;
     if (ok) {
