@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -32,8 +33,9 @@ using search::Finite;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
 
-// CheckLazily tests the rest of the candidates at once after this many ranks at least.
-constexpr int kCheckRestMin = 64;
+// CheckLazily walks this many ranks in cost order (more when traced), then tests the rest by
+// their cost bound.
+constexpr int kCheckRestMin = 16;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -73,7 +75,6 @@ class SearchPlanner : public Planner {
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
-    collides_.assign(ws_.order.capacity(), 0);
     rest_.reserve(ws_.order.capacity());
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
@@ -263,14 +264,12 @@ class SearchPlanner : public Planner {
   // Checks the scored candidates in cost order, sorting lazily, until one passes: the
   // Frenet-only collision test first, then the hard limits. False when none passed or the
   // deadline (85% of budget_ms) cut it short (then *over_budget is set).
-  // After the first quarter of the candidates (and the traced ones) have failed, the rest are
-  // tested at once, by their cost bound (CheckRest): when none of them passes either, the cycle
-  // ends without the exact cost of every candidate that the walk in cost order would need.
+  // Past the first few ranks (and the traced ones) the rest are tested by their cost bound
+  // instead (CheckRest), which needs no exact cost for a candidate that collides.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
-    const int rest_at = std::max({kCheckRestMin, n / 4, trace_ != nullptr ? trace_max_ : 0});
-    bool tested = false;  // the collisions of ranks >= rest_at are in collides_
+    const int rest_at = std::max(kCheckRestMin, trace_ != nullptr ? trace_max_ : 0);
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
@@ -278,11 +277,11 @@ class SearchPlanner : public Planner {
       }
       if (r == rest_at) {
         bool cut = false;
-        tested = true;
-        if (!CheckRest(r, &cut)) {
-          if (cut) *over_budget = true;
-          return false;
-        }
+        const int best = CheckRest(r, &cut);
+        if (cut) *over_budget = true;
+        if (best < 0) return false;
+        ws_.TakeWinner(best);
+        return true;
       }
       if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
         *over_budget = true;
@@ -294,9 +293,7 @@ class SearchPlanner : public Planner {
       // conversion for the many candidates that run into traffic.
       // Past the traced ranks, whether it collides is all the walk needs.
       int hit_car = -1, hit = ws_.n_steps + 1;
-      if (tested && collides_[c] != kUntested) {
-        hit = collides_[c] ? 1 : hit;
-      } else if (trace_ != nullptr && r < trace_max_) {
+      if (trace_ != nullptr && r < trace_max_) {
         hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
       } else {
         hit = checker_.CandidateCollides(c) ? 1 : hit;
@@ -327,49 +324,52 @@ class SearchPlanner : public Planner {
     return false;
   }
 
-  // Tests the candidates of ranks [r0, n) by their cost bound, cheapest first: for collision,
-  // then a collision-free one for the hard limits when it is cheaper than the cheapest that
-  // passed so far, until no bound is left below that one's cost (no later candidate can rank
-  // before it). True when one passed (the walk in cost order goes on, and stops at it; the
-  // candidates not reached are marked kUntested). Otherwise every one of them counts as checked
-  // and rejected, as the walk would have counted them, and false (*cut set when the deadline
-  // cut it short).
-  bool CheckRest(int r0, bool* cut) {
+  // The cheapest candidate of ranks [r0, n) that passes every check, -1 when none does (or the
+  // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
+  // (a heap: only the ones taken are ordered), and tested for collision; one that does not
+  // collide gets its exact cost, and the hard limits when it is cheaper than the cheapest that
+  // passed so far. The test ends once no bound is left below that one's cost (no candidate
+  // left can be cheaper). Every one tested counts as checked, and as rejected when it collides
+  // or breaks a limit (one outranked by a passing one is neither).
+  int CheckRest(int r0, bool* cut) {
+    PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
     rest_.clear();
     for (int k = r0; k < n; ++k) {
       const int c = ws_.order[k];
-      collides_[c] = kUntested;
       rest_.push_back({scorer_.Bound(c), c});
     }
-    std::sort(rest_.begin(), rest_.end());  // smallest bound, then index, first
+    const auto later = std::greater<std::pair<double, int>>();  // a min-heap by bound, index
+    std::make_heap(rest_.begin(), rest_.end(), later);
     int best = -1;  // the cheapest candidate that passed
-    for (int k = 0; k < static_cast<int>(rest_.size()); ++k) {
+    for (int k = 0; !rest_.empty(); ++k) {
       if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
-        return false;
+        return -1;
       }
-      const int c = rest_[k].second;
+      const auto [bc, c] = rest_.front();
       if (best >= 0) {
-        const double bc = rest_[k].first, cost = ws_.cand_cost[best];
-        if (bc > cost || (bc == cost && c > best)) return true;
+        const double cost = ws_.cand_cost[best];
+        if (bc > cost || (bc == cost && c > best)) break;
       }
-      collides_[c] = checker_.CandidateCollides(c);
-      if (collides_[c]) continue;
+      std::pop_heap(rest_.begin(), rest_.end(), later);
+      rest_.pop_back();
+      ++sum.candidates_checked;
+      if (checker_.CandidateCollides(c)) {
+        ++sum.rejections[static_cast<int>(Reject::kCollision)];
+        continue;
+      }
       scorer_.ExactCost(c);
       if (best >= 0 && !search::Cheaper(ws_, c, best)) continue;
-      if (checker_.CandidateViolation(c, nullptr) <= 0) best = c;
+      Reject why = Reject::kCount;
+      if (checker_.CandidateViolation(c, &why) > 0) {
+        ++sum.rejections[static_cast<int>(why)];
+        continue;
+      }
+      ++sum.candidates_feasible;
+      best = c;
     }
-    if (best >= 0) return true;
-    PlanSummary& sum = result_.summary;
-    for (int k = r0; k < n; ++k) {
-      const int c = ws_.order[k];
-      ++sum.candidates_checked;
-      Reject why = Reject::kCollision;
-      if (!collides_[c]) checker_.CandidateViolation(c, &why);
-      ++sum.rejections[static_cast<int>(why)];
-    }
-    return false;
+    return best;
   }
 
   // car: context index of the car a collision rejection is against (-1: none), at time t.
@@ -445,10 +445,7 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
-  // CheckRest: per candidate, whether it collides (or kUntested); its candidates by bound.
-  std::vector<char> collides_;
-  static constexpr char kUntested = 2;
-  std::vector<std::pair<double, int>> rest_;
+  std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
