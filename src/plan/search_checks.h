@@ -273,12 +273,15 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
       : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                           : margin_scale * cfg_.margin_s;
   if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
-  // The car's heading from its predicted velocity (a lane change turns it).
-  const double cv = std::max(ws_.step_v[at], 0.5), cvd = ws_.step_vd[at];
-  const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+  const double cu = ws_.step_dir_s[at], cw = ws_.step_dir_d[at];  // the car's unit heading
   const traj::OrientedBox car{cs, cd, 0.0, ego.half_length + margin,
                               ego.half_width + margin_scale * cfg_.margin_d};
-  return traj::Overlap(ego, e.dir_s, e.dir_d, car, cv * cinv, cvd * cinv);
+  // The d axis separates the boxes when their extents along it do not reach (most cars
+  // alongside, in the next lane): a gap over 1 mm is one Overlap finds on its axes too.
+  const double reach_d = ego.half_length * std::abs(e.dir_d) + ego.half_width * e.dir_s +
+                         car.half_length * std::abs(cw) + car.half_width * cu;
+  if (std::abs(cd - ego.cy) > reach_d + 1e-3) return false;
+  return traj::Overlap(ego, e.dir_s, e.dir_d, car, cu, cw);
 }
 
 template <typename StateAt>

@@ -114,6 +114,11 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
       ws.step_d[row + j] = p.d;
       ws.step_v[row + j] = p.v;
       ws.step_vd[row + j] = p.v_d;
+      // The car's heading from its predicted velocity (a lane change turns it).
+      const double cv = std::max(p.v, 0.5), cvd = p.v_d;
+      const double cinv = 1.0 / std::sqrt(cv * cv + cvd * cvd);
+      ws.step_dir_s[row + j] = cv * cinv;
+      ws.step_dir_d[row + j] = cvd * cinv;
     }
     ++nc;
   }

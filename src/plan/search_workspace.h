@@ -70,10 +70,11 @@ struct Workspace {
   // Traffic of the cycle (context index c): predicted s, d, speed at the scoring samples
   // ([c * n_samples + k]), where it is at the start instant, its predictor index, and its
   // predicted s, d, speed and lateral speed at the collision-check steps ([c * (n_steps + 1) +
-  // j], t_keep + j * collision_step ticks).
+  // j], t_keep + j * collision_step ticks), and its unit heading (s', d') there, with s' at
+  // least 0.5.
   std::vector<double> car_s, car_d, car_v, car_s0, car_d0;
   std::vector<int> car_index;
-  std::vector<double> step_s, step_d, step_v, step_vd;
+  std::vector<double> step_s, step_d, step_v, step_vd, step_dir_s, step_dir_d;
   double step_v_max = std::numeric_limits<double>::infinity();  // >= every step_v (inf: unknown)
   std::uint64_t traffic_stamp = 0;  // changes whenever the traffic arrays above are rewritten
   std::vector<double> prev_s, prev_d;  // the previous winner at the scoring samples
