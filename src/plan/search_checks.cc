@@ -87,7 +87,8 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
       std::uint64_t m = 0;
       for (int car = 0; car < num_cars; ++car) {
         const double cs = ws_.step_s[car * w + j];
-        m |= std::abs(cs - s) > reach_s ? 0 : std::uint64_t{1} << car;
+        // Branch-free: which cars pass is data the branch predictor cannot learn.
+        m |= static_cast<std::uint64_t>(!(std::abs(cs - s) > reach_s)) << car;
       }
       lon_near_[i * w + j] = m;
     }
@@ -100,7 +101,7 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
       std::uint64_t m = 0;
       for (int car = 0; car < num_cars; ++car) {
         const double cd = ws_.step_d[car * w + j];
-        m |= std::abs(cd - d) > 5 ? 0 : std::uint64_t{1} << car;
+        m |= static_cast<std::uint64_t>(!(std::abs(cd - d) > 5)) << car;
       }
       lat_near_[k * w + j] = m;
     }
