@@ -38,10 +38,10 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
     for (auto* v : {&rows->p, &rows->v, &rows->a}) v->assign(n * wt, 0.0);
   }
   lon_centre_.resize(n_lon * wt);
+  lon_centre_have_.assign(n_lon, 0);
 }
 
-bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
-                          std::vector<map::CentrePoint>* centre) {
+bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows) {
   if (rows.have[i] && std::memcmp(&rows.key[i], &tr, sizeof(tr)) == 0) return false;
   const int w = ws_.n_ticks + 1;
   for (int t = 1; t <= ws_.n_ticks; ++t) {
@@ -49,7 +49,6 @@ bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
     rows.p[i * w + t] = st.p;
     rows.v[i * w + t] = st.v;
     rows.a[i * w + t] = st.a;
-    if (centre != nullptr) (*centre)[i * w + t] = line_.Centre(st.p);
   }
   std::memcpy(&rows.key[i], &tr, sizeof(tr));
   rows.have[i] = 1;
@@ -207,25 +206,33 @@ Checker::ReadRange Checker::ReadBetween(const double* s, const double* d, int pr
 }
 
 double Checker::CandidateViolation(int c, Reject* reason) {
+  return CandidateMeasure(c, reason, false);
+}
+
+bool Checker::CandidateBreaksLimits(int c) { return CandidateMeasure(c, nullptr, true) > 0; }
+
+double Checker::CandidateMeasure(int c, Reject* reason, bool any) {
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
   Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
-  if (v != nullptr && v->prefix_stamp == prefix_stamp_ && v->straddle == ws_.straddle_at_start &&
-      std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
+  if (v != nullptr && (any || !v->any) && v->prefix_stamp == prefix_stamp_ &&
+      v->straddle == ws_.straddle_at_start && std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
     if (reason != nullptr) *reason = v->why;
     return v->worst;
   }
   // FillTicks' values, from the bundles' rows: the candidates of a bundle share its ticks and
   // the centre line there.
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
-  SampleTicks(tr.lon, i, lon_ticks_, &lon_centre_);
-  SampleTicks(tr.lat, k, lat_ticks_, nullptr);
+  if (SampleTicks(tr.lon, i, lon_ticks_)) lon_centre_have_[i] = 0;
+  SampleTicks(tr.lat, k, lat_ticks_);
   const int w = ws_.n_ticks + 1;
   Reject why = Reject::kCount;
-  const double worst = Measure(
-      &why, true,
-      {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], &lon_centre_[i * w]});
+  const double worst =
+      Measure(&why, true,
+              {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], nullptr, i}, any);
+  // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
+  const bool partial = any && worst > 0;
   if (reason != nullptr) *reason = why;
-  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst};
+  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst, partial};
   return worst;
 }
 
@@ -244,7 +251,7 @@ double Checker::Violation(Reject* reason, bool lane_line) {
   return Measure(reason, lane_line, {ws_.tk_s.data(), ws_.tk_sd.data(), ws_.tk_d.data(), nullptr});
 }
 
-double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks) {
+double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any) {
   const int n_ticks = ws_.n_ticks;
   const double* tk_s = ticks.s;
   const double* tk_d = ticks.d;
@@ -270,6 +277,11 @@ double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks) {
     dmax = std::max(dmax, read.hi);
     straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
     worst_straddle = std::max(worst_straddle, straddle);
+    if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.d_min - dmin > 0 ||
+                dmax - cfg_.d_max > 0)) {
+      if (reason != nullptr) *reason = Reject::kCount;  // unknown: not measured in full
+      return 1.0;  // a limit is broken (which one is worst is not known)
+    }
     if (i == n_ticks) break;
   }
   if (straddle > 0) worst_straddle = 1 << 20;
@@ -283,7 +295,16 @@ double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks) {
     if (reason != nullptr) *reason = why;
     return worst;
   }
-  const int n = BuildXyPath(ticks);
+  Ticks xy_ticks = ticks;
+  if (ticks.lon_slot >= 0) {
+    const int i = ticks.lon_slot, w = n_ticks + 1;
+    if (!lon_centre_have_[i]) {
+      for (int t = 1; t <= n_ticks; ++t) lon_centre_[i * w + t] = line_.Centre(ticks.s[t]);
+      lon_centre_have_[i] = 1;
+    }
+    xy_ticks.centre = &lon_centre_[i * w];
+  }
+  const int n = BuildXyPath(xy_ticks);
   const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
   take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);

@@ -89,6 +89,11 @@ class Checker {
   // about candidates the lazy check has measured. Measured on its bundles' ticks: ws.tk_* are
   // left as they are.
   double CandidateViolation(int c, Reject* reason);
+  // Whether candidate c breaks a limit: CandidateViolation(c, nullptr) > 0, the same answer,
+  // but the Frenet checks stop at the first limit found broken (the lane-line timer of a car
+  // long astride a line, say), so that no worst excess or reason is known then (a later
+  // CandidateViolation measures it all).
+  bool CandidateBreaksLimits(int c);
 
   // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
   bool Collides() const {
@@ -155,25 +160,28 @@ class Checker {
   ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
 
   // What Violation reads of the ticks [1, n_ticks]: s, s', d, and the centre line at s when
-  // known (null: from the line).
+  // known (null: from the line, or from lon bundle slot lon_slot's row when that is >= 0,
+  // sampled there on first use: a candidate the Frenet checks reject does not need it).
   struct Ticks {
     const double *s, *sd, *d;
     const map::CentrePoint* centre;
+    int lon_slot = -1;
   };
   // Appends the ticks to the XY prefix; returns the path length.
   int BuildXyPath(const Ticks& ticks);
-  // Violation of `ticks` (ws.tk_*, or a candidate's bundle rows).
-  double Measure(Reject* reason, bool lane_line, const Ticks& ticks);
+  // Violation of `ticks` (ws.tk_*, or a candidate's bundle rows). any: a positive value as soon
+  // as one limit is found broken (not the worst, and no reason).
+  double Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any = false);
+  // CandidateViolation's work: Measure of candidate c's bundle ticks, through the verdicts.
+  double CandidateMeasure(int c, Reject* reason, bool any);
   // Bundle trajectory `tr` (slot i) at every tick [1, n_ticks], FillTicks' values, in the rows
-  // of p / v / a (and the centre line at p when centre is not null) unless kept; true when
-  // sampled anew.
+  // of p / v / a unless kept; true when sampled anew.
   struct TickRows {
     std::vector<traj::Trajectory1d> key;
     std::vector<char> have;
     std::vector<double> p, v, a;
   };
-  bool SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows,
-                   std::vector<map::CentrePoint>* centre);
+  bool SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows);
 
   const Settings& cfg_;
   const map::ReferenceLine& line_;
@@ -204,6 +212,7 @@ class Checker {
     int straddle = 0;
     Reject why = Reject::kCount;
     double worst = 0;
+    bool any = false;  // measured with Measure(..., any): only worst > 0 is known
   };
   std::vector<Verdict> verdicts_;
   // CandidateCollides: per lon slot, the last step and car hit, and the traffic they were for.
@@ -216,6 +225,7 @@ class Checker {
   // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
   TickRows lon_ticks_, lat_ticks_;
   std::vector<map::CentrePoint> lon_centre_;
+  std::vector<char> lon_centre_have_;  // lon_centre_'s row is the one of lon_ticks_' row
   std::uint64_t prefix_stamp_ = 1;
 };
 

@@ -112,15 +112,15 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
     if (best < 0) {
       // Nothing to beat yet: whether it collides first (most do, and then its clearance is
       // not needed: the ranking counts it as 0), and what ChooseByRanking would measure.
-      first_hit_[c] = checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr,
-                                              false);
+      first_hit_[c] =
+          checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
       clearance_[c] = 0.0;
       known_[c] = 1;
       if (first_hit_[c] <= n_steps) continue;
       const Checker::Rows rows = checker_.StepRows(c);
-      clearance_[c] = ClearanceAbove(cfg_, ws_, rows.s, rows.d,
-                                     -std::numeric_limits<double>::infinity());
-      if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+      clearance_[c] =
+          ClearanceAbove(cfg_, ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
+      if (checker_.CandidateBreaksLimits(c)) continue;
       scorer_.ExactCost(c);
       best = c;
       best_clr = clearance_[c];
@@ -137,7 +137,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
         n_steps) {
       continue;
     }
-    if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+    if (checker_.CandidateBreaksLimits(c)) continue;
     scorer_.ExactCost(c);
     best = c;
     best_clr = clr;
@@ -175,9 +175,13 @@ int LeastHarm::LatestContact(bool* over_budget) {
         continue;
       }
     }
+    // The cost first once there is one to beat (the limits cost more); before, the limits.
+    if (best >= 0) {
+      scorer_.ExactCost(c);
+      if (!Cheaper(ws_, c, best)) continue;
+    }
+    if (checker_.CandidateBreaksLimits(c)) continue;
     scorer_.ExactCost(c);
-    if (best >= 0 && !Cheaper(ws_, c, best)) continue;
-    if (checker_.CandidateViolation(c, nullptr) > 0) continue;
     best = c;
   }
   return best;
@@ -223,7 +227,7 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
       }
       const int c = order[r];
       if (lane_line) {
-        if (checker_.CandidateViolation(c, nullptr) > 0) continue;
+        if (checker_.CandidateBreaksLimits(c)) continue;
       } else {
         checker_.FillTicks(ws_.Candidate(c));
         if (checker_.Violation(nullptr, false) > 0) continue;

@@ -7,8 +7,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -359,13 +359,16 @@ class SearchPlanner : public Planner {
         ++sum.rejections[static_cast<int>(Reject::kCollision)];
         continue;
       }
-      scorer_.ExactCost(c);
-      if (best >= 0 && !search::Cheaper(ws_, c, best)) continue;
+      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
+        scorer_.ExactCost(c);
+        if (!search::Cheaper(ws_, c, best)) continue;
+      }
       Reject why = Reject::kCount;
       if (checker_.CandidateViolation(c, &why) > 0) {
         ++sum.rejections[static_cast<int>(why)];
         continue;
       }
+      scorer_.ExactCost(c);
       ++sum.candidates_feasible;
       best = c;
     }

@@ -39,7 +39,8 @@ Workspace::Workspace(const Settings& cfg) {
   car_d0.assign(kMaxCars, 0.0);
   collision_step = std::max(1, static_cast<int>(std::lround(cfg.collision_dt / kTickSeconds)));
   n_steps = n_ticks / collision_step;
-  for (auto* v : {&step_s, &step_d, &step_v, &step_vd, &step_dir_s, &step_dir_d}) v->assign(kMaxCars * (n_steps + 1), 0.0);
+  for (auto* v : {&step_s, &step_d, &step_v, &step_vd, &step_dir_s, &step_dir_d})
+    v->assign(kMaxCars * (n_steps + 1), 0.0);
   lat_near.assign(2 * max_lat * n_samples, 0);
   lon_near.assign(2 * max_lon * n_samples, 0);
   prev_s.assign(n_samples, 0.0);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "plan/search_stages_testing.h"
 
@@ -100,6 +101,45 @@ TEST(SearchChecksTest, LaneLineTimerCountsFromTheStartAndCanBeLeftOut) {
   // The helpers agree: the line at 4 m is within kStraddle of 4.5, not of 5.
   EXPECT_TRUE(StraddlesRead(st.cfg, 4.5, 4.5));
   EXPECT_FALSE(StraddlesRead(st.cfg, 5.0, 5.0));
+}
+
+// The least-harm choice asks only whether a candidate breaks a limit, and the Frenet checks
+// stop at the first one found broken: the answer is CandidateViolation's, and a verdict cut
+// short that way is measured in full when the reason is asked for later.
+TEST(SearchChecksTest, BreaksLimitsAgreesWithTheFullViolation) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  int broken = 0, cut_short_then_full = 0, total = 0;
+  // Astride a line and in a lane, slow and fast, with the lane-line count fresh, near and past
+  // its limit.
+  for (const double d0 : {4.0, 5.2, 6.0, 9.9}) {
+    for (const double v0 : {8.0, 21.5}) {
+      for (const int straddle : {0, 120, 130, 200}) {
+        st.Prepare({kS, v0, 0, d0, 0, 0});
+        st.ws.straddle_at_start = straddle;
+        st.lattice.Generate();
+        ASSERT_TRUE(st.scorer.Score());
+        const int n = static_cast<int>(st.ws.order.size());
+        std::vector<char> breaks(n);
+        for (int c = 0; c < n; ++c) breaks[c] = st.checker.CandidateBreaksLimits(c);
+        for (int c = 0; c < n; ++c) {
+          Reject why = Reject::kCount, why_ref = Reject::kCount;
+          const double worst = st.checker.CandidateViolation(c, &why);
+          st.checker.FillTicks(st.ws.Candidate(c));
+          const double worst_ref = st.checker.Violation(&why_ref);
+          ASSERT_EQ(breaks[c] != 0, worst_ref > 0) << "candidate " << c;
+          EXPECT_EQ(worst, worst_ref) << "candidate " << c;
+          EXPECT_EQ(why, why_ref) << "candidate " << c;
+          broken += breaks[c];
+          cut_short_then_full += breaks[c] && why == Reject::kLaneLine && straddle >= 120;
+          ++total;
+        }
+      }
+    }
+  }
+  EXPECT_GT(broken, total / 10);
+  EXPECT_LT(broken, total);
+  EXPECT_GT(cut_short_then_full, 0);
 }
 
 TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
