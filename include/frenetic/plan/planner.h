@@ -44,8 +44,8 @@ struct CostTermValue {
 struct PlanSummary {
   int candidates_generated = 0;
   int candidates_scored = 0;
-  int candidates_checked = 0;   // went through the lazy feasibility / collision check
-  int candidates_feasible = 0;  // passed it (the first one wins)
+  int candidates_checked = 0;   // tested by the lazy collision / feasibility check
+  int candidates_feasible = 0;  // passed it (the cheapest one that passed wins)
   std::array<int, static_cast<int>(Reject::kCount)> rejections{};
   std::vector<CostTermValue> winner_costs;  // per term, in config order (capacity kept)
   double winner_total_cost = 0;
