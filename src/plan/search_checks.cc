@@ -26,6 +26,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_.assign(n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
   near_.assign(w, 0);
+  reach_.assign(w, 0.0);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
@@ -78,31 +79,31 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
   // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
   const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
   LonNearKey& lk = lon_near_key_[i];
+  // Car by car over contiguous steps (the inner loops vectorise); no branch on which cars pass.
   if (new_lon || lk.stamp != ws_.traffic_stamp || lk.margin_scale != margin_scale ||
       lk.behind_scale != behind_scale) {
+    std::uint64_t* m = &lon_near_[i * w];
+    const double* s = &lon_s_[i * w];
     for (int j = 1; j <= ws_.n_steps; ++j) {
-      const double s = lon_s_[i * w + j];
-      const double reach_s = ReachS(lon_sd_[i * w + j], margin_scale, behind_scale);
-      std::uint64_t m = 0;
-      for (int car = 0; car < num_cars; ++car) {
-        const double cs = ws_.step_s[car * w + j];
-        // Branch-free: which cars pass is data the branch predictor cannot learn.
-        m |= static_cast<std::uint64_t>(!(std::abs(cs - s) > reach_s)) << car;
-      }
-      lon_near_[i * w + j] = m;
+      reach_[j] = ReachS(lon_sd_[i * w + j], margin_scale, behind_scale);
+      m[j] = 0;
+    }
+    for (int car = 0; car < num_cars; ++car) {
+      const double* cs = &ws_.step_s[car * w];
+      const std::uint64_t bit = std::uint64_t{1} << car;
+      for (int j = 1; j <= ws_.n_steps; ++j) m[j] |= std::abs(cs[j] - s[j]) > reach_[j] ? 0 : bit;
     }
     lk = {ws_.traffic_stamp, margin_scale, behind_scale};
   }
   const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
   if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
-    for (int j = 1; j <= ws_.n_steps; ++j) {
-      const double d = lat_d_[k * w + j];
-      std::uint64_t m = 0;
-      for (int car = 0; car < num_cars; ++car) {
-        const double cd = ws_.step_d[car * w + j];
-        m |= static_cast<std::uint64_t>(!(std::abs(cd - d) > 5)) << car;
-      }
-      lat_near_[k * w + j] = m;
+    std::uint64_t* m = &lat_near_[k * w];
+    const double* d = &lat_d_[k * w];
+    for (int j = 1; j <= ws_.n_steps; ++j) m[j] = 0;
+    for (int car = 0; car < num_cars; ++car) {
+      const double* cd = &ws_.step_d[car * w];
+      const std::uint64_t bit = std::uint64_t{1} << car;
+      for (int j = 1; j <= ws_.n_steps; ++j) m[j] |= std::abs(cd[j] - d[j]) > 5 ? 0 : bit;
     }
     lat_near_stamp_[k] = ws_.traffic_stamp;
   }
