@@ -20,11 +20,12 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
   contact_.reserve(ws_.order.capacity());
+  group_start_.reserve(ws_.n_steps + 2);
+  group_fill_.reserve(ws_.n_steps + 2);
   bound_.reserve(ws_.order.capacity());
   heap_.reserve(ws_.order.capacity());
   lon_done_.reserve(ws_.lon.capacity());
   lat_done_.reserve(ws_.lat.capacity());
-  sep_.assign(kProbes * kMaxCars, 0.0);
   lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
   lat_sep_.assign(ws_.lat.capacity() * kProbes * kMaxCars, 0.0);
 }
@@ -86,10 +87,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
       if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
       lon_done_[i] = lat_done_[k] = 1;
     }
-    const double* a = &lon_sep_[i * row];
-    const double* b = &lat_sep_[k * row];
-    for (int q = 0; q < row; ++q) sep_[q] = std::max(a[q], b[q]);
-    bound_[c] = MinOf(sep_.data(), row);
+    bound_[c] = MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);
     heap_[r] = c;
   }
   // Largest bound first, then the smallest index (any order gives the same maximum; this one
@@ -100,15 +98,8 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
   std::make_heap(heap_.begin(), heap_.end(), lower);
   int best = -1;
   double best_clr = 0;
-  for (int k = 0; !heap_.empty(); ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
-      *over_budget = true;
-      return -1;
-    }
-    const int c = heap_.front();
-    if (best >= 0 && bound_[c] < best_clr) break;
-    std::pop_heap(heap_.begin(), heap_.end(), lower);
-    heap_.pop_back();
+  // Visits c: whether it beats the best one so far.
+  const auto visit = [&](int c) {
     if (best < 0) {
       // Nothing to beat yet: whether it collides first (most do, and then its clearance is
       // not needed: the ranking counts it as 0), and what ChooseByRanking would measure.
@@ -116,31 +107,59 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
           checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
       clearance_[c] = 0.0;
       known_[c] = 1;
-      if (first_hit_[c] <= n_steps) continue;
+      if (first_hit_[c] <= n_steps) return;
       const Checker::Rows rows = checker_.StepRows(c);
       clearance_[c] =
           ClearanceAbove(cfg_, ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
-      if (checker_.CandidateBreaksLimits(c)) continue;
+      if (checker_.CandidateBreaksLimits(c)) return;
       scorer_.ExactCost(c);
       best = c;
       best_clr = clearance_[c];
-      continue;
+      return;
     }
     const Checker::Rows rows = checker_.StepRows(c);
     const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, best_clr);
-    if (clr < best_clr) continue;
+    if (clr < best_clr) return;
     if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
-      if (!Cheaper(ws_, c, best)) continue;
+      if (!Cheaper(ws_, c, best)) return;
     }
     if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
         n_steps) {
-      continue;
+      return;
     }
-    if (checker_.CandidateBreaksLimits(c)) continue;
+    if (checker_.CandidateBreaksLimits(c)) return;
     scorer_.ExactCost(c);
     best = c;
     best_clr = clr;
+  };
+  // Best bound first: a clear candidate is mostly among the first few. After kHeapVisits
+  // without one, the rest in the heap's array order (popping each would cost more than the
+  // order saves: none may be clear at all), each skipped when its bound cannot beat the best.
+  int k = 0;
+  bool done = false;
+  for (; !heap_.empty() && k < kHeapVisits; ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const int c = heap_.front();
+    if (best >= 0 && bound_[c] < best_clr) {
+      done = true;
+      break;
+    }
+    std::pop_heap(heap_.begin(), heap_.end(), lower);
+    heap_.pop_back();
+    visit(c);
+  }
+  for (int e = 0; !done && e < static_cast<int>(heap_.size()); ++e, ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const int c = heap_[e];
+    if (best >= 0 && bound_[c] < best_clr) continue;
+    visit(c);
   }
   // With no winner every candidate was visited before the best one was found.
   *all_known = best < 0;
@@ -154,37 +173,54 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
 int LeastHarm::LatestContact(bool* over_budget) {
   const std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
-  contact_.clear();
+  const int n_steps = ws_.n_steps;
+  // The colliding candidates grouped by contact step, latest first (a counting sort: only the
+  // groups reached are sorted by bound).
+  group_start_.assign(n_steps + 2, 0);
+  for (int r = 0; r < n; ++r) {
+    const int h = first_hit_[order[r]];
+    if (h <= n_steps) ++group_start_[h];
+  }
+  int at = 0;
+  for (int h = n_steps; h >= 1; --h) {
+    const int count = group_start_[h];
+    group_start_[h] = at;
+    at += count;
+  }
+  group_start_[0] = at;  // the end of the last group (h = 1)
+  contact_.resize(at);
+  group_fill_.assign(group_start_.begin(), group_start_.end());
   for (int r = 0; r < n; ++r) {
     const int c = order[r];
-    if (first_hit_[c] <= ws_.n_steps) contact_.push_back({-first_hit_[c], scorer_.Bound(c), c});
+    const int h = first_hit_[c];
+    if (h <= n_steps) contact_[group_fill_[h]++] = {scorer_.Bound(c), c};
   }
-  std::sort(contact_.begin(), contact_.end());  // latest contact, then smallest bound, index
-  int best = -1;
-  for (int k = 0; k < static_cast<int>(contact_.size()); ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
-      *over_budget = true;
-      return -1;
-    }
-    const auto& [neg_hit, bound, c] = contact_[k];
-    if (best >= 0) {
-      if (neg_hit != -first_hit_[best]) break;  // an earlier contact: the best one stands
-      const double cost = ws_.cand_cost[best];
-      if (bound > cost || (bound == cost && c > best)) {
-        // No cheaper one in this group: skip to the next group's end (the loop breaks there).
-        continue;
+  int k = 0;
+  for (int h = n_steps; h >= 1; --h) {
+    const auto first = contact_.begin() + group_start_[h];
+    const auto last = contact_.begin() + (h > 1 ? group_start_[h - 1] : group_start_[0]);
+    std::sort(first, last);  // smallest bound, then index
+    int best = -1;
+    for (auto it = first; it != last; ++it, ++k) {
+      if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+        *over_budget = true;
+        return -1;
       }
-    }
-    // The cost first once there is one to beat (the limits cost more); before, the limits.
-    if (best >= 0) {
+      const auto [bound, c] = *it;
+      if (best >= 0) {
+        // The cost first once there is one to beat (the limits cost more); before, the limits.
+        const double cost = ws_.cand_cost[best];
+        if (bound > cost || (bound == cost && c > best)) break;  // none cheaper is left
+        scorer_.ExactCost(c);
+        if (!Cheaper(ws_, c, best)) continue;
+      }
+      if (checker_.CandidateBreaksLimits(c)) continue;
       scorer_.ExactCost(c);
-      if (!Cheaper(ws_, c, best)) continue;
+      best = c;
     }
-    if (checker_.CandidateBreaksLimits(c)) continue;
-    scorer_.ExactCost(c);
-    best = c;
+    if (best >= 0) return best;  // an earlier contact ranks after it
   }
-  return best;
+  return -1;
 }
 
 bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {

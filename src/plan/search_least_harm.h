@@ -7,7 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "frenetic/traj/frenet.h"
@@ -79,6 +79,25 @@ inline double MinOf(const double* v, int n) {
   return b < a ? b : a;
 }
 
+// MinOf(max(a[q], b[q]) for q in [0, n)), in one pass: the same running minima, so the same
+// value.
+inline double MinOfMax(const double* a, const double* b, int n) {
+  double m[4] = {1e9, 1e9, 1e9, 1e9};
+  int q = 0;
+  for (; q + 4 <= n; q += 4) {
+    for (int u = 0; u < 4; ++u) {
+      const double v = std::max(a[q + u], b[q + u]);
+      m[u] = v < m[u] ? v : m[u];
+    }
+  }
+  for (; q < n; ++q) {
+    const double v = std::max(a[q], b[q]);
+    m[0] = v < m[0] ? v : m[0];
+  }
+  const double x = m[1] < m[0] ? m[1] : m[0], y = m[3] < m[2] ? m[3] : m[2];
+  return y < x ? y : x;
+}
+
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
 // `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
 // minimum, car by car: the order does not change a minimum that ignores NaN.
@@ -148,13 +167,17 @@ class LeastHarm {
   std::vector<char> known_;
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;
-  // LatestContact's colliding candidates: minus the contact step, cost bound, index.
-  std::vector<std::tuple<int, double, int>> contact_;
+  // LatestContact's colliding candidates (cost bound, index), grouped by contact step, latest
+  // first: group h starts at group_start_[h] (and ends where group h - 1 starts; group 1 at
+  // group_start_[0]).
+  std::vector<std::pair<double, int>> contact_;
+  std::vector<int> group_start_, group_fill_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;
+  static constexpr int kHeapVisits = 48;  // BestClear: candidates taken best bound first
   std::vector<char> lon_done_, lat_done_;
-  std::vector<double> lon_sep_, lat_sep_, sep_;
+  std::vector<double> lon_sep_, lat_sep_;
 };
 
 }  // namespace frenetic::plan::search

@@ -36,6 +36,9 @@ using traj::FrenetTrajectory;
 // CheckLazily walks this many ranks in cost order (more when traced), then tests the rest by
 // their cost bound.
 constexpr int kCheckRestMin = 16;
+// CheckRest takes this many candidates cheapest bound first, then the rest in any order, when
+// none passed in the last search either.
+constexpr int kRestHeapTests = 64;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -100,6 +103,7 @@ class SearchPlanner : public Planner {
     ws_.lane_before_change = -1;
     ws_.time_since_change = 1e9;
     sim_time_ = NAN;
+    none_passed_last_ = false;
     predictor_->Reset();
   }
 
@@ -188,6 +192,7 @@ class SearchPlanner : public Planner {
       const double t_check = Elapsed();
       bool check_cut = false;
       found = CheckLazily(&check_cut);
+      none_passed_last_ = !found && !check_cut;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut);
       if (check_cut) {
         over_budget = true;
@@ -329,8 +334,10 @@ class SearchPlanner : public Planner {
   // (a heap: only the ones taken are ordered), and tested for collision; one that does not
   // collide gets its exact cost, and the hard limits when it is cheaper than the cheapest that
   // passed so far. The test ends once no bound is left below that one's cost (no candidate
-  // left can be cheaper). Every one tested counts as checked, and as rejected when it collides
-  // or breaks a limit (one outranked by a passing one is neither).
+  // left can be cheaper). After kRestHeapTests the rest are taken in any order, each skipped
+  // when its bound is not below that cost: the same cheapest one. Every one tested counts as
+  // checked, and as rejected when it collides or breaks a limit (one outranked by a passing
+  // one is neither).
   int CheckRest(int r0, bool* cut) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
@@ -342,35 +349,56 @@ class SearchPlanner : public Planner {
     const auto later = std::greater<std::pair<double, int>>();  // a min-heap by bound, index
     std::make_heap(rest_.begin(), rest_.end(), later);
     int best = -1;  // the cheapest candidate that passed
-    for (int k = 0; !rest_.empty(); ++k) {
+    // Tests c: whether it passes and is the cheapest so far.
+    const auto test = [&](int c) {
+      ++sum.candidates_checked;
+      if (checker_.CandidateCollides(c)) {
+        ++sum.rejections[static_cast<int>(Reject::kCollision)];
+        return;
+      }
+      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
+        scorer_.ExactCost(c);
+        if (!search::Cheaper(ws_, c, best)) return;
+      }
+      Reject why = Reject::kCount;
+      if (checker_.CandidateViolation(c, &why) > 0) {
+        ++sum.rejections[static_cast<int>(why)];
+        return;
+      }
+      scorer_.ExactCost(c);
+      ++sum.candidates_feasible;
+      best = c;
+    };
+    // Whether no candidate left in the heap can be cheaper than the best one.
+    const auto beaten = [&](double bc, int c) {
+      if (best < 0) return false;
+      const double cost = ws_.cand_cost[best];
+      return bc > cost || (bc == cost && c > best);
+    };
+    // Popped in bound order to the end, unless the last search found none passing either.
+    const int heap_tests = none_passed_last_ ? kRestHeapTests : n;
+    int k = 0;
+    for (; !rest_.empty() && k < heap_tests; ++k) {
       if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return -1;
       }
       const auto [bc, c] = rest_.front();
-      if (best >= 0) {
-        const double cost = ws_.cand_cost[best];
-        if (bc > cost || (bc == cost && c > best)) break;
-      }
+      if (beaten(bc, c)) return best;
       std::pop_heap(rest_.begin(), rest_.end(), later);
       rest_.pop_back();
-      ++sum.candidates_checked;
-      if (checker_.CandidateCollides(c)) {
-        ++sum.rejections[static_cast<int>(Reject::kCollision)];
-        continue;
+      test(c);
+    }
+    // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
+    // rest in the heap's array order then (popping each costs more than the order saves), each
+    // skipped when its bound cannot beat the best one.
+    for (int e = 0; e < static_cast<int>(rest_.size()); ++e, ++k) {
+      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+        *cut = true;
+        return -1;
       }
-      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
-        scorer_.ExactCost(c);
-        if (!search::Cheaper(ws_, c, best)) continue;
-      }
-      Reject why = Reject::kCount;
-      if (checker_.CandidateViolation(c, &why) > 0) {
-        ++sum.rejections[static_cast<int>(why)];
-        continue;
-      }
-      scorer_.ExactCost(c);
-      ++sum.candidates_feasible;
-      best = c;
+      const auto [bc, c] = rest_[e];
+      if (!beaten(bc, c)) test(c);
     }
     return best;
   }
@@ -449,6 +477,7 @@ class SearchPlanner : public Planner {
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
   std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
+  bool none_passed_last_ = false;             // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
