@@ -9,6 +9,9 @@
 #include <cmath>
 #include <utility>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "frenetic/traj/frenet.h"
 #include "plan/search_checks.h"
@@ -79,23 +82,31 @@ inline double MinOf(const double* v, int n) {
   return b < a ? b : a;
 }
 
-// MinOf(max(a[q], b[q]) for q in [0, n)), in one pass: the same running minima, so the same
-// value.
+// MinOf(max(a[q], b[q]) for q in [0, n)), in one pass. A minimum that ignores NaN (a NaN
+// separation never replaces a running minimum) does not depend on the order, so the SSE2 lanes
+// give the same value: _mm_max_pd(y, x) is std::max(x, y) ((x < y) ? y : x, also for NaN) and
+// _mm_min_pd(v, m) is (v < m) ? v : m.
 inline double MinOfMax(const double* a, const double* b, int n) {
-  double m[4] = {1e9, 1e9, 1e9, 1e9};
   int q = 0;
+  double r = 1e9;
+#if defined(__SSE2__)
+  __m128d m0 = _mm_set1_pd(1e9), m1 = m0;
   for (; q + 4 <= n; q += 4) {
-    for (int u = 0; u < 4; ++u) {
-      const double v = std::max(a[q + u], b[q + u]);
-      m[u] = v < m[u] ? v : m[u];
-    }
+    const __m128d v0 = _mm_max_pd(_mm_loadu_pd(b + q), _mm_loadu_pd(a + q));
+    const __m128d v1 = _mm_max_pd(_mm_loadu_pd(b + q + 2), _mm_loadu_pd(a + q + 2));
+    m0 = _mm_min_pd(v0, m0);
+    m1 = _mm_min_pd(v1, m1);
   }
+  double lanes[4];
+  _mm_storeu_pd(lanes, m0);
+  _mm_storeu_pd(lanes + 2, m1);
+  for (const double v : lanes) r = v < r ? v : r;
+#endif
   for (; q < n; ++q) {
     const double v = std::max(a[q], b[q]);
-    m[0] = v < m[0] ? v : m[0];
+    r = v < r ? v : r;
   }
-  const double x = m[1] < m[0] ? m[1] : m[0], y = m[3] < m[2] ? m[3] : m[2];
-  return y < x ? y : x;
+  return r;
 }
 
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least

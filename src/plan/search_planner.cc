@@ -35,7 +35,7 @@ using traj::FrenetTrajectory;
 
 // CheckLazily walks this many ranks in cost order (more when traced), then tests the rest by
 // their cost bound.
-constexpr int kCheckRestMin = 16;
+constexpr int kCheckRestMin = 4;
 // CheckRest takes this many candidates cheapest bound first, then the rest in any order, when
 // none passed in the last search either.
 constexpr int kRestHeapTests = 64;
