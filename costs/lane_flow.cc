@@ -41,6 +41,7 @@ class LaneFlowCost : public CostTerm {
     }
     return std::clamp((limit - flow) / limit, 0.0, 1.0) / scale_;
   }
+  bool LaneOnly() const override { return true; }
 
  private:
   double horizon_ = 20.0, scale_ = 0.4;

@@ -58,12 +58,26 @@ double CostSet::Evaluate(const CostContext& ctx, const CostInput& in, double* pe
   return total;
 }
 
-double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* cheap) const {
+double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
+                           LaneMemo* memo) const {
   // Evaluate's sum, term for term, with 0 in place of the expensive terms' values.
   double total = 0;
   const int n = size();
+  const int lane = in.target_lane;
+  const bool memo_lane = memo != nullptr && lane >= 0 && lane < kMaxLanes;
   for (int i = 0; i < n; ++i) {
-    const double v = terms_[i]->Expensive() ? 0.0 : terms_[i]->Evaluate(ctx, in);
+    double v = 0.0;
+    if (terms_[i]->Expensive()) {
+      v = 0.0;
+    } else if (memo_lane && i < LaneMemo::kMaxTerms && terms_[i]->LaneOnly()) {
+      if (!memo->known_[i][lane]) {
+        memo->value_[i][lane] = terms_[i]->Evaluate(ctx, in);
+        memo->known_[i][lane] = 1;
+      }
+      v = memo->value_[i][lane];
+    } else {
+      v = terms_[i]->Evaluate(ctx, in);
+    }
     if (cheap != nullptr) cheap[i] = v;
     total += weights_[i] * v;
   }

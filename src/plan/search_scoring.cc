@@ -62,6 +62,7 @@ bool Scorer::Score() {
   ws_.sorted = 0;
   pending_.clear();
   ready_.clear();
+  lane_memo_.Clear();  // a new context
   int scored = n;
   for (int c = 0; c < n; ++c) {
     if ((c & 63) == 63 && clock_.Elapsed() > kScoreShare * cfg_.budget_ms) {
@@ -69,8 +70,9 @@ bool Scorer::Score() {
       break;
     }
     // Resolve() makes the cost 1e300 when it is not finite: never below this bound.
-    const double b = costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
-                                       &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
+    const double b =
+        costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+                          &cheap_[static_cast<std::size_t>(c) * costs_.size()], &lane_memo_);
     bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
     ws_.order[c] = c;
     pos_[c] = c;

@@ -104,6 +104,7 @@ class Scorer {
   // Per candidate, the cheap terms' values Score() computed for its bound ([c * terms + t]):
   // Resolve() evaluates only the expensive ones.
   std::vector<double> cheap_;
+  cost::CostSet::LaneMemo lane_memo_;  // Score()'s lane-only terms, per target lane
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;
 };
 

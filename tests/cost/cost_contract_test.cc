@@ -193,6 +193,63 @@ TEST_P(CostContractTest, BroadPhaseMasksDoNotChangeTheValue) {
   EXPECT_GT(with_cars, 0);
 }
 
+// A term that says it reads only the target lane (LaneOnly) gives the same value for any other
+// input bound for that lane: the planner keeps one value per lane and cycle.
+TEST(CostRegistryTest, LaneOnlyTermsReadNothingButTheTargetLane) {
+  int lane_only = 0;
+  for (const std::string& name : CostRegistry::Global().Names()) {
+    auto made = CostRegistry::Global().Make(name);
+    ASSERT_TRUE(made.ok()) << made.message();
+    std::unique_ptr<CostTerm> term = std::move(made.value());
+    if (!term->LaneOnly()) continue;
+    ++lane_only;
+    std::vector<double> defaults;
+    for (const auto& spec : term->ParamSpecs()) defaults.push_back(spec.default_value);
+    term->Configure(defaults);
+    std::mt19937 rng(777);
+    int distinct = 0;
+    for (int i = 0; i < 500; ++i) {
+      Fixture f = RandomFixture(rng);
+      const Fixture other = RandomFixture(rng);  // another candidate, the same context
+      CostInput in = other.in;
+      in.target_lane = f.in.target_lane;
+      const double v = term->Evaluate(f.ctx, f.in);
+      ASSERT_EQ(term->Evaluate(f.ctx, in), v) << name << " case " << i;
+      in.target_lane = (f.in.target_lane + 1) % 3;
+      distinct += term->Evaluate(f.ctx, in) != v;
+    }
+    EXPECT_GT(distinct, 0) << name << ": the lane matters";
+  }
+  EXPECT_GE(lane_only, 1);
+}
+
+// CostSet::LowerBound with a lane memo: the same bound and cheap values as without, candidate
+// by candidate, while the context stays; after a new context and Clear(), the new values.
+TEST(CostSetTest, LaneMemoKeepsTheValues) {
+  auto set = CostSet::Build({{"efficiency", 2.0, {}},
+                             {"lane_flow", 3.0, {}},
+                             {"collision", 10.0, {}},
+                             {"lane_change", 1.0, {}}});
+  ASSERT_TRUE(set.ok()) << set.message();
+  ASSERT_TRUE((*set)->term(1).LaneOnly());
+  std::mt19937 rng(31);
+  CostSet::LaneMemo memo;
+  for (int scene = 0; scene < 20; ++scene) {
+    const Fixture f = RandomFixture(rng);
+    memo.Clear();
+    for (int i = 0; i < 30; ++i) {
+      const Fixture g = RandomFixture(rng);
+      CostInput in = g.in;
+      in.target_lane = i % 3;
+      double plain[4], kept[4];
+      const double a = (*set)->LowerBound(f.ctx, in, plain);
+      const double b = (*set)->LowerBound(f.ctx, in, kept, &memo);
+      ASSERT_EQ(a, b) << "scene " << scene << " candidate " << i;
+      for (int t = 0; t < 4; ++t) ASSERT_EQ(plain[t], kept[t]);
+    }
+  }
+}
+
 TEST_P(CostContractTest, NearZeroOnIdealLaneKeeping) {
   auto term = Make();
   Fixture f = IdealLaneKeeping();

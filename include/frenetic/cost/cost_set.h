@@ -3,6 +3,7 @@
 // cycles by building a new set).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <utility>
@@ -23,6 +24,21 @@ struct CostTermConfig {
 
 class CostSet {
  public:
+  // The values of the LaneOnly() terms per target lane, kept by CostSet::LowerBound for the
+  // context it was filled under: Clear() it whenever the context changes.
+  class LaneMemo {
+   public:
+    void Clear() {
+      for (auto& row : known_) row.fill(0);
+    }
+
+   private:
+    friend class CostSet;
+    static constexpr int kMaxTerms = 16;
+    std::array<std::array<char, kMaxLanes>, kMaxTerms> known_{};
+    std::array<std::array<double, kMaxLanes>, kMaxTerms> value_{};
+  };
+
   // Errors name the unknown term, the unknown parameter key or the bad value.
   static StatusOr<std::shared_ptr<const CostSet>> Build(const std::vector<CostTermConfig>& terms);
 
@@ -40,7 +56,10 @@ class CostSet {
   // cheap term is NaN (Evaluate is then NaN too). Does not allocate.
   // When cheap is not null it receives the unweighted value of each term that is not
   // Expensive() (0 for those that are; size() entries).
-  double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr) const;
+  // With memo (not null), a LaneOnly() term is evaluated once per target lane while the memo
+  // is not cleared: the same values.
+  double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr,
+                    LaneMemo* memo = nullptr) const;
   // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
   // Expensive() terms are evaluated; the same sum, term for term. Does not allocate.
   double EvaluateWithCheap(const CostContext& ctx, const CostInput& in, const double* cheap) const;

@@ -184,6 +184,10 @@ class CostTerm {
   // the term out of a first, cheap lower bound of the total (CostSet::LowerBound) and evaluate it
   // only for the candidates that bound cannot rule out. Changes no value.
   virtual bool Expensive() const { return false; }
+  // Whether Evaluate reads nothing of the input but in.target_lane: within one context, every
+  // candidate bound for a lane has the same value, so a caller may keep it per lane
+  // (CostSet::LaneMemo). Changes no value.
+  virtual bool LaneOnly() const { return false; }
 };
 
 }  // namespace frenetic::cost
