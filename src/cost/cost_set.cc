@@ -42,6 +42,8 @@ StatusOr<std::shared_ptr<const CostSet>> CostSet::Build(
     term->Configure(values);
     set->names_.push_back(tc.name);
     set->weights_.push_back(tc.weight);
+    set->expensive_.push_back(term->Expensive());
+    set->lane_only_.push_back(term->LaneOnly());
     set->terms_.push_back(std::move(term));
   }
   return std::shared_ptr<const CostSet>(std::move(set));
@@ -67,9 +69,9 @@ double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* 
   const bool memo_lane = memo != nullptr && lane >= 0 && lane < kMaxLanes;
   for (int i = 0; i < n; ++i) {
     double v = 0.0;
-    if (terms_[i]->Expensive()) {
+    if (expensive_[i]) {
       v = 0.0;
-    } else if (memo_lane && i < LaneMemo::kMaxTerms && terms_[i]->LaneOnly()) {
+    } else if (memo_lane && i < LaneMemo::kMaxTerms && lane_only_[i]) {
       if (!memo->known_[i][lane]) {
         memo->value_[i][lane] = terms_[i]->Evaluate(ctx, in);
         memo->known_[i][lane] = 1;
@@ -89,7 +91,7 @@ double CostSet::EvaluateWithCheap(const CostContext& ctx, const CostInput& in,
   double total = 0;
   const int n = size();
   for (int i = 0; i < n; ++i) {
-    const double v = terms_[i]->Expensive() ? terms_[i]->Evaluate(ctx, in) : cheap[i];
+    const double v = expensive_[i] ? terms_[i]->Evaluate(ctx, in) : cheap[i];
     total += weights_[i] * v;
   }
   return total;

@@ -25,7 +25,6 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   for (auto* v : {&lat_d_, &lat_dd_}) v->assign(n_lat * w, 0.0);
   lon_near_.assign(n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
-  near_.assign(w, 0);
   reach_.assign(w, 0.0);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
@@ -107,9 +106,9 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
     }
     lat_near_stamp_[k] = ws_.traffic_stamp;
   }
-  for (int j = 1; j <= ws_.n_steps; ++j) near_[j] = lon_near_[i * w + j] & lat_near_[k * w + j];
   return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
-          lat_dd_.data() + k * w, ws_.collision_step, near_.data()};
+          lat_dd_.data() + k * w, ws_.collision_step, lon_near_.data() + i * w,
+          lat_near_.data() + k * w};
 }
 
 Checker::Rows Checker::StepRows(int c) {

@@ -47,21 +47,23 @@ inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, doubl
 // StepsOf was given; the others are skipped there without changing its result.
 class StepStates {
  public:
+  // near_lon, near_lat: per step, the cars passing the longitudinal and the lateral reach
+  // tests (Near is their and).
   StepStates(const double* s, const double* sd, const double* d, const double* dd, int step,
-             const std::uint64_t* near)
-      : s_(s), sd_(sd), d_(d), dd_(dd), near_(near), step_(step) {}
+             const std::uint64_t* near_lon, const std::uint64_t* near_lat)
+      : s_(s), sd_(sd), d_(d), dd_(dd), near_lon_(near_lon), near_lat_(near_lat), step_(step) {}
   traj::FrenetState operator()(int tick) const {
     const int j = tick / step_;
     return {s_[j], sd_[j], 0.0, d_[j], dd_[j], 0.0};
   }
-  std::uint64_t Near(int j) const { return near_[j]; }
+  std::uint64_t Near(int j) const { return near_lon_[j] & near_lat_[j]; }
   // s and d at step j ([0, n_steps]; rows contiguous in j).
   const double* s() const { return s_; }
   const double* d() const { return d_; }
 
  private:
   const double *s_, *sd_, *d_, *dd_;
-  const std::uint64_t* near_;
+  const std::uint64_t *near_lon_, *near_lat_;
   int step_;
 };
 
@@ -194,12 +196,12 @@ class Checker {
   std::vector<char> lon_have_, lat_have_;
   std::vector<double> lon_s_, lon_sd_, lat_d_, lat_dd_;
   // Per bundle slot and step, the cars passing the lateral (lat) and the longitudinal (lon)
-  // reach tests, with what they were computed for; near_: the candidate's (their and).
+  // reach tests, with what they were computed for.
   struct LonNearKey {
     std::uint64_t stamp = 0;
     double margin_scale = 0, behind_scale = 0;
   };
-  std::vector<std::uint64_t> lon_near_, lat_near_, near_;
+  std::vector<std::uint64_t> lon_near_, lat_near_;
   std::vector<double> reach_;  // StepsOf: the lon reach at each step
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;

@@ -69,6 +69,7 @@ class CostSet {
   std::vector<std::string> names_;
   std::vector<double> weights_;
   std::vector<std::unique_ptr<CostTerm>> terms_;
+  std::vector<char> expensive_, lane_only_;  // each term's Expensive() and LaneOnly()
 };
 
 }  // namespace frenetic::cost
