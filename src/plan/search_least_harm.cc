@@ -30,9 +30,10 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   lat_sep_.assign(ws_.lat.capacity() * kProbes * kMaxCars, 0.0);
 }
 
-bool LeastHarm::Choose(bool* over_budget) {
+bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   bool all_known = false;
-  int best = BestClear(over_budget, &all_known);
+  int best = BestClear(over_budget, &all_known, none_passed_before && !clear_before_);
+  clear_before_ = best >= 0;
   if (best < 0 && all_known && !*over_budget) best = LatestContact(over_budget);
   if (best >= 0) {
     ws_.TakeWinner(best);
@@ -49,7 +50,7 @@ bool LeastHarm::Choose(bool* over_budget) {
 // visit ends once no bound can reach the best clearance found; the clearance itself stops as
 // soon as it falls below that, and only a candidate that would rank before the best one is
 // tested for collision, then for feasibility.
-int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
+int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   const std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   const int n_steps = ws_.n_steps;
@@ -59,43 +60,49 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
   known_.assign(n, 0);
   first_hit_.resize(n);
   clearance_.resize(n);
-  // The bound's steps: the first ones (where every candidate is still near the start, and the
-  // clearance is often smallest) and a few spread over the horizon.
-  const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
-  // The two parts of each separation at those steps, per bundle (computed at its first
-  // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
-  const int row = kProbes * num_cars;
-  lon_done_.assign(ws_.lon.size(), 0);
-  lat_done_.assign(ws_.lat.size(), 0);
-  const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
-                        double* out) {
-    for (int q = 0; q < kProbes; ++q) {
-      const int j = std::clamp(probe[q], 1, n_steps);
-      for (int car = 0; car < num_cars; ++car) {
-        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
-      }
-    }
-  };
-  bound_.resize(ws_.cand_cost.size());
   heap_.resize(n);
-  for (int r = 0; r < n; ++r) {
-    const int c = order[r];
-    const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
-    if (!lon_done_[i] || !lat_done_[k]) {
-      const Checker::Rows rows = checker_.StepRows(c);
-      if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
-      if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
-      lon_done_[i] = lat_done_[k] = 1;
-    }
-    bound_[c] = MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);
-    heap_[r] = c;
-  }
   // Largest bound first, then the smallest index (any order gives the same maximum; this one
   // is deterministic).
   const auto lower = [this](int a, int b) {
     return bound_[a] < bound_[b] || (bound_[a] == bound_[b] && a > b);
   };
-  std::make_heap(heap_.begin(), heap_.end(), lower);
+  if (unbounded) {
+    // Expecting no clear candidate (none was last cycle): every one is visited, so the
+    // bounds and their order would be work for nothing; in cost order.
+    for (int r = 0; r < n; ++r) heap_[r] = order[r];
+  } else {
+    // The bound's steps: the first ones (where every candidate is still near the start, and the
+    // clearance is often smallest) and a few spread over the horizon.
+    const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+    // The two parts of each separation at those steps, per bundle (computed at its first
+    // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
+    const int row = kProbes * num_cars;
+    lon_done_.assign(ws_.lon.size(), 0);
+    lat_done_.assign(ws_.lat.size(), 0);
+    const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
+                          double* out) {
+      for (int q = 0; q < kProbes; ++q) {
+        const int j = std::clamp(probe[q], 1, n_steps);
+        for (int car = 0; car < num_cars; ++car) {
+          out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
+        }
+      }
+    };
+    bound_.resize(ws_.cand_cost.size());
+    for (int r = 0; r < n; ++r) {
+      const int c = order[r];
+      const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+      if (!lon_done_[i] || !lat_done_[k]) {
+        const Checker::Rows rows = checker_.StepRows(c);
+        if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
+        if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
+        lon_done_[i] = lat_done_[k] = 1;
+      }
+      bound_[c] = MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);
+      heap_[r] = c;
+    }
+    std::make_heap(heap_.begin(), heap_.end(), lower);
+  }
   int best = -1;
   double best_clr = 0;
   // Visits c: whether it beats the best one so far.
@@ -138,7 +145,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
   // order saves: none may be clear at all), each skipped when its bound cannot beat the best.
   int k = 0;
   bool done = false;
-  for (; !heap_.empty() && k < kHeapVisits; ++k) {
+  for (; !unbounded && !heap_.empty() && k < kHeapVisits; ++k) {
     if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
       *over_budget = true;
       return -1;
@@ -158,7 +165,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known) {
       return -1;
     }
     const int c = heap_[e];
-    if (best >= 0 && bound_[c] < best_clr) continue;
+    if (!unbounded && best >= 0 && bound_[c] < best_clr) continue;
     visit(c);
   }
   // With no winner every candidate was visited before the best one was found.

@@ -153,13 +153,16 @@ class LeastHarm {
   // candidate is ranked and ws.order is left in harm order. False when
   // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
   // short: then *over_budget is set.
-  bool Choose(bool* over_budget);
+  // none_passed_before: the last cycle's search found no candidate passing either (its Choose
+  // was the last call), a hint that changes no choice, only the work.
+  bool Choose(bool* over_budget, bool none_passed_before = false);
 
  private:
   // The first feasible collision-free candidate in harm order, -1 when there is none (or the
   // deadline cut it short: then *over_budget is set). *all_known: none is, and every
   // candidate's contact and clearance are in first_hit_ and clearance_.
-  int BestClear(bool* over_budget, bool* all_known);
+  // unbounded: no clear candidate is expected (every one will be visited): no bounds.
+  int BestClear(bool* over_budget, bool* all_known, bool unbounded);
   // After BestClear found none with every candidate known: the first feasible colliding
   // candidate in harm order, -1 when there is none (or the deadline cut it short).
   int LatestContact(bool* over_budget);
@@ -175,6 +178,7 @@ class LeastHarm {
   const CycleClock& clock_;
   // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
   // BestClear measured them already), and an upper bound of the clearance (BestClear).
+  bool clear_before_ = false;  // the last Choose found a collision-free feasible candidate
   std::vector<char> known_;
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;

@@ -191,9 +191,10 @@ class SearchPlanner : public Planner {
       sum.ms_score = Elapsed() - t_score;
       const double t_check = Elapsed();
       bool check_cut = false;
+      const bool none_passed_before = none_passed_last_;
       found = CheckLazily(&check_cut);
       none_passed_last_ = !found && !check_cut;
-      if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut);
+      if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut, none_passed_before);
       if (check_cut) {
         over_budget = true;
         sum.deadline_stage = PlanSummary::Stage::kCheck;

@@ -165,7 +165,9 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
       ASSERT_TRUE(st.scorer.ResolveAll());
     }
     bool over_budget = false;
-    const bool ok = st.least_harm.Choose(&over_budget);
+    // Every third scene says the last search found nothing passing (after a scene without a
+    // clear candidate, every candidate is then visited without bounds): the same choice.
+    const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
     ASSERT_TRUE(st.scorer.ResolveAll());
     const int expected = ReferenceChoice(st);
     EXPECT_FALSE(over_budget);
