@@ -249,17 +249,26 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
 // FirstCollision's ego at one step.
 struct Checker::StepEgo {
   traj::OrientedBox box;
-  double s_d = 0;       // the state's s'
-  double dir_s, dir_d;  // unit heading (s', d') with s' at least 0.5
-  double reach_s;       // ReachS
+  double s_d = 0;  // the state's s'
+  double vs, vd;   // the heading's velocity (s', d') with s' at least 0.5
+  double reach_s;  // ReachS
+  // The unit heading, from (vs, vd) when a car first comes near enough to need it (most steps
+  // have none: the square root is saved there).
+  mutable double dir_s = 0, dir_d = 0;
+  mutable bool has_dir = false;
+  void Direction() const {
+    if (has_dir) return;
+    const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
+    dir_s = vs * inv;
+    dir_d = vd * inv;
+    has_dir = true;
+  }
 };
 
 inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
                                        double behind_scale) const {
-  const double vs = std::max(st.s_d, 0.5), vd = st.d_d;
-  const double inv = 1.0 / std::sqrt(vs * vs + vd * vd);
   return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.car_length, 0.5 * cfg_.car_width}, st.s_d,
-          vs * inv, vd * inv, ReachS(st.s_d, margin_scale, behind_scale)};
+          std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
 }
 
 inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
@@ -287,6 +296,7 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
                           : margin_scale * cfg_.margin_s;
   if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
   const double cu = ws_.step_dir_s[at], cw = ws_.step_dir_d[at];  // the car's unit heading
+  e.Direction();
   const traj::OrientedBox car{cs, cd, 0.0, ego.half_length + margin,
                               ego.half_width + margin_scale * cfg_.margin_d};
   // The d axis separates the boxes when their extents along it do not reach (most cars

@@ -24,6 +24,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   group_fill_.reserve(ws_.n_steps + 2);
   bound_.reserve(ws_.order.capacity());
   heap_.reserve(ws_.order.capacity());
+  visited_.reserve(ws_.order.capacity());
   lon_done_.reserve(ws_.lon.capacity());
   lat_done_.reserve(ws_.lat.capacity());
   lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
@@ -60,49 +61,39 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   known_.assign(n, 0);
   first_hit_.resize(n);
   clearance_.resize(n);
-  heap_.resize(n);
+  // The bound's steps: the first ones (where every candidate is still near the start, and the
+  // clearance is often smallest) and a few spread over the horizon.
+  const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
+  // The two parts of each separation at those steps, per bundle (computed at its first
+  // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
+  const int row = kProbes * num_cars;
+  lon_done_.assign(ws_.lon.size(), 0);
+  lat_done_.assign(ws_.lat.size(), 0);
+  const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
+                        double* out) {
+    for (int q = 0; q < kProbes; ++q) {
+      const int j = std::clamp(probe[q], 1, n_steps);
+      for (int car = 0; car < num_cars; ++car) {
+        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
+      }
+    }
+  };
+  bound_.resize(ws_.cand_cost.size());
+  const auto bound_of = [&](int c) {
+    const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+    if (!lon_done_[i] || !lat_done_[k]) {
+      const Checker::Rows rows = checker_.StepRows(c);
+      if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
+      if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
+      lon_done_[i] = lat_done_[k] = 1;
+    }
+    return MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);
+  };
   // Largest bound first, then the smallest index (any order gives the same maximum; this one
   // is deterministic).
   const auto lower = [this](int a, int b) {
     return bound_[a] < bound_[b] || (bound_[a] == bound_[b] && a > b);
   };
-  if (unbounded) {
-    // Expecting no clear candidate (none was last cycle): every one is visited, so the
-    // bounds and their order would be work for nothing; in cost order.
-    for (int r = 0; r < n; ++r) heap_[r] = order[r];
-  } else {
-    // The bound's steps: the first ones (where every candidate is still near the start, and the
-    // clearance is often smallest) and a few spread over the horizon.
-    const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
-    // The two parts of each separation at those steps, per bundle (computed at its first
-    // candidate): |ds| - length per lon bundle, |dd| - width per lat bundle, [probe][car].
-    const int row = kProbes * num_cars;
-    lon_done_.assign(ws_.lon.size(), 0);
-    lat_done_.assign(ws_.lat.size(), 0);
-    const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
-                          double* out) {
-      for (int q = 0; q < kProbes; ++q) {
-        const int j = std::clamp(probe[q], 1, n_steps);
-        for (int car = 0; car < num_cars; ++car) {
-          out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
-        }
-      }
-    };
-    bound_.resize(ws_.cand_cost.size());
-    for (int r = 0; r < n; ++r) {
-      const int c = order[r];
-      const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
-      if (!lon_done_[i] || !lat_done_[k]) {
-        const Checker::Rows rows = checker_.StepRows(c);
-        if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
-        if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
-        lon_done_[i] = lat_done_[k] = 1;
-      }
-      bound_[c] = MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);
-      heap_[r] = c;
-    }
-    std::make_heap(heap_.begin(), heap_.end(), lower);
-  }
   int best = -1;
   double best_clr = 0;
   // Visits c: whether it beats the best one so far.
@@ -140,12 +131,28 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
     best = c;
     best_clr = clr;
   };
+  // Unbounded: in cost order, without bounds, until a clear one is found (mostly none is);
+  // then the rest as below.
+  heap_.clear();
+  int r = 0;
+  for (; unbounded && r < n && best < 0; ++r) {
+    if ((r & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    visit(order[r]);
+  }
+  const int r0 = r;  // order[r0, n): not visited yet
+  for (; r < n; ++r) heap_.push_back(order[r]);
+  for (const int c : heap_) bound_[c] = bound_of(c);
+  std::make_heap(heap_.begin(), heap_.end(), lower);
   // Best bound first: a clear candidate is mostly among the first few. After kHeapVisits
   // without one, the rest in the heap's array order (popping each would cost more than the
   // order saves: none may be clear at all), each skipped when its bound cannot beat the best.
   int k = 0;
   bool done = false;
-  for (; !unbounded && !heap_.empty() && k < kHeapVisits; ++k) {
+  visited_.assign(n, 0);
+  for (; !heap_.empty() && k < kHeapVisits; ++k) {
     if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
       *over_budget = true;
       return -1;
@@ -157,15 +164,18 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
     }
     std::pop_heap(heap_.begin(), heap_.end(), lower);
     heap_.pop_back();
+    visited_[c] = 1;
     visit(c);
   }
-  for (int e = 0; !done && e < static_cast<int>(heap_.size()); ++e, ++k) {
+  // The rest in cost order (the candidates of a bundle are neighbours there: their rows stay
+  // in cache), skipping the ones visited.
+  for (int e = r0; !done && !heap_.empty() && e < n; ++e, ++k) {
     if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
       *over_budget = true;
       return -1;
     }
-    const int c = heap_[e];
-    if (!unbounded && best >= 0 && bound_[c] < best_clr) continue;
+    const int c = order[e];
+    if (visited_[c] || (best >= 0 && bound_[c] < best_clr)) continue;
     visit(c);
   }
   // With no winner every candidate was visited before the best one was found.

@@ -188,6 +188,7 @@ class LeastHarm {
   std::vector<std::pair<double, int>> contact_;
   std::vector<int> group_start_, group_fill_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
+  std::vector<char> visited_;  // BestClear: taken from the heap
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;
   static constexpr int kHeapVisits = 48;  // BestClear: candidates taken best bound first

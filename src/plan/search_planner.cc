@@ -79,6 +79,7 @@ class SearchPlanner : public Planner {
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
     rest_.reserve(ws_.order.capacity());
+    popped_.assign(ws_.order.capacity(), 0);
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -346,6 +347,7 @@ class SearchPlanner : public Planner {
     for (int k = r0; k < n; ++k) {
       const int c = ws_.order[k];
       rest_.push_back({scorer_.Bound(c), c});
+      popped_[c] = 0;
     }
     const auto later = std::greater<std::pair<double, int>>();  // a min-heap by bound, index
     std::make_heap(rest_.begin(), rest_.end(), later);
@@ -388,18 +390,19 @@ class SearchPlanner : public Planner {
       if (beaten(bc, c)) return best;
       std::pop_heap(rest_.begin(), rest_.end(), later);
       rest_.pop_back();
+      popped_[c] = 1;
       test(c);
     }
     // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
-    // rest in the heap's array order then (popping each costs more than the order saves), each
-    // skipped when its bound cannot beat the best one.
-    for (int e = 0; e < static_cast<int>(rest_.size()); ++e, ++k) {
+    // rest in rank order then (popping each costs more than the order saves; the candidates of
+    // a bundle are neighbours there), each skipped when its bound cannot beat the best one.
+    for (int e = r0; !rest_.empty() && e < n; ++e, ++k) {
       if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return -1;
       }
-      const auto [bc, c] = rest_[e];
-      if (!beaten(bc, c)) test(c);
+      const int c = ws_.order[e];
+      if (!popped_[c] && !beaten(scorer_.Bound(c), c)) test(c);
     }
     return best;
   }
@@ -478,6 +481,7 @@ class SearchPlanner : public Planner {
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
   std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
+  std::vector<char> popped_;                  // CheckRest: taken from the heap
   bool none_passed_last_ = false;             // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
