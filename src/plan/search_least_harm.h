@@ -176,14 +176,14 @@ class LeastHarm {
   Scorer& scorer_;
   Checker& checker_;
   const CycleClock& clock_;
+  bool clear_before_ = false;  // the last Choose found a collision-free feasible candidate
   // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
   // BestClear measured them already), and an upper bound of the clearance (BestClear).
-  bool clear_before_ = false;  // the last Choose found a collision-free feasible candidate
   std::vector<char> known_;
   std::vector<int> first_hit_;
   std::vector<double> clearance_, bound_;
   // LatestContact's colliding candidates (cost bound, index), grouped by contact step, latest
-  // first: group h starts at group_start_[h] (and ends where group h - 1 starts; group 1 at
+  // first: group h starts at group_start_[h] and ends where group h - 1 starts (group 1 ends at
   // group_start_[0]).
   std::vector<std::pair<double, int>> contact_;
   std::vector<int> group_start_, group_fill_;
