@@ -33,8 +33,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
 
 bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   bool all_known = false;
-  int best = BestClear(over_budget, &all_known, none_passed_before && !clear_before_);
-  clear_before_ = best >= 0;
+  int best = BestClear(over_budget, &all_known, none_passed_before);
   if (best < 0 && all_known && !*over_budget) best = LatestContact(over_budget);
   if (best >= 0) {
     ws_.TakeWinner(best);

@@ -161,7 +161,8 @@ class LeastHarm {
   // The first feasible collision-free candidate in harm order, -1 when there is none (or the
   // deadline cut it short: then *over_budget is set). *all_known: none is, and every
   // candidate's contact and clearance are in first_hit_ and clearance_.
-  // unbounded: no clear candidate is expected (every one will be visited): no bounds.
+  // unbounded: none may be clear (nothing passed last cycle either): in cost order without
+  // bounds until a clear one is found, then the rest by bound.
   int BestClear(bool* over_budget, bool* all_known, bool unbounded);
   // After BestClear found none with every candidate known: the first feasible colliding
   // candidate in harm order, -1 when there is none (or the deadline cut it short).
@@ -176,7 +177,6 @@ class LeastHarm {
   Scorer& scorer_;
   Checker& checker_;
   const CycleClock& clock_;
-  bool clear_before_ = false;  // the last Choose found a collision-free feasible candidate
   // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
   // BestClear measured them already), and an upper bound of the clearance (BestClear).
   std::vector<char> known_;

@@ -165,8 +165,8 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
       ASSERT_TRUE(st.scorer.ResolveAll());
     }
     bool over_budget = false;
-    // Every third scene says the last search found nothing passing (after a scene without a
-    // clear candidate, every candidate is then visited without bounds): the same choice.
+    // Every third scene says the last search found nothing passing (the candidates are then
+    // visited in cost order without bounds until a clear one is found): the same choice.
     const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
     ASSERT_TRUE(st.scorer.ResolveAll());
     const int expected = ReferenceChoice(st);
