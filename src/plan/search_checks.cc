@@ -151,16 +151,8 @@ bool Checker::CandidateCollides(int c) {
   int hit = 0, car = -1;
   for (int q = 0; q < n_steps && hit == 0; ++q) {
     const int j = (from - 1 + q) % n_steps + 1;
-    const std::uint64_t near = steps.Near(j) & cars;
-    if (near == 0) continue;
-    const StepEgo ego = EgoAt(steps(j * ws_.collision_step), 1.0, 1.0);
-    for (std::uint64_t m = near; m != 0; m &= m - 1) {
-      if (HitsAt(ego, j, std::countr_zero(m), 1.0, 1.0)) {
-        hit = j;
-        car = std::countr_zero(m);
-        break;
-      }
-    }
+    car = FirstCarHit(steps, j, cars, 1.0, 1.0);
+    if (car >= 0) hit = j;
   }
   if (hit == 0) return false;
   const LastHit now{ws_.traffic_stamp, hit, car};

@@ -148,6 +148,11 @@ class Checker {
   struct StepEgo;
   StepEgo EgoAt(const traj::FrenetState& st, double margin_scale, double behind_scale) const;
   bool HitsAt(const StepEgo& e, int j, int c, double margin_scale, double behind_scale) const;
+  // The first car (by index) of the mask `cars` that the ego of `state_at` (with Near) collides
+  // with at step j, -1 when none.
+  template <typename StateAt>
+  int FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
+                  double behind_scale) const;
 
   // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept; true
   // when sampled anew.
@@ -308,6 +313,19 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
 }
 
 template <typename StateAt>
+int Checker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
+                         double behind_scale) const {
+  const std::uint64_t near = state_at.Near(j) & cars;
+  if (near == 0) return -1;  // no car within reach at this step: nothing to test
+  const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
+  for (std::uint64_t m = near; m != 0; m &= m - 1) {
+    const int c = std::countr_zero(m);
+    if (HitsAt(ego, j, c, margin_scale, behind_scale)) return c;
+  }
+  return -1;
+}
+
+template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit, bool ghosts) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
@@ -315,27 +333,19 @@ int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind
       num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
   const int n_steps = ws_.n_steps;
   for (int j = 1; j <= n_steps; ++j) {
-    // No car within reach at this step: nothing to test (and no square root to take).
-    if constexpr (requires { state_at.Near(j); }) {
-      if ((state_at.Near(j) & cars) == 0) continue;
-    }
-    const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
     // Cars in index order either way: the first one hit is the same.
+    int hit = -1;
     if constexpr (requires { state_at.Near(j); }) {
-      for (std::uint64_t m = state_at.Near(j) & cars; m != 0; m &= m - 1) {
-        const int c = std::countr_zero(m);
-        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
-          if (car_hit != nullptr) *car_hit = c;
-          return j;
-        }
-      }
+      hit = FirstCarHit(state_at, j, cars, margin_scale, behind_scale);
     } else {
-      for (int c = 0; c < num_cars; ++c) {
-        if (HitsAt(ego, j, c, margin_scale, behind_scale)) {
-          if (car_hit != nullptr) *car_hit = c;
-          return j;
-        }
+      const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
+      for (int c = 0; c < num_cars && hit < 0; ++c) {
+        if (HitsAt(ego, j, c, margin_scale, behind_scale)) hit = c;
       }
+    }
+    if (hit >= 0) {
+      if (car_hit != nullptr) *car_hit = hit;
+      return j;
     }
   }
   return n_steps + 1;
