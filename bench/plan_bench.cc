@@ -119,7 +119,8 @@ StatusOr<Rig> MakeRig(const Scene& scene, const plan::PlannerConfig& config) {
 // The measured loop over one or more rigs, round robin (one cycle per iteration).
 void RunCycles(benchmark::State& state, std::vector<Rig>& rigs, CycleStats* stats) {
   stats->us.reserve(1 << 16);
-  // FRENETIC_BENCH_TRACE=1 prints every measured cycle's summary to stderr (diagnosis only).
+  // FRENETIC_BENCH_TRACE=1 prints every measured cycle's summary and stage times to stderr
+  // (diagnosis only).
   static const bool trace = std::getenv("FRENETIC_BENCH_TRACE") != nullptr;
   std::size_t k = 0;
   for (auto _ : state) {
@@ -140,10 +141,13 @@ void RunCycles(benchmark::State& state, std::vector<Rig>& rigs, CycleStats* stat
       const auto& rej = r.summary.rejections;
       std::fprintf(stderr,
                    "cycle: %s %.1f us, %d candidates, %d checked (rejected: speed %d accel %d "
-                   "jerk %d off_road %d collision %d), %d kept\n",
+                   "jerk %d off_road %d collision %d), %d kept; us: prepare %.0f generate %.0f "
+                   "score %.0f check %.0f refine %.0f output %.0f\n",
                    plan::ToString(r.status), dt * 1e6, r.summary.candidates_generated,
                    r.summary.candidates_checked, rej[0], rej[1], rej[2], rej[3], rej[4],
-                   r.summary.points_kept);
+                   r.summary.points_kept, 1e3 * r.summary.ms_prepare, 1e3 * r.summary.ms_generate,
+                   1e3 * r.summary.ms_score, 1e3 * r.summary.ms_check, 1e3 * r.summary.ms_refine,
+                   1e3 * r.summary.ms_output);
     }
     rig.replay->Finish(r);
     state.ResumeTiming();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "frenetic/plan/planner.h"
@@ -212,17 +213,22 @@ int LeastHarm::LatestContact(bool* over_budget) {
     if (h <= n_steps) contact_[group_fill_[h]++] = {scorer_.Bound(c), c};
   }
   int k = 0;
+  // A min-heap by bound, then index (a strict order: popping gives the sorted order), so that
+  // only the candidates taken are ordered: a group may hold nearly all of them (every one in
+  // contact at the first step) and few are taken.
+  const auto later = std::greater<std::pair<double, int>>();
   for (int h = n_steps; h >= 1; --h) {
     const auto first = contact_.begin() + group_start_[h];
-    const auto last = contact_.begin() + (h > 1 ? group_start_[h - 1] : group_start_[0]);
-    std::sort(first, last);  // smallest bound, then index
+    auto last = contact_.begin() + (h > 1 ? group_start_[h - 1] : group_start_[0]);
+    std::make_heap(first, last, later);
     int best = -1;
-    for (auto it = first; it != last; ++it, ++k) {
+    for (; first != last; ++k) {
       if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return -1;
       }
-      const auto [bound, c] = *it;
+      const auto [bound, c] = *first;
+      std::pop_heap(first, last--, later);
       if (best >= 0) {
         // The cost first once there is one to beat (the limits cost more); before, the limits.
         const double cost = ws_.cand_cost[best];
