@@ -145,8 +145,7 @@ bool Checker::CandidateCollides(int c) {
   // a neighbour's is found sooner); any hit answers.
   const StepStates steps = StepsOf(c);
   const int n_steps = ws_.n_steps;
-  const std::uint64_t cars =
-      ws_.num_check_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << ws_.num_check_cars) - 1;
+  const std::uint64_t cars = CarMask(true);
   const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;
   int hit = 0, car = -1;
   for (int q = 0; q < n_steps && hit == 0; ++q) {

@@ -114,9 +114,16 @@ class Checker {
   // in front of it (the simulator's traffic only brakes for a car within 2 m laterally), so
   // moving into its way is never safe. With ghosts false only the real cars count, not the
   // predictor's lane-change hypotheses (Workspace::num_check_cars).
+  // from: the first step tested (the caller knows the earlier ones do not collide).
   template <typename StateAt>
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
-                     int* car_hit = nullptr, bool ghosts = true) const;
+                     int* car_hit = nullptr, bool ghosts = true, int from = 1) const;
+  // Whether `steps` collide at step j (1..n_steps) as FirstCollision(steps, margin_scale,
+  // behind_scale, nullptr, ghosts) tests it there.
+  bool CollidesAt(const StepStates& steps, int j, double margin_scale, double behind_scale,
+                  bool ghosts) const {
+    return FirstCarHit(steps, j, CarMask(ghosts), margin_scale, behind_scale) >= 0;
+  }
 
   // Candidate c's states at the collision-check steps, with the cars within reach of a
   // FirstCollision(..., margin_scale, behind_scale) at each step. Each bundle trajectory is
@@ -148,6 +155,11 @@ class Checker {
   struct StepEgo;
   StepEgo EgoAt(const traj::FrenetState& st, double margin_scale, double behind_scale) const;
   bool HitsAt(const StepEgo& e, int j, int c, double margin_scale, double behind_scale) const;
+  // FirstCollision's cars: bit c for each context index it tests.
+  std::uint64_t CarMask(bool ghosts) const {
+    const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
+    return num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
+  }
   // The first car (by index) of the mask `cars` that the ego of `state_at` (with Near) collides
   // with at step j, -1 when none.
   template <typename StateAt>
@@ -327,12 +339,11 @@ int Checker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, dou
 
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
-                            int* car_hit, bool ghosts) const {
+                            int* car_hit, bool ghosts, int from) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
-  const std::uint64_t cars =
-      num_cars >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << num_cars) - 1;
+  const std::uint64_t cars = CarMask(ghosts);
   const int n_steps = ws_.n_steps;
-  for (int j = 1; j <= n_steps; ++j) {
+  for (int j = std::max(from, 1); j <= n_steps; ++j) {
     // Cars in index order either way: the first one hit is the same.
     int hit = -1;
     if constexpr (requires { state_at.Near(j); }) {

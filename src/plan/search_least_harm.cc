@@ -26,6 +26,8 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
   bound_.reserve(ws_.order.capacity());
   heap_.reserve(ws_.order.capacity());
   visited_.reserve(ws_.order.capacity());
+  lon_hit_.reserve(ws_.lon.capacity());
+  lat_hit_.reserve(ws_.lat.capacity());
   lon_done_.reserve(ws_.lon.capacity());
   lat_done_.reserve(ws_.lat.capacity());
   lon_sep_.assign(ws_.lon.capacity() * kProbes * kMaxCars, 0.0);
@@ -96,15 +98,19 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   };
   int best = -1;
   double best_clr = 0;
+  latest_ = 0;
+  bounded_ = 0;
+  lon_hit_.assign(ws_.lon.size(), 0);
+  lat_hit_.assign(ws_.lat.size(), 0);
   // Visits c: whether it beats the best one so far.
   const auto visit = [&](int c) {
     if (best < 0) {
       // Nothing to beat yet: whether it collides first (most do, and then its clearance is
-      // not needed: the ranking counts it as 0), and what ChooseByRanking would measure.
-      first_hit_[c] =
-          checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+      // not needed: the ranking counts it as 0), and what ChooseByRanking would measure; of
+      // one that hits before the latest contact so far, only a step it hits at (LatestContact
+      // finds its contact if that is ever needed).
       clearance_[c] = 0.0;
-      known_[c] = 1;
+      Contact(c);
       if (first_hit_[c] <= n_steps) return;
       const Checker::Rows rows = checker_.StepRows(c);
       clearance_[c] =
@@ -183,66 +189,134 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   return best;
 }
 
+void LeastHarm::Contact(int c) {
+  const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
+  int& lon_hit = lon_hit_[ws_.cand_lon[c]];
+  int& lat_hit = lat_hit_[ws_.cand_lat[c]];
+  // A step before latest_ that collides: the ones its bundles' last candidates hit at first.
+  int hit = 0;
+  if (latest_ > 1) {
+    for (const int j : {lon_hit, lat_hit}) {
+      if (j >= 1 && j < latest_ && checker_.CollidesAt(steps, j, 0.0, 1.0, false)) {
+        hit = j;
+        break;
+      }
+    }
+    for (int j = latest_ - 1; hit == 0 && j >= 1; --j) {
+      if (checker_.CollidesAt(steps, j, 0.0, 1.0, false)) hit = j;
+    }
+  }
+  if (hit > 0) {
+    first_hit_[c] = hit;
+    known_[c] = 2;
+    ++bounded_;
+  } else {  // none before latest_: the first one from there on
+    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false, latest_);
+    known_[c] = 1;
+    if (first_hit_[c] > ws_.n_steps) return;
+    latest_ = std::max(latest_, first_hit_[c]);
+  }
+  lon_hit = lat_hit = first_hit_[c];
+}
+
+int LeastHarm::CheapestFeasible(std::vector<BoundIndex>::iterator first,
+                                std::vector<BoundIndex>::iterator last, int* k, bool* over_budget) {
+  // A min-heap by bound, then index (a strict order: popping gives the sorted order), so that
+  // only the candidates taken are ordered: a group may hold nearly all of them (every one in
+  // contact at the first step) and few are taken.
+  const auto later = std::greater<BoundIndex>();
+  std::make_heap(first, last, later);
+  int best = -1;
+  for (; first != last; ++*k) {
+    if ((*k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *over_budget = true;
+      return -1;
+    }
+    const auto [bound, c] = *first;
+    std::pop_heap(first, last--, later);
+    if (best >= 0) {
+      // The cost first once there is one to beat (the limits cost more); before, the limits.
+      const double cost = ws_.cand_cost[best];
+      if (bound > cost || (bound == cost && c > best)) break;  // none cheaper is left
+      scorer_.ExactCost(c);
+      if (!Cheaper(ws_, c, best)) continue;
+    }
+    if (checker_.CandidateBreaksLimits(c)) continue;
+    scorer_.ExactCost(c);
+    best = c;
+  }
+  return best;
+}
+
 // No collision-free candidate is feasible (BestClear visited them all): in harm order the
 // colliding ones come next, latest contact first, and at equal contact their clearance is 0,
 // so the cost decides. The contact groups are taken latest first; in each, the candidates by
 // cost bound, feasible ones only, until no bound is below the cheapest feasible one's cost.
+// The groups from latest_ on are known as they are (every candidate that reached latest_
+// without contact was scanned on); only when none of them is feasible are the next ones
+// searched for among the others, the same way (Contact).
 int LeastHarm::LatestContact(bool* over_budget) {
   const std::vector<int>& order = ws_.order;
   const int n = static_cast<int>(order.size());
   const int n_steps = ws_.n_steps;
-  // The colliding candidates grouped by contact step, latest first (a counting sort: only the
-  // groups reached are sorted by bound).
-  group_start_.assign(n_steps + 2, 0);
-  for (int r = 0; r < n; ++r) {
-    const int h = first_hit_[order[r]];
-    if (h <= n_steps) ++group_start_[h];
-  }
-  int at = 0;
-  for (int h = n_steps; h >= 1; --h) {
-    const int count = group_start_[h];
-    group_start_[h] = at;
-    at += count;
-  }
-  group_start_[0] = at;  // the end of the last group (h = 1)
-  contact_.resize(at);
-  group_fill_.assign(group_start_.begin(), group_start_.end());
-  for (int r = 0; r < n; ++r) {
-    const int c = order[r];
-    const int h = first_hit_[c];
-    if (h <= n_steps) contact_[group_fill_[h]++] = {scorer_.Bound(c), c};
-  }
   int k = 0;
-  // A min-heap by bound, then index (a strict order: popping gives the sorted order), so that
-  // only the candidates taken are ordered: a group may hold nearly all of them (every one in
-  // contact at the first step) and few are taken.
-  const auto later = std::greater<std::pair<double, int>>();
-  for (int h = n_steps; h >= 1; --h) {
-    const auto first = contact_.begin() + group_start_[h];
-    auto last = contact_.begin() + (h > 1 ? group_start_[h - 1] : group_start_[0]);
-    std::make_heap(first, last, later);
-    int best = -1;
-    for (; first != last; ++k) {
+  for (int top = n_steps;;) {
+    // The exact contacts in [floor, top] grouped by step, latest first (a counting sort).
+    const int floor = bounded_ > 0 ? latest_ : 1;
+    group_start_.assign(n_steps + 2, 0);
+    for (int r = 0; r < n; ++r) {
+      const int c = order[r];
+      if (known_[c] == 1 && first_hit_[c] >= floor && first_hit_[c] <= top) {
+        ++group_start_[first_hit_[c]];
+      }
+    }
+    int at = 0;
+    for (int h = n_steps; h >= 1; --h) {
+      const int count = group_start_[h];
+      group_start_[h] = at;
+      at += count;
+    }
+    group_start_[0] = at;  // the end of the last group (h = 1)
+    contact_.resize(at);
+    group_fill_.assign(group_start_.begin(), group_start_.end());
+    for (int r = 0; r < n; ++r) {
+      const int c = order[r];
+      const int h = first_hit_[c];
+      if (known_[c] == 1 && h >= floor && h <= top) {
+        contact_[group_fill_[h]++] = {scorer_.Bound(c), c};
+      }
+    }
+    for (int h = top; h >= floor; --h) {
+      const auto first = contact_.begin() + group_start_[h];
+      const auto last = contact_.begin() + (h > 1 ? group_start_[h - 1] : group_start_[0]);
+      const int best = CheapestFeasible(first, last, &k, over_budget);
+      if (best >= 0 || *over_budget) return best;  // an earlier contact ranks after it
+    }
+    if (floor <= 1) return -1;
+    // None from latest_ on is feasible: the latest contact before, as BestClear found it, from
+    // the latest exact one before (an exact contact, so that group is not empty); a candidate
+    // known to hit before that needs nothing more.
+    top = floor - 1;
+    latest_ = 0;
+    for (int r = 0; r < n; ++r) {
+      const int c = order[r];
+      if (known_[c] == 1 && first_hit_[c] <= top) latest_ = std::max(latest_, first_hit_[c]);
+    }
+    bounded_ = 0;
+    for (int r = 0; r < n; ++r, ++k) {
       if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
         return -1;
       }
-      const auto [bound, c] = *first;
-      std::pop_heap(first, last--, later);
-      if (best >= 0) {
-        // The cost first once there is one to beat (the limits cost more); before, the limits.
-        const double cost = ws_.cand_cost[best];
-        if (bound > cost || (bound == cost && c > best)) break;  // none cheaper is left
-        scorer_.ExactCost(c);
-        if (!Cheaper(ws_, c, best)) continue;
+      const int c = order[r];
+      if (known_[c] != 2) continue;
+      if (first_hit_[c] < latest_) {
+        ++bounded_;
+      } else {
+        Contact(c);
       }
-      if (checker_.CandidateBreaksLimits(c)) continue;
-      scorer_.ExactCost(c);
-      best = c;
     }
-    if (best >= 0) return best;  // an earlier contact ranks after it
   }
-  return -1;
 }
 
 bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {

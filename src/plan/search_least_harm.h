@@ -160,13 +160,30 @@ class LeastHarm {
  private:
   // The first feasible collision-free candidate in harm order, -1 when there is none (or the
   // deadline cut it short: then *over_budget is set). *all_known: none is, and every
-  // candidate's contact and clearance are in first_hit_ and clearance_.
+  // candidate's clearance is in clearance_ and its contact in first_hit_ (known_ 1), or for
+  // one that hits before the latest contact latest_, a step it hits at (known_ 2: its exact
+  // contact is needed only when no candidate of the latest contact is feasible).
   // unbounded: none may be clear (nothing passed last cycle either): in cost order without
   // bounds until a clear one is found, then the rest by bound.
   int BestClear(bool* over_budget, bool* all_known, bool unbounded);
+  // Candidate c's contact on bare boxes as far as the ranking needs it: a step before latest_
+  // at which it collides (known_ 2, counted in bounded_), else its first collision step, from
+  // latest_ on (known_ 1; n_steps + 1 when none), raising latest_ to it. The steps before
+  // latest_ are tried where its bundles' last candidates hit first (the candidates of a bundle
+  // mostly run into the same car at about the same time), then from latest_ - 1 down (a
+  // contact mostly lasts: an early one often still holds there).
+  void Contact(int c);
   // After BestClear found none with every candidate known: the first feasible colliding
-  // candidate in harm order, -1 when there is none (or the deadline cut it short).
+  // candidate in harm order, -1 when there is none (or the deadline cut it short). Makes every
+  // contact exact (known_ 1) unless it returns a candidate of a contact from latest_ on or is
+  // cut short.
   int LatestContact(bool* over_budget);
+  // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
+  // pairs [first, last), taken by bound from a heap there; -1 when none is (or the deadline cut
+  // it short). *k counts the candidates taken, for the deadline checks.
+  using BoundIndex = std::pair<double, int>;
+  int CheapestFeasible(std::vector<BoundIndex>::iterator first,
+                       std::vector<BoundIndex>::iterator last, int* k, bool* over_budget);
   // The whole ranking: every candidate's contact and clearance (unless all_known), ws.order
   // sorted by harm, the first feasible one (unless all_known: none is), else the first
   // feasible but for the lane-line timer.
@@ -185,8 +202,14 @@ class LeastHarm {
   // LatestContact's colliding candidates (cost bound, index), grouped by contact step, latest
   // first: group h starts at group_start_[h] and ends where group h - 1 starts (group 1 ends at
   // group_start_[0]).
-  std::vector<std::pair<double, int>> contact_;
+  std::vector<BoundIndex> contact_;
   std::vector<int> group_start_, group_fill_;
+  // BestClear: the latest contact step of a candidate known so far (0: none), how many
+  // candidates have known_ 2, and per lon / lat bundle slot the step its last candidate
+  // visited was found hitting at (0: none).
+  int latest_ = 0;
+  int bounded_ = 0;
+  std::vector<int> lon_hit_, lat_hit_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
   std::vector<char> visited_;  // BestClear: taken from the heap
   // BestClear's bound: its steps, and the separations' parts there per bundle.

@@ -180,5 +180,50 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
   EXPECT_GT(chosen, 12);
 }
 
+// Boxed in: a slow or stopped car ahead and cars alongside in the other lanes, so that every
+// candidate collides, and the latest contacts come from braking hard, which often breaks a
+// limit: the choice is then in an earlier contact group, which LatestContact reaches without
+// every candidate's contact step (a step it hits at before the latest contact is enough until
+// that group fails).
+TEST(SearchLeastHarmTest, LatestFeasibleContactWhenTheLatestOnesBreakLimits) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> gap(6.0, 20.0), slow(0.0, 6.0), beside(-8.0, 8.0),
+      ego_v(14.0, 22.0);
+  int earlier_group = 0;  // scenes whose choice is not in the latest contact group
+  for (int scene = 0; scene < 40; ++scene) {
+    const double v = ego_v(rng);
+    const std::vector<SceneCar> cars = {{kS + gap(rng), st.ws.lane_center[1], slow(rng)},
+                                        {kS + beside(rng), st.ws.lane_center[0], v},
+                                        {kS + beside(rng), st.ws.lane_center[2], v},
+                                        {kS + 15 + beside(rng), st.ws.lane_center[0], v},
+                                        {kS + 15 + beside(rng), st.ws.lane_center[2], v}};
+    Start(st, cars);
+    st.Prepare({kS, v, 0, st.ws.lane_center[1], 0, 0}, cars);
+    st.lattice.Generate();
+    ASSERT_TRUE(st.scorer.Score());
+    bool over_budget = false;
+    const bool ok = st.least_harm.Choose(&over_budget, scene % 2 == 0);
+    ASSERT_TRUE(st.scorer.ResolveAll());
+    const int expected = ReferenceChoice(st);
+    EXPECT_FALSE(over_budget);
+    ASSERT_EQ(ok, expected >= 0) << "scene " << scene;
+    if (!ok) continue;
+    EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    // Whether a later contact than the choice's exists (among the colliding candidates).
+    int latest = 0;
+    for (const int c : st.ws.order) {
+      const int hit =
+          st.checker.FirstCollision(st.checker.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+      if (hit <= st.ws.n_steps) latest = std::max(latest, hit);
+    }
+    const int chosen =
+        st.checker.FirstCollision(st.checker.StepsOf(expected, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+    earlier_group += chosen <= st.ws.n_steps && chosen < latest;
+  }
+  EXPECT_GE(earlier_group, 5) << "the scenes do not reach an earlier contact group";
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search
