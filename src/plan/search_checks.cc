@@ -44,12 +44,8 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
 bool Checker::SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows) {
   if (rows.have[i] && std::memcmp(&rows.key[i], &tr, sizeof(tr)) == 0) return false;
   const int w = ws_.n_ticks + 1;
-  for (int t = 1; t <= ws_.n_ticks; ++t) {
-    const traj::State1d st = tr.At(0.0 + t * kTickSeconds);  // FillTicks' time, t0 = 0
-    rows.p[i * w + t] = st.p;
-    rows.v[i * w + t] = st.v;
-    rows.a[i * w + t] = st.a;
-  }
+  tr.Sample(1, ws_.n_ticks + 1, [](int t) { return 0.0 + t * kTickSeconds; },  // FillTicks' time
+            &rows.p[i * w], &rows.v[i * w], &rows.a[i * w]);
   std::memcpy(&rows.key[i], &tr, sizeof(tr));
   rows.have[i] = 1;
   return true;
@@ -60,12 +56,10 @@ bool Checker::SampleSteps(const traj::Trajectory1d& tr, int i,
                           std::vector<double>& p, std::vector<double>& v) {
   if (have[i] && std::memcmp(&key[i], &tr, sizeof(tr)) == 0) return false;
   const int w = ws_.n_steps + 1;
-  for (int j = 1; j <= ws_.n_steps; ++j) {
-    // The time FirstCollision's callers sample at: tick j * collision_step.
-    const traj::State1d st = tr.At((j * ws_.collision_step) * kTickSeconds);
-    p[i * w + j] = st.p;
-    v[i * w + j] = st.v;
-  }
+  // The time FirstCollision's callers sample at: tick j * collision_step.
+  const int step = ws_.collision_step;
+  tr.Sample(1, ws_.n_steps + 1, [step](int j) { return (j * step) * kTickSeconds; }, &p[i * w],
+            &v[i * w], nullptr);
   std::memcpy(&key[i], &tr, sizeof(tr));
   have[i] = 1;
   return true;

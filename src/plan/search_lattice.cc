@@ -26,12 +26,9 @@ void Lattice::AddLon(const LonTraj& l) {
   ws_.lon.push_back(l);
   ws_.lon.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
   const int n = ws_.n_samples;
-  for (int k = 0; k < n; ++k) {
-    const traj::State1d st = l.traj.At(k * cfg_.score_dt);
-    ws_.lon_s[i * n + k] = st.p;
-    ws_.lon_sd[i * n + k] = st.v;
-    ws_.lon_sdd[i * n + k] = st.a;
-  }
+  const double dt = cfg_.score_dt;
+  l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
+                &ws_.lon_sdd[i * n]);
   NearLon(ws_, ws_.lon_s.data() + i * n, ws_.lon_near.data() + 2 * i * n);
 }
 
@@ -41,12 +38,9 @@ void Lattice::AddLat(const LatTraj& l) {
   ws_.lat.push_back(l);
   ws_.lat.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
   const int n = ws_.n_samples;
-  for (int k = 0; k < n; ++k) {
-    const traj::State1d st = l.traj.At(k * cfg_.score_dt);
-    ws_.lat_d[i * n + k] = st.p;
-    ws_.lat_dd[i * n + k] = st.v;
-    ws_.lat_ddd[i * n + k] = st.a;
-  }
+  const double dt = cfg_.score_dt;
+  l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
+                &ws_.lat_ddd[i * n]);
   NearLat(ws_, ws_.lat_d.data() + i * n, ws_.lat_near.data() + 2 * i * n);
 }
 

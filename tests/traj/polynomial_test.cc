@@ -1,5 +1,7 @@
 #include "frenetic/traj/polynomial.h"
 
+#include <cmath>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -102,6 +104,30 @@ TEST(TrajectoryTest, ContinuesAtConstantVelocityAfterItsEnd) {
   EXPECT_NEAR(wait.At(1.5 + 1.2).p, ft.lat.At(1.2).p, 1e-12);
   EXPECT_NEAR(wait.At(1.5 + 1.2).v, ft.lat.At(1.2).v, 1e-12);
   EXPECT_NEAR(wait.At(10).p, 2, 1e-9);
+}
+
+TEST(TrajectoryTest, SampleGivesAtsValuesExactly) {
+  // Before the delay, on the polynomial, past its end; and NaN times: bit for bit At's values.
+  const Trajectory1d trs[] = {{SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0},
+                              {SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5},
+                              {SolveQuintic(0, 20, 1, 90, 15, 0, 4.7), 4.7, 0.3}};
+  constexpr int kN = 61;
+  const auto time = [](int k) { return k == kN - 1 ? NAN : k * 0.1; };
+  for (const Trajectory1d& tr : trs) {
+    double p[kN], v[kN], a[kN], p2[kN], v2[kN];
+    tr.Sample(0, kN, time, p, v, a);
+    tr.Sample(2, kN, time, p2, v2, nullptr);  // from k = 2 on, without the acceleration
+    for (int k = 0; k < kN; ++k) {
+      const State1d st = tr.At(time(k));
+      EXPECT_EQ(std::memcmp(&p[k], &st.p, sizeof(double)), 0) << k;
+      EXPECT_EQ(std::memcmp(&v[k], &st.v, sizeof(double)), 0) << k;
+      EXPECT_EQ(std::memcmp(&a[k], &st.a, sizeof(double)), 0) << k;
+      if (k >= 2) {
+        EXPECT_EQ(std::memcmp(&p2[k], &st.p, sizeof(double)), 0) << k;
+        EXPECT_EQ(std::memcmp(&v2[k], &st.v, sizeof(double)), 0) << k;
+      }
+    }
+  }
 }
 
 TEST(BoxTest, OverlapSeparatingAxis) {

@@ -51,6 +51,32 @@ struct Trajectory1d {
     const State1d e = poly.At(duration);
     return {e.p + e.v * (t - duration), e.v, 0.0, 0.0};
   }
+  // At(time(k)).p, .v and .a in p[k], v[k] and a[k] (a may be null) for k in [k0, k1): the
+  // same values (the same expressions), with the continuation's start, the polynomial's end
+  // state, evaluated once instead of at every sample past it, and no jerk.
+  template <typename Time>
+  void Sample(int k0, int k1, Time time, double* p, double* v, double* a) const {
+    const double end_p = poly.P(duration), end_v = poly.V(duration);
+    for (int k = k0; k < k1; ++k) {
+      double t = time(k);
+      if (t < delay) {
+        p[k] = poly.c[0];
+        v[k] = 0.0;
+        if (a != nullptr) a[k] = 0.0;
+        continue;
+      }
+      t -= delay;
+      if (t <= duration) {
+        p[k] = poly.P(t);
+        v[k] = poly.V(t);
+        if (a != nullptr) a[k] = poly.A(t);
+      } else {
+        p[k] = end_p + end_v * (t - duration);
+        v[k] = end_v;
+        if (a != nullptr) a[k] = 0.0;
+      }
+    }
+  }
 };
 
 }  // namespace frenetic::traj
