@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace frenetic::plan {
 namespace {
@@ -10,10 +13,14 @@ constexpr double kDt = 0.02;
 constexpr int kBlock = 10;  // ticks per acceleration sample (0.2 s)
 constexpr int kJerkBlocks = 5;  // acceleration samples per jerk sample (1 s)
 
+double Norm(double x, double y) { return std::sqrt(x * x + y * y); }
+
+}  // namespace
+
 // Menger curvature of three points as the simulator computes it: 2 sin(theta) / |p3 - p1|.
 // Squared lengths and one square root: the path coordinates are far from overflow, so
 // std::hypot's care (and cost) is not needed.
-double Menger(double x1, double y1, double x2, double y2, double x3, double y3) {
+double MengerCurvature(double x1, double y1, double x2, double y2, double x3, double y3) {
   const double ax = x2 - x1, ay = y2 - y1, bx = x3 - x2, by = y3 - y2;
   const double la2 = ax * ax + ay * ay, lb2 = bx * bx + by * by;
   if (la2 == 0 || lb2 == 0) return 0.0;
@@ -26,9 +33,41 @@ double Menger(double x1, double y1, double x2, double y2, double x3, double y3) 
   return 2.0 * std::abs(cross) / (lalb * std::sqrt(chord2));
 }
 
-double Norm(double x, double y) { return std::sqrt(x * x + y * y); }
-
-}  // namespace
+void MengerCurvatures(const double* x, const double* y, int first, int n, double* kappa) {
+  int i = std::max(1, first);
+#if defined(__SSE2__)
+  // Two triples at a time: MengerCurvature's operations lane by lane (IEEE, the same values), its cases
+  // selected by masks.
+  for (; i + 2 < n; i += 2) {
+    const __m128d x1 = _mm_loadu_pd(x + i - 1), x2 = _mm_loadu_pd(x + i),
+                  x3 = _mm_loadu_pd(x + i + 1);
+    const __m128d y1 = _mm_loadu_pd(y + i - 1), y2 = _mm_loadu_pd(y + i),
+                  y3 = _mm_loadu_pd(y + i + 1);
+    const __m128d ax = _mm_sub_pd(x2, x1), ay = _mm_sub_pd(y2, y1);
+    const __m128d bx = _mm_sub_pd(x3, x2), by = _mm_sub_pd(y3, y2);
+    const __m128d la2 = _mm_add_pd(_mm_mul_pd(ax, ax), _mm_mul_pd(ay, ay));
+    const __m128d lb2 = _mm_add_pd(_mm_mul_pd(bx, bx), _mm_mul_pd(by, by));
+    const __m128d cross = _mm_sub_pd(_mm_mul_pd(ax, by), _mm_mul_pd(ay, bx));
+    const __m128d dot = _mm_add_pd(_mm_mul_pd(ax, bx), _mm_mul_pd(ay, by));
+    const __m128d lalb = _mm_sqrt_pd(_mm_mul_pd(la2, lb2));
+    const __m128d cx = _mm_sub_pd(x3, x1), cy = _mm_sub_pd(y3, y1);
+    const __m128d chord2 = _mm_add_pd(_mm_mul_pd(cx, cx), _mm_mul_pd(cy, cy));
+    const __m128d abs_cross = _mm_andnot_pd(_mm_set1_pd(-0.0), cross);
+    const __m128d curv =
+        _mm_div_pd(_mm_mul_pd(_mm_set1_pd(2.0), abs_cross), _mm_mul_pd(lalb, _mm_sqrt_pd(chord2)));
+    const __m128d zero = _mm_setzero_pd();
+    const __m128d reversal = _mm_and_pd(
+        _mm_cmplt_pd(abs_cross, _mm_mul_pd(_mm_set1_pd(1e-12), lalb)), _mm_cmplt_pd(dot, zero));
+    const __m128d big = _mm_or_pd(reversal, _mm_cmpeq_pd(chord2, zero));
+    const __m128d bent = _mm_or_pd(_mm_and_pd(big, _mm_set1_pd(1e6)), _mm_andnot_pd(big, curv));
+    const __m128d flat = _mm_or_pd(_mm_cmpeq_pd(la2, zero), _mm_cmpeq_pd(lb2, zero));
+    _mm_storeu_pd(&kappa[i], _mm_andnot_pd(flat, bent));
+  }
+#endif
+  for (; i + 1 < n; ++i) {
+    kappa[i] = MengerCurvature(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
+  }
+}
 
 XyChecker::XyChecker(int capacity) {
   for (auto* v : {&v_, &kappa_, &vsum_, &ksum_, &acc_, &asum_}) v->assign(capacity + 1, 0.0);
@@ -57,9 +96,7 @@ int XyChecker::Compute(const double* x, const double* y, int n, int from) {
   v_[0] = 0;
   for (int i = from; i < n; ++i) v_[i] = Norm(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
   kappa_[0] = 0;
-  for (int i = std::max(1, from - 1); i + 1 < n; ++i) {
-    kappa_[i] = Menger(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
-  }
+  MengerCurvatures(x, y, std::max(1, from - 1), n, kappa_.data());
   kappa_[n - 1] = 0;
   // Prefix sums make every sliding block mean O(1).
   vsum_[0] = 0;
@@ -116,7 +153,7 @@ XyMeasure MeasureLikeSimulator(std::span<const double> x, std::span<const double
       vs += v;
     }
     for (int i = start + 1; i + 1 < start + kBlock; ++i) {
-      ks += Menger(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
+      ks += MengerCurvature(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
     }
     const double vm = vs / kBlock, km = ks / 8.0;
     const double a = std::hypot((vm - v_prev_mean) / (kBlock * kDt), vm * vm * km);
@@ -125,7 +162,8 @@ XyMeasure MeasureLikeSimulator(std::span<const double> x, std::span<const double
     a_acc += a;
     if (++a_count == kJerkBlocks) {
       const double mean = a_acc / kJerkBlocks;
-      m.max_jerk = std::max(m.max_jerk, std::abs(mean - a_prev_mean) / (kJerkBlocks * kBlock * kDt));
+      m.max_jerk =
+          std::max(m.max_jerk, std::abs(mean - a_prev_mean) / (kJerkBlocks * kBlock * kDt));
       a_prev_mean = mean;
       a_acc = 0;
       a_count = 0;

@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -765,6 +766,37 @@ TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
   EXPECT_TRUE(none({{240, 6.0, 15.0}}));                                      // no leader
   EXPECT_TRUE(none({{215, 6.0, 15.0}, {230, 6.0, 12.0}}));                    // within 20 m
   EXPECT_TRUE(none({{240, 6.0, 6.0}, {250, 6.0, 4.0}}));                      // under 15 mph
+}
+
+TEST(FeasibilityTest, CurvaturesOfAPathAreEachTriplesBitForBit) {
+  // A wavy path with repeated points (a leg of no length), reversals, a zero chord, a point
+  // far off and NaN: the run (two triples at a time) gives each triple's value exactly, from
+  // an odd and an even first index.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> step(-0.4, 0.6);
+  std::vector<double> x(301), y(301);
+  for (int i = 1; i <= 300; ++i) {
+    x[i] = x[i - 1] + 0.3 + step(rng);
+    y[i] = y[i - 1] + 0.2 * step(rng);
+  }
+  x[40] = x[39], y[40] = y[39];   // no length
+  x[80] = x[78], y[80] = y[78];   // back where it was: a zero chord
+  x[120] = x[119] - 0.5;          // a reversal along x
+  y[120] = y[119];
+  y[118] = y[119];
+  x[200] = 1e7;                    // far off
+  y[250] = std::nan("");
+  for (const int first : {1, 2, 37}) {
+    std::vector<double> run(301, -1.0);
+    MengerCurvatures(x.data(), y.data(), first, 301, run.data());
+    for (int i = first; i < 300; ++i) {
+      const double one = MengerCurvature(x[i - 1], y[i - 1], x[i], y[i], x[i + 1], y[i + 1]);
+      EXPECT_EQ(std::memcmp(&run[i], &one, sizeof(double)), 0) << "triple " << i;
+    }
+    EXPECT_EQ(run[300], -1.0) << "the last point has no triple";
+  }
+  EXPECT_EQ(MengerCurvature(0, 0, 0, 0, 1, 0), 0.0);
+  EXPECT_EQ(MengerCurvature(0, 0, 1, 0, 0, 0), 1e6);
 }
 
 TEST(FeasibilityTest, MeasureWithAPrefixEqualsTheWholeMeasure) {

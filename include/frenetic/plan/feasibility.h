@@ -16,6 +16,13 @@ struct XyLimits {
   double max_jerk = 9.0;      // m/s^3
 };
 
+// The Menger curvature of three points as the simulator computes it, 2 sin(theta) / |p3 - p1|
+// (0 when a leg has no length, 1e6 for a reversal or a zero chord), and the same of every
+// triple (i - 1, i, i + 1) for i in [first, n - 1) into kappa[i]: bit for bit the same values
+// (two triples at a time where SSE2 is there).
+double MengerCurvature(double x1, double y1, double x2, double y2, double x3, double y3);
+void MengerCurvatures(const double* x, const double* y, int first, int n, double* kappa);
+
 // Worst values found (m/s, m/s^2, m/s^3).
 struct XyMeasure {
   double max_speed = 0, max_accel = 0, max_jerk = 0;
