@@ -255,13 +255,11 @@ void BM_ScoreSweep(benchmark::State& state) {
   for (auto _ : state) {
     for (int j = 0; j < n_lat; ++j) {
       cost::FillNearMasks(b.lat_d.data() + j * kSamples, kSamples, vehicles, cost::kNearLateral,
-                          [&](int c, int k) { return tr.d_at[c * kSamples + k]; },
-                          near_lat.data() + 2 * j * kSamples);
+                          tr.d_at.data(), kSamples, near_lat.data() + 2 * j * kSamples);
     }
     for (int i = 0; i < n_lon; ++i) {
       cost::FillNearMasks(b.lon_s.data() + i * kSamples, kSamples, vehicles,
-                          cost::kNearLongitudinal,
-                          [&](int c, int k) { return tr.s[c * kSamples + k]; },
+                          cost::kNearLongitudinal, tr.s.data(), kSamples,
                           near_lon.data() + 2 * i * kSamples);
     }
     for (int i = 0; i < n_lon; ++i) {

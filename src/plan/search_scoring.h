@@ -17,14 +17,12 @@ namespace frenetic::plan::search {
 // Broad phase of the cost terms (cost::CostInput::near_lat, near_lon): which of the context's
 // cars are within each reach of d[k] (near[0..n) and near[n..2n)), and of s[k]; n = n_samples.
 inline void NearLat(const Workspace& ws, const double* d, std::uint64_t* near) {
-  cost::FillNearMasks(
-      d, ws.n_samples, ws.ctx.num_cars, cost::kNearLateral,
-      [&ws](int c, int k) { return ws.car_d[c * ws.n_samples + k]; }, near);
+  cost::FillNearMasks(d, ws.n_samples, ws.ctx.num_cars, cost::kNearLateral, ws.car_d.data(),
+                      ws.n_samples, near);
 }
 inline void NearLon(const Workspace& ws, const double* s, std::uint64_t* near) {
-  cost::FillNearMasks(
-      s, ws.n_samples, ws.ctx.num_cars, cost::kNearLongitudinal,
-      [&ws](int c, int k) { return ws.car_s[c * ws.n_samples + k]; }, near);
+  cost::FillNearMasks(s, ws.n_samples, ws.ctx.num_cars, cost::kNearLongitudinal,
+                      ws.car_s.data(), ws.n_samples, near);
 }
 // Points a cost input at a trajectory's masks (each 2 * n_samples words, as Near* fill them).
 inline void SetNear(const Workspace& ws, cost::CostInput& in, const std::uint64_t* lat,

@@ -1,5 +1,6 @@
 // Every registered cost term through the same property checks, and the registry against
 // config/planner.yaml.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -195,6 +196,37 @@ TEST_P(CostContractTest, BroadPhaseMasksDoNotChangeTheValue) {
 
 // A term that says it reads only the target lane (LaneOnly) gives the same value for any other
 // input bound for that lane: the planner keeps one value per lane and cycle.
+// The masks bit by bit as their definition reads: |car - x| < reach, NaN never near, for
+// every sample count (the last samples of a block too) and up to 64 cars (more are left out).
+TEST(NearMasksTest, EveryBitIsTheDistanceTest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> pos(-80.0, 80.0);
+  for (const int n : {1, 3, 4, 7, 61}) {
+    for (const int num_cars : {0, 1, 5, 64, 70}) {
+      std::vector<double> x(n), cars(static_cast<std::size_t>(num_cars) * n);
+      for (double& v : x) v = pos(rng);
+      for (double& v : cars) v = pos(rng);
+      if (num_cars > 2 && n > 2) {
+        cars[2 * n + 1] = std::nan("");
+        x[n - 1] = std::nan("");
+        cars[n] = x[0] + kNearLongitudinal[0];  // exactly at the reach: not near
+      }
+      std::vector<std::uint64_t> near(2 * n, ~std::uint64_t{0});
+      FillNearMasks(x.data(), n, num_cars, kNearLongitudinal, cars.data(), n, near.data());
+      for (int k = 0; k < n; ++k) {
+        for (int m = 0; m < 2; ++m) {
+          std::uint64_t want = 0;
+          for (int c = 0; c < std::min(num_cars, 64); ++c) {
+            const bool in = std::abs(cars[c * n + k] - x[k]) < kNearLongitudinal[m];
+            want |= in ? std::uint64_t{1} << c : 0;
+          }
+          EXPECT_EQ(near[m * n + k], want) << "n " << n << " cars " << num_cars << " k " << k;
+        }
+      }
+    }
+  }
+}
+
 TEST(CostRegistryTest, LaneOnlyTermsReadNothingButTheTargetLane) {
   int lane_only = 0;
   for (const std::string& name : CostRegistry::Global().Names()) {

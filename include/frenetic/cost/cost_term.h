@@ -8,11 +8,15 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace frenetic::cost {
 
@@ -147,17 +151,45 @@ inline constexpr double kNearLateral[2] = {3.2, 4.5};
 inline constexpr double kNearLongitudinal[2] = {8.0, 60.0};
 
 // Builds one trajectory's pair of broad-phase masks (CostInput::near_lat or near_lon): bit c of
-// near[k] (of near[n + k]) is set when |car_at(c, k) - x[k]| < reach[0] (reach[1]), for cars
-// c < num_cars <= 64, with x the trajectory's d (or s) at the n samples. Car-major, so that the
-// inner loop over samples vectorises.
-template <typename CarAt>
-void FillNearMasks(const double* x, int n, int num_cars, const double reach[2], CarAt car_at,
-                   std::uint64_t* near) {
-  std::fill(near, near + 2 * n, std::uint64_t{0});
-  for (int c = 0; c < num_cars && c < 64; ++c) {
+// near[k] (of near[n + k]) is set when |cars[c * stride + k] - x[k]| < reach[0] (reach[1]),
+// for cars c < num_cars <= 64, with x the trajectory's d (or s) at the n samples and cars the
+// cars' rows of d (or s) at the same samples. Four samples at a time, car by car, the masks in
+// registers until every car is in (SSE2 where it is there).
+inline void FillNearMasks(const double* x, int n, int num_cars, const double reach[2],
+                          const double* cars, int stride, std::uint64_t* near) {
+  const int count = std::min(num_cars, 64);
+  int k0 = 0;
+#if defined(__SSE2__)
+  const __m128d r0 = _mm_set1_pd(reach[0]), r1 = _mm_set1_pd(reach[1]);
+  const __m128d sign = _mm_set1_pd(-0.0);
+  for (; k0 + 4 <= n; k0 += 4) {
+    const __m128d xa = _mm_loadu_pd(x + k0), xb = _mm_loadu_pd(x + k0 + 2);
+    __m128i a0 = _mm_setzero_si128(), b0 = a0, a1 = a0, b1 = a0;
+    for (int c = 0; c < count; ++c) {
+      const __m128i bit = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << c));
+      const double* row = cars + static_cast<std::ptrdiff_t>(c) * stride + k0;
+      // |car - x| < reach: the same comparison, lane by lane (NaN compares false).
+      const __m128d da = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row), xa));
+      const __m128d db = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row + 2), xb));
+      a0 = _mm_or_si128(a0, _mm_and_si128(_mm_castpd_si128(_mm_cmplt_pd(da, r0)), bit));
+      b0 = _mm_or_si128(b0, _mm_and_si128(_mm_castpd_si128(_mm_cmplt_pd(db, r0)), bit));
+      a1 = _mm_or_si128(a1, _mm_and_si128(_mm_castpd_si128(_mm_cmplt_pd(da, r1)), bit));
+      b1 = _mm_or_si128(b1, _mm_and_si128(_mm_castpd_si128(_mm_cmplt_pd(db, r1)), bit));
+    }
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(near + k0), a0);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(near + k0 + 2), b0);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(near + n + k0), a1);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(near + n + k0 + 2), b1);
+  }
+#endif
+  // The rest (the last samples), car-major.
+  std::fill(near + k0, near + n, std::uint64_t{0});
+  std::fill(near + n + k0, near + 2 * n, std::uint64_t{0});
+  for (int c = 0; c < count; ++c) {
     const std::uint64_t bit = std::uint64_t{1} << c;
-    for (int k = 0; k < n; ++k) {
-      const double dist = std::abs(car_at(c, k) - x[k]);
+    const double* row = cars + static_cast<std::ptrdiff_t>(c) * stride;
+    for (int k = k0; k < n; ++k) {
+      const double dist = std::abs(row[k] - x[k]);
       near[k] |= dist < reach[0] ? bit : 0;
       near[n + k] |= dist < reach[1] ? bit : 0;
     }
