@@ -1,10 +1,51 @@
 #include "plan/search_checks.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace frenetic::plan::search {
+namespace {
+
+// m[j] for j in [1, n]: bit c set unless |cars[c * w + j] - x[j]| > reach[j] (NaN passes), for
+// cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2 registers until
+// every car is in; the rest car by car over the last steps.
+void ReachMasks(const double* x, const double* reach, const double* cars, int w, int n,
+                int num_cars, std::uint64_t* m) {
+  int j = 1;
+#if defined(__SSE2__)
+  const __m128d sign = _mm_set1_pd(-0.0);
+  for (; j + 3 <= n; j += 4) {
+    const __m128d xa = _mm_loadu_pd(x + j), xb = _mm_loadu_pd(x + j + 2);
+    const __m128d ra = _mm_loadu_pd(reach + j), rb = _mm_loadu_pd(reach + j + 2);
+    __m128i a = _mm_setzero_si128(), b = a;
+    for (int car = 0; car < num_cars; ++car) {
+      const __m128i bit = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << car));
+      const double* row = cars + static_cast<std::ptrdiff_t>(car) * w + j;
+      const __m128d da = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row), xa));
+      const __m128d db = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row + 2), xb));
+      // !(|d| > reach): the same test, lane by lane (NaN passes).
+      a = _mm_or_si128(a, _mm_and_si128(_mm_castpd_si128(_mm_cmpngt_pd(da, ra)), bit));
+      b = _mm_or_si128(b, _mm_and_si128(_mm_castpd_si128(_mm_cmpngt_pd(db, rb)), bit));
+    }
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(m + j), a);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(m + j + 2), b);
+  }
+#endif
+  const int j0 = j;
+  for (; j <= n; ++j) m[j] = 0;
+  for (int car = 0; car < num_cars; ++car) {
+    const double* row = cars + static_cast<std::ptrdiff_t>(car) * w;
+    const std::uint64_t bit = std::uint64_t{1} << car;
+    for (j = j0; j <= n; ++j) m[j] |= std::abs(row[j] - x[j]) > reach[j] ? 0 : bit;
+  }
+}
+
+}  // namespace
 
 Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
     : cfg_(cfg),
@@ -26,6 +67,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_.assign(n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
   reach_.assign(w, 0.0);
+  lat_reach_.assign(w, 5.0);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
@@ -72,32 +114,20 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
   // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
   const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_key_, lon_have_, lon_s_, lon_sd_);
   LonNearKey& lk = lon_near_key_[i];
-  // Car by car over contiguous steps (the inner loops vectorise); no branch on which cars pass.
+  // No branch on which cars pass (ReachMasks).
   if (new_lon || lk.stamp != ws_.traffic_stamp || lk.margin_scale != margin_scale ||
       lk.behind_scale != behind_scale) {
-    std::uint64_t* m = &lon_near_[i * w];
-    const double* s = &lon_s_[i * w];
     for (int j = 1; j <= ws_.n_steps; ++j) {
       reach_[j] = ReachS(lon_sd_[i * w + j], margin_scale, behind_scale);
-      m[j] = 0;
     }
-    for (int car = 0; car < num_cars; ++car) {
-      const double* cs = &ws_.step_s[car * w];
-      const std::uint64_t bit = std::uint64_t{1} << car;
-      for (int j = 1; j <= ws_.n_steps; ++j) m[j] |= std::abs(cs[j] - s[j]) > reach_[j] ? 0 : bit;
-    }
+    ReachMasks(&lon_s_[i * w], reach_.data(), ws_.step_s.data(), w, ws_.n_steps, num_cars,
+               &lon_near_[i * w]);
     lk = {ws_.traffic_stamp, margin_scale, behind_scale};
   }
   const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
   if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
-    std::uint64_t* m = &lat_near_[k * w];
-    const double* d = &lat_d_[k * w];
-    for (int j = 1; j <= ws_.n_steps; ++j) m[j] = 0;
-    for (int car = 0; car < num_cars; ++car) {
-      const double* cd = &ws_.step_d[car * w];
-      const std::uint64_t bit = std::uint64_t{1} << car;
-      for (int j = 1; j <= ws_.n_steps; ++j) m[j] |= std::abs(cd[j] - d[j]) > 5 ? 0 : bit;
-    }
+    ReachMasks(&lat_d_[k * w], lat_reach_.data(), ws_.step_d.data(), w, ws_.n_steps, num_cars,
+               &lat_near_[k * w]);
     lat_near_stamp_[k] = ws_.traffic_stamp;
   }
   return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,

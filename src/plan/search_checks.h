@@ -219,7 +219,8 @@ class Checker {
     double margin_scale = 0, behind_scale = 0;
   };
   std::vector<std::uint64_t> lon_near_, lat_near_;
-  std::vector<double> reach_;  // StepsOf: the lon reach at each step
+  std::vector<double> reach_;      // StepsOf: the lon reach at each step
+  std::vector<double> lat_reach_;  // StepsOf: the lat reach (5 m) at each step
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_

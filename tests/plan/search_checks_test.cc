@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 #include "plan/search_stages_testing.h"
@@ -140,6 +143,48 @@ TEST(SearchChecksTest, BreaksLimitsAgreesWithTheFullViolation) {
   EXPECT_GT(broken, total / 10);
   EXPECT_LT(broken, total);
   EXPECT_GT(cut_short_then_full, 0);
+}
+
+// StepsOf's reach masks bit by bit as FirstCollision's reach tests read (a car is kept unless
+// it is farther than the reach along s or 5 m along d; NaN is kept), over a whole lattice in
+// traffic, at both margin scales; and the first collision with them is the one without.
+TEST(SearchChecksTest, StepsReachMasksAreTheReachTests) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> ahead(-40.0, 70.0), speed(5.0, 24.0);
+  std::vector<testing::SceneCar> cars;
+  for (int k = 0; k < 14; ++k) {
+    cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
+  }
+  st.Prepare({kS, 18, 0, st.ws.lane_center[1], 0, 0}, cars);
+  st.lattice.Generate();
+  const int n_cand = static_cast<int>(st.ws.cand_lon.size());
+  ASSERT_GT(n_cand, 500);
+  const int w = st.ws.n_steps + 1;
+  int near_bits = 0;
+  for (const double scale : {1.0, 0.0}) {
+    for (int c = 0; c < n_cand; c += 7) {
+      const StepStates steps = st.checker.StepsOf(c, scale, 1.0);
+      for (int j = 1; j <= st.ws.n_steps; ++j) {
+        const traj::FrenetState e = steps(j * st.ws.collision_step);
+        const double reach = st.checker.ReachS(e.s_d, scale, 1.0);
+        std::uint64_t want = 0;
+        for (int car = 0; car < std::min(st.ws.num_check_cars, 64); ++car) {
+          const bool far = std::abs(st.ws.step_s[car * w + j] - e.s) > reach ||
+                           std::abs(st.ws.step_d[car * w + j] - e.d) > 5;
+          want |= far ? 0 : std::uint64_t{1} << car;
+        }
+        ASSERT_EQ(steps.Near(j), want) << "candidate " << c << " step " << j;
+        near_bits += std::popcount(want);
+      }
+      const auto plain = [&steps](int tick) { return steps(tick); };  // no masks: every car
+      EXPECT_EQ(st.checker.FirstCollision(steps, scale, 1.0),
+                st.checker.FirstCollision(plain, scale, 1.0))
+          << "candidate " << c;
+    }
+  }
+  EXPECT_GT(near_bits, 1000) << "the scene has cars within reach";
 }
 
 TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
