@@ -13,7 +13,10 @@ namespace {
 
 // m[j] for j in [1, n]: bit c set unless |cars[c * w + j] - x[j]| > reach[j] (NaN passes), for
 // cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2 registers until
-// every car is in; the rest car by car over the last steps.
+// every car is in; the rest car by car over the last steps. The scoring's
+// cost::FillNearMasks is built the same way but is not this test: a reach per step here
+// (FirstCollision's, from the step's speed), and a car at a NaN distance is kept (HitsAt then
+// decides), where a broad-phase mask leaves it out.
 void ReachMasks(const double* x, const double* reach, const double* cars, int w, int n,
                 int num_cars, std::uint64_t* m) {
   int j = 1;
