@@ -38,15 +38,19 @@ int ReferenceLine::Impl::NearestGlobal(double px, double py) const {
   // the nearest one: a sample j is within kStride/2 samples (arc) of a coarse one, so its coarse
   // neighbour is at most kStride/2 * step farther than j itself.
   constexpr int kStride = 8;
+  // The coarse samples: every kStride-th, and an open line's last one.
+  const int count = SampleCount();
+  const int last_coarse = closed ? -1 : n;
   double best = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < n; i += kStride) best = std::min(best, Dist2(i, px, py));
+  for (int i = 0; i < count; i += kStride) best = std::min(best, Dist2(i, px, py));
+  if (last_coarse >= 0) best = std::min(best, Dist2(last_coarse, px, py));
   const double margin = (kStride / 2 + 1) * step;
   const double limit = std::sqrt(best) + margin;
   const double limit2 = limit * limit;
   int best_i = 0;
   double best_d2 = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < n; i += kStride) {
-    if (Dist2(i, px, py) > limit2) continue;
+  auto refine = [&](int i) {
+    if (Dist2(i, px, py) > limit2) return;
     for (int o = -kStride / 2 - 1; o <= kStride / 2 + 1; ++o) {
       const int j = Wrap(i + o);
       const double d2 = Dist2(j, px, py);
@@ -55,7 +59,9 @@ int ReferenceLine::Impl::NearestGlobal(double px, double py) const {
         best_i = j;
       }
     }
-  }
+  };
+  for (int i = 0; i < count; i += kStride) refine(i);
+  if (last_coarse >= 0) refine(last_coarse);
   return best_i;
 }
 
@@ -83,6 +89,19 @@ int ReferenceLine::Impl::NearestLocal(double px, double py, int start, bool* ok)
 }
 
 FrenetPoint ReferenceLine::Impl::Project(double px, double py, int nearest) const {
+  // An open line continues straight beyond its ends.
+  if (!closed && (nearest == 0 || nearest == n)) {
+    const int e = nearest;
+    const double along = (px - x[e]) * tx[e] + (py - y[e]) * ty[e];
+    if ((e == 0 && along <= 0) || (e == n && along >= 0)) {
+      FrenetPoint out;
+      out.s = (e == 0 ? 0.0 : length) + along;
+      out.d = (px - x[e]) * ty[e] - (py - y[e]) * tx[e];
+      return out;
+    }
+  }
+  const double sigma_lo = closed ? -std::numeric_limits<double>::infinity() : 0.0;
+  const double sigma_hi = closed ? std::numeric_limits<double>::infinity() : n;
   // f(sigma) = (p - C) . t is positive while the foot of p lies ahead of C. Bracket a sign change
   // around the nearest sample, then safeguarded Newton (bisection when Newton leaves the bracket).
   auto f_of = [&](double sigma, Eval* out) {
@@ -98,6 +117,10 @@ FrenetPoint ReferenceLine::Impl::Project(double px, double py, int nearest) cons
     const double c = e.c, s = e.s;
     FrenetPoint out;
     out.d = (px - e.x) * s - (py - e.y) * c;
+    if (!closed) {
+      out.s = sigma * step;
+      return out;
+    }
     double sw = std::fmod(sigma * step, length);
     if (sw < 0) sw += length;
     if (sw >= length) sw = 0;
@@ -116,21 +139,21 @@ FrenetPoint ReferenceLine::Impl::Project(double px, double py, int nearest) cons
       const double fp = -(e.dx * c + e.dy * s) - e.dth * ((px - e.x) * s - (py - e.y) * c);
       if (!(fp < 0)) break;
       sigma -= f / fp * inv_step;
-      if (std::abs(sigma - nearest) > 1.0) break;
+      if (std::abs(sigma - nearest) > 1.0 || !(sigma >= sigma_lo && sigma <= sigma_hi)) break;
     }
   }
-  double lo = nearest - 1.0, hi = nearest + 1.0;
+  double lo = std::max(nearest - 1.0, sigma_lo), hi = std::min(nearest + 1.0, sigma_hi);
   double flo = f_of(lo, nullptr), fhi = f_of(hi, nullptr);
-  for (int ext = 0; ext < 8 && flo < 0; ++ext) {
+  for (int ext = 0; ext < 8 && flo < 0 && lo > sigma_lo; ++ext) {
     hi = lo;
     fhi = flo;
-    lo -= 1.0;
+    lo = std::max(lo - 1.0, sigma_lo);
     flo = f_of(lo, nullptr);
   }
-  for (int ext = 0; ext < 8 && fhi > 0; ++ext) {
+  for (int ext = 0; ext < 8 && fhi > 0 && hi < sigma_hi; ++ext) {
     lo = hi;
     flo = fhi;
-    hi += 1.0;
+    hi = std::min(hi + 1.0, sigma_hi);
     fhi = f_of(hi, nullptr);
   }
   double sigma = nearest;
@@ -174,7 +197,10 @@ ReferenceLine::~ReferenceLine() = default;
 
 double ReferenceLine::length() const { return impl_->length; }
 
+bool ReferenceLine::closed() const { return impl_->closed; }
+
 double ReferenceLine::WrapS(double s) const {
+  if (!impl_->closed) return std::isfinite(s) ? s : 0.0;
   const double len = impl_->length;
   if (s >= 0 && s < len) return s;  // the common case, without fmod
   if (!std::isfinite(s)) return 0;
@@ -185,6 +211,7 @@ double ReferenceLine::WrapS(double s) const {
 }
 
 double ReferenceLine::DiffS(double s_to, double s_from) const {
+  if (!impl_->closed) return s_to - s_from;
   const double len = impl_->length;
   double d = WrapS(s_to - s_from);  // [0, L)
   if (d >= 0.5 * len) d -= len;
@@ -193,6 +220,15 @@ double ReferenceLine::DiffS(double s_to, double s_from) const {
 
 CartesianPose ReferenceLine::ToCartesian(double s, double d) const {
   const Impl& m = *impl_;
+  if (const int e = m.EndBeyond(s); e >= 0) {  // an open line's straight continuation
+    const CentrePoint cp = Centre(s);
+    CartesianPose p;
+    p.x = cp.OffsetX(d);
+    p.y = cp.OffsetY(d);
+    p.heading = WrapAngle(m.th[e]);
+    p.kappa = 0;
+    return p;
+  }
   const double sigma = WrapS(s) * m.inv_step;
   int i = static_cast<int>(sigma);
   if (i >= m.n) i = m.n - 1;
@@ -219,6 +255,10 @@ CartesianPose ReferenceLine::ToCartesian(double s, double d) const {
 
 CentrePoint ReferenceLine::Centre(double s) const {
   const Impl& m = *impl_;
+  if (const int e = m.EndBeyond(s); e >= 0) {
+    const double ds = e == 0 ? s : s - m.length;
+    return {m.x[e] + ds * m.tx[e], m.y[e] + ds * m.ty[e], m.tx[e], m.ty[e]};
+  }
   const double sigma = WrapS(s) * m.inv_step;
   int i = static_cast<int>(sigma);
   if (i >= m.n) i = m.n - 1;
@@ -235,8 +275,9 @@ FrenetPoint ReferenceLine::ToFrenet(double x, double y, double s_hint) const {
   if (!std::isfinite(x) || !std::isfinite(y)) return FrenetPoint{0, 0};
   if (!std::isfinite(s_hint)) return ToFrenet(x, y);
   const Impl& m = *impl_;
-  int start = static_cast<int>(WrapS(s_hint) * m.inv_step);
-  if (start >= m.n) start = m.n - 1;
+  const double sigma_hint = std::clamp(WrapS(s_hint) * m.inv_step, 0.0, static_cast<double>(m.n));
+  int start = static_cast<int>(sigma_hint);
+  if (start >= m.n && m.closed) start = m.n - 1;
   bool ok = false;
   const int nearest = m.NearestLocal(x, y, start, &ok);
   if (!ok) return ToFrenet(x, y);
@@ -275,6 +316,15 @@ ReferenceLine::OffsetRange ReferenceLine::ChordOffset(double s_from, double s_to
 
 RefSample ReferenceLine::At(double s) const {
   const Impl& m = *impl_;
+  if (const int e = m.EndBeyond(s); e >= 0) {
+    const CentrePoint cp = Centre(s);
+    RefSample r;
+    r.s = s;
+    r.x = cp.x;
+    r.y = cp.y;
+    r.heading = WrapAngle(m.th[e]);
+    return r;
+  }
   const double sw = WrapS(s);
   const double sigma = sw * m.inv_step;
   int i = static_cast<int>(sigma);

@@ -37,6 +37,13 @@ constexpr double kTargetDistance = 0.22;
 constexpr double kMaxReweight = 2.0;
 // Likewise spans whose change of curvature exceeds this (1/m^2) get more smoothness weight.
 constexpr double kTargetDkappa = 1.4e-4;
+// FitOpen: points closer than this are one; the polyline is resampled every kOpenSpacing m and
+// extended straight by at least kOpenExtension m at each end, along the direction of its last
+// kOpenEndProbe m.
+constexpr double kOpenMinSpacing = 1e-3;
+constexpr double kOpenSpacing = 2.0;
+constexpr double kOpenExtension = 30.0;
+constexpr double kOpenEndProbe = 5.0;
 
 // Polynomial coefficients (in local t in [0,1)) of the six uniform quintic B-spline weights of a
 // span, from the truncated-power form of the cardinal B-spline.
@@ -113,21 +120,34 @@ class LinearResidual : public ceres::SizedCostFunction<2, 2, 2, 2, 2, 2, 2> {
 };
 
 // The fitted spline: evaluation of position and derivatives w.r.t. the parameter u in [0, N).
+// Periodic (closed: N control points indexed modulo N, u in [0, N)) or open (N spans, u in
+// [0, N], N + 5 control points: span j is shaped by points j..j + 5, none repeated).
 struct Spline {
   std::vector<double> px, py;  // control points
+  bool closed = true;
   int n() const { return static_cast<int>(px.size()); }
-  // Derivative `order` of the curve at u (wrapped).
+  int spans() const { return closed ? n() : n() - kDegree; }
+  // The control point that weight k of span j multiplies.
+  int Index(long j, int k) const {
+    const long nn = n();
+    return closed ? static_cast<int>(((j + k - 2) % nn + nn) % nn) : static_cast<int>(j + k);
+  }
+  // Derivative `order` of the curve at u (wrapped; an open one's u clamped to its spans).
   void Eval(double u, int order, double* x, double* y) const {
     const int nn = n();
     double fl = std::floor(u);
+    if (!closed) fl = std::clamp(fl, 0.0, spans() - 1.0);  // the last span includes u = N
     double t = u - fl;
-    long j = static_cast<long>(fl) % nn;
-    if (j < 0) j += nn;
+    long j = static_cast<long>(fl);
+    if (closed) {
+      j %= nn;
+      if (j < 0) j += nn;
+    }
     double w[kOrder];
     Basis().Weights(t, order, w);
     double sx = 0, sy = 0;
     for (int k = 0; k < kOrder; ++k) {
-      const int idx = static_cast<int>(((j + k - 2) % nn + nn) % nn);
+      const int idx = Index(j, k);
       sx += w[k] * px[idx];
       sy += w[k] * py[idx];
     }
@@ -184,34 +204,43 @@ Status ReferenceLine::Options::Validate() const {
   return Status::Ok();
 }
 
-StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& track,
-                                                                  const Options& options) {
+// The fit of Fit (closed: the track's loop) and FitOpen (open: `open` says which waypoints are
+// the line's own, the others being its straight extensions).
+StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::FitLine(const Track& track,
+                                                                      const Options& options,
+                                                                      const OpenRange* open) {
   if (Status st = options.Validate(); !st.ok()) return st;
+  const bool closed = open == nullptr;
   const auto& wps = track.waypoints;
   const int nw = static_cast<int>(wps.size());
   const std::string src = track.source.empty() ? std::string("track") : track.source;
   if (nw < 4) return Status::Error(src + ": need at least 4 waypoints to fit a reference line");
   const double s0 = wps.front().s;
-  const double period = track.max_s - s0;
-  if (!std::isfinite(period) || !(track.max_s > wps.back().s)) {
+  // Closed: the loop's length; open: the parameter range's (the last waypoint's s).
+  const double period = closed ? track.max_s - s0 : wps.back().s - s0;
+  if (closed && (!std::isfinite(period) || !(track.max_s > wps.back().s))) {
     return Status::Error(src + ": max_s must be greater than the last waypoint's s");
   }
 
-  // Control points: one every ~control_spacing m.
-  const int nc =
+  // Control points: one every ~control_spacing m (spans; an open line has kDegree more).
+  const int spans =
       std::max(kMinControlPoints, static_cast<int>(std::lround(period / options.control_spacing)));
-  const double h = period / nc;  // metres of map s per unit of u
+  const int nc = closed ? spans : spans + kDegree;
+  const double h = period / spans;  // metres of map s per unit of u
+  const double u_max = spans;       // u in [0, u_max)
   Spline sp;
+  sp.closed = closed;
   sp.px.resize(nc);
   sp.py.resize(nc);
   {
-    // Initial guess: the waypoint polyline at map s = m h (control point m is centred at u = m).
+    // Initial guess: the waypoint polyline at map s = m h (control point m is centred at u = m;
+    // an open line's at u = m - 2.5, within its ends).
     int seg = 0;
     for (int m = 0; m < nc; ++m) {
-      const double s = m * h;
+      const double s = closed ? m * h : std::clamp((m - 2.5) * h, 0.0, period);
       while (seg + 1 < nw && wps[seg + 1].s - s0 <= s) ++seg;
       const Waypoint& a = wps[seg];
-      const Waypoint& b = wps[(seg + 1) % nw];
+      const Waypoint& b = wps[closed ? (seg + 1) % nw : std::min(seg + 1, nw - 1)];
       const double sa = a.s - s0, sb = (seg + 1 < nw) ? b.s - s0 : period;
       const double f = std::clamp((s - sa) / std::max(sb - sa, 1e-9), 0.0, 1.0);
       sp.px[m] = a.x + f * (b.x - a.x);
@@ -231,14 +260,16 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
     params[2 * m + 1] = sp.py[m];
   }
   auto blocks_for = [&](double u, double* w, int order, std::vector<double*>* blocks) {
-    const double fl = std::floor(u);
-    long j = static_cast<long>(fl) % nc;
-    if (j < 0) j += nc;
+    double fl = std::floor(u);
+    if (!closed) fl = std::clamp(fl, 0.0, spans - 1.0);
+    long j = static_cast<long>(fl);
+    if (closed) {
+      j %= nc;
+      if (j < 0) j += nc;
+    }
     Basis().Weights(u - fl, order, w);
     blocks->clear();
-    for (int k = 0; k < kOrder; ++k) {
-      blocks->push_back(&params[2 * (((j + k - 2) % nc + nc) % nc)]);
-    }
+    for (int k = 0; k < kOrder; ++k) blocks->push_back(&params[2 * sp.Index(j, k)]);
   };
   const double lambda = options.smoothness_weight * kSmoothnessScale;
   std::vector<double> data_weight(nw, 1.0);
@@ -256,7 +287,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
     if (lambda > 0) {
       constexpr std::array<double, 3> kGx = {0.112701665379258, 0.5, 0.887298334620742};
       constexpr std::array<double, 3> kGw = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-      for (int j = 0; j < nc; ++j) {
+      for (int j = 0; j < spans; ++j) {
         for (int q = 0; q < 3; ++q) {
           blocks_for(j + kGx[q], w, 3, &blocks);
           const double scale = std::sqrt(lambda * span_weight[j] * kGw[q] * h) / (h * h * h);
@@ -284,7 +315,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
     }
     if (pass == kParameterCorrections) break;
     if (lambda > 0) {
-      for (int j = 0; j < nc; ++j) {
+      for (int j = 0; j < spans; ++j) {
         double worst = 0;
         for (double t : {0.0, 0.25, 0.5, 0.75})
           worst = std::max(worst, std::abs(sp.DKappaDs(j + t)));
@@ -315,7 +346,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
       if (i == 0) continue;
       // Keep the waypoints in order and inside the loop's parameter range.
       const double lo = wp_u[i - 1] + 1e-3;
-      const double hi = (i + 1 < nw ? wp_u[i + 1] : static_cast<double>(nc)) - 1e-3;
+      const double hi = (i + 1 < nw ? wp_u[i + 1] : u_max) - 1e-3;
       wp_u[i] = std::clamp(u, lo, std::max(lo, hi));
     }
   }
@@ -323,37 +354,43 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
                 src, nc, summary.iterations.size(), summary.initial_cost, summary.final_cost);
 
   // Arc length of every span (u in [j, j+1)).
-  std::vector<double> cum(nc + 1, 0.0);
-  for (int j = 0; j < nc; ++j) {
+  std::vector<double> cum(spans + 1, 0.0);
+  for (int j = 0; j < spans; ++j) {
     const double half = 0.5;  // two Gauss panels per span: spans are ~10 m of nearly-constant speed
     cum[j + 1] = cum[j] + ArcLength(sp, j, j + half) + ArcLength(sp, j + half, j + 1);
   }
-  const double length = cum[nc];
-  for (int j = 0; j < nc; ++j) {
+  for (int j = 0; j < spans; ++j) {
     if (!(cum[j + 1] - cum[j] > 1e-6)) {
       return Status::Error(src + ": reference line fit is degenerate (zero-length span)");
     }
   }
   auto arc_to = [&](double u) {
-    const int j = std::clamp(static_cast<int>(std::floor(u)), 0, nc - 1);
+    const int j = std::clamp(static_cast<int>(std::floor(u)), 0, spans - 1);
     return cum[j] + ArcLength(sp, j, u);
   };
+  // The line's s = 0 and its length: the loop's, or the open line's own waypoints' (the
+  // extensions are left to the straight continuation beyond the ends).
+  const double arc0 = closed ? 0.0 : arc_to(wp_u[open->first]);
+  const double length = closed ? cum[spans] : arc_to(wp_u[open->last]) - arc0;
+  if (!(length > 1e-3)) return Status::Error(src + ": reference line fit is degenerate (no length)");
 
   auto impl = std::make_unique<Impl>();
+  impl->closed = closed;
   impl->length = length;
   const int n = std::max(8, static_cast<int>(std::ceil(length / options.sample_step)));
   impl->n = n;
   impl->step = length / n;
   impl->inv_step = 1.0 / impl->step;
-  impl->samples.resize(n);
-  double u = 0;
-  for (int i = 0; i < n; ++i) {
-    const double s = i * impl->step;
+  const int count = closed ? n : n + 1;  // an open line's last sample is its end
+  impl->samples.resize(count);
+  double u = closed ? 0.0 : wp_u[open->first];
+  for (int i = 0; i < count; ++i) {
+    const double s = arc0 + i * impl->step;
     // Newton on arc(u) = s, starting from the previous sample's u.
     for (int it = 0; it < 20; ++it) {
       const double err = arc_to(u) - s;
       const double du = err / sp.Speed(u);
-      u = std::clamp(u - du, 0.0, static_cast<double>(nc) - 1e-12);
+      u = std::clamp(u - du, 0.0, u_max - 1e-12);
       if (std::abs(err) < 1e-10) break;
     }
     double x, y, x1, y1, x2, y2, x3, y3;
@@ -367,7 +404,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
     const double dc = x1 * y3 - y1 * x3;
     const double dv = (x1 * x2 + y1 * y2) / v;
     RefSample& r = impl->samples[i];
-    r.s = s;
+    r.s = s - arc0;
     r.x = x;
     r.y = y;
     r.heading = std::atan2(y1, x1);
@@ -385,7 +422,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
   impl->k.resize(n + 1);
   impl->dk.resize(n + 1);
   for (int i = 0; i <= n; ++i) {
-    const RefSample& r = impl->samples[i % n];
+    const RefSample& r = impl->samples[i % count];
     impl->x[i] = r.x;
     impl->y[i] = r.y;
     impl->th[i] = (i == 0) ? r.heading : impl->th[i - 1] + WrapAngle(r.heading - impl->th[i - 1]);
@@ -394,18 +431,22 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
     impl->k[i] = r.kappa;
     impl->dk[i] = r.dkappa;
   }
-  // Entry n continues the unwrapped heading; the loop closes with a whole number of turns, which
-  // only shifts heading by a multiple of 2 pi (harmless for cos/sin and wrapped output).
+  // Closed: entry n continues the unwrapped heading; the loop closes with a whole number of
+  // turns, which only shifts heading by a multiple of 2 pi (harmless for cos/sin and wrapped
+  // output).
 
   std::shared_ptr<ReferenceLine> line(new ReferenceLine(std::move(impl)));
   double max_dist = 0, max_ds = 0;
-  for (const Waypoint& wp : wps) {
+  const int w_first = closed ? 0 : open->first, w_last = closed ? nw - 1 : open->last;
+  for (int i = w_first; i <= w_last; ++i) {
+    const Waypoint& wp = wps[i];
     const FrenetPoint f = line->ToFrenet(wp.x, wp.y);
     max_dist = std::max(max_dist, std::abs(f.d));
-    max_ds = std::max(max_ds, std::abs(line->DiffS(f.s, wp.s - s0)));
+    max_ds = std::max(max_ds, std::abs(line->DiffS(f.s, wp.s - wps[w_first].s)));
   }
   line->impl_->max_waypoint_distance = max_dist;
   line->impl_->max_map_s_difference = max_ds;
+  if (!closed) return std::shared_ptr<const ReferenceLine>(std::move(line));
   // The simulator's reading of d at every sample (float32 chords, as it computes them).
   const ChordFrenet chords(track);
   Impl& m = *line->impl_;
@@ -421,5 +462,89 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& t
   return std::shared_ptr<const ReferenceLine>(std::move(line));
 }
 
+StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::Fit(const Track& track,
+                                                                  const Options& options) {
+  return FitLine(track, options, nullptr);
+}
+
+StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::FitOpen(
+    std::span<const Point> polyline, const Options& options, std::string_view source) {
+  if (Status st = options.Validate(); !st.ok()) return st;
+  const std::string src = source.empty() ? std::string("polyline") : std::string(source);
+  // Distinct points (consecutive repeats dropped), finite.
+  std::vector<Point> pts;
+  for (const Point& p : polyline) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      return Status::Error(src + ": polyline point " + std::to_string(&p - polyline.data()) +
+                           " is not finite");
+    }
+    if (pts.empty() || std::hypot(p.x - pts.back().x, p.y - pts.back().y) > kOpenMinSpacing) {
+      pts.push_back(p);
+    }
+  }
+  if (pts.size() < 2) return Status::Error(src + ": a line needs at least 2 distinct points");
+  std::vector<double> cum(pts.size(), 0.0);
+  for (size_t i = 1; i < pts.size(); ++i) {
+    cum[i] = cum[i - 1] + std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
+  }
+  const double total = cum.back();
+  // The point at chord length c along the polyline (c may lie beyond either end: straight on).
+  auto at = [&](double c) {
+    size_t i = std::upper_bound(cum.begin(), cum.end(), c) - cum.begin();
+    i = std::clamp<size_t>(i, 1, pts.size() - 1);
+    const Point& a = pts[i - 1];
+    const Point& b = pts[i];
+    const double f = (c - cum[i - 1]) / (cum[i] - cum[i - 1]);
+    return Point{a.x + f * (b.x - a.x), a.y + f * (b.y - a.y)};
+  };
+  // Resampled every ~kOpenSpacing m; the ends extended straight along the direction of their
+  // last few metres.
+  const int inner = std::max(1, static_cast<int>(std::ceil(total / kOpenSpacing)));
+  const double ext = std::max(kOpenExtension, 3 * options.control_spacing);
+  const int ext_n = static_cast<int>(std::ceil(ext / kOpenSpacing));
+  auto direction = [&](double c0, double c1) {
+    const Point a = at(c0), b = at(c1);
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    return Point{(b.x - a.x) / len, (b.y - a.y) / len};
+  };
+  const double probe = std::min(kOpenEndProbe, total);
+  const Point d0 = direction(0.0, probe), d1 = direction(total - probe, total);
+  Track track;
+  track.source = src;
+  auto add = [&](double x, double y) {
+    Waypoint w;
+    w.x = x;
+    w.y = y;
+    if (!track.waypoints.empty()) {
+      const Waypoint& prev = track.waypoints.back();
+      w.s = prev.s + std::hypot(x - prev.x, y - prev.y);
+    }
+    track.waypoints.push_back(w);
+  };
+  for (int i = ext_n; i >= 1; --i) {
+    const double c = -i * ext / ext_n;
+    add(pts.front().x + c * d0.x, pts.front().y + c * d0.y);
+  }
+  OpenRange range;
+  range.first = static_cast<int>(track.waypoints.size());
+  for (int i = 0; i <= inner; ++i) {
+    const Point p = at(total * i / inner);
+    add(p.x, p.y);
+  }
+  range.last = static_cast<int>(track.waypoints.size()) - 1;
+  for (int i = 1; i <= ext_n; ++i) {
+    const double c = i * ext / ext_n;
+    add(pts.back().x + c * d1.x, pts.back().y + c * d1.y);
+  }
+  for (size_t i = 0; i < track.waypoints.size(); ++i) {  // right normals, for completeness
+    const Waypoint& a = track.waypoints[i == 0 ? 0 : i - 1];
+    const Waypoint& b = track.waypoints[i == 0 ? 1 : i];
+    const double len = std::hypot(b.x - a.x, b.y - a.y);
+    track.waypoints[i].dx = (b.y - a.y) / len;
+    track.waypoints[i].dy = -(b.x - a.x) / len;
+  }
+  track.max_s = track.waypoints.back().s;
+  return FitLine(track, options, &range);
+}
 
 }  // namespace frenetic::map

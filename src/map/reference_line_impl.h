@@ -2,6 +2,7 @@
 // (reference_line.cc: queries; reference_line_fit.cc: the Ceres fit that fills them).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -41,13 +42,15 @@ using detail::Hermite;
 using detail::HermiteAt;
 
 struct ReferenceLine::Impl {
+  bool closed = true;  // a loop; else an open line with n + 1 samples, straight beyond its ends
   double length = 0;
   double step = 0;
   double inv_step = 0;
   int n = 0;
   std::vector<RefSample> samples;
-  // Struct-of-arrays copies with n + 1 entries (entry n repeats sample 0 at s = length, heading
-  // unwrapped), so segment i always interpolates between entries i and i + 1.
+  // Struct-of-arrays copies with n + 1 entries (closed: entry n repeats sample 0 at s = length,
+  // heading unwrapped; open: entry n is the last sample), so segment i always interpolates
+  // between entries i and i + 1.
   std::vector<double> x, y, th, tx, ty, k, dk;
   // Chord offset (ChordOffset) at each sample for d = 0 and d = kChordD1; linear in d between.
   std::vector<double> chord0, chord1;
@@ -108,22 +111,38 @@ struct ReferenceLine::Impl {
     CosSin(i, e.th, &e.c, &e.s);
     return e;
   }
-  // Splits an unwrapped sample coordinate sigma = s / step into (segment, t).
+  // Splits an unwrapped sample coordinate sigma = s / step into (segment, t); on an open line
+  // sigma must be within [0, n].
   void Split(double sigma, int* i, double* t) const {
     const double fl = std::floor(sigma);
+    if (!closed) {
+      const long j = std::clamp(static_cast<long>(fl), 0L, static_cast<long>(n) - 1);
+      *i = static_cast<int>(j);
+      *t = sigma - static_cast<double>(j);
+      return;
+    }
     long j = static_cast<long>(fl) % n;
     if (j < 0) j += n;
     *i = static_cast<int>(j);
     *t = sigma - fl;
   }
+  // An open line's end that s lies beyond (0: before the start, n: past the end), or -1 when s
+  // is on the line (always on a closed one).
+  int EndBeyond(double s) const {
+    if (closed) return -1;
+    return s < 0 ? 0 : s > length ? n : -1;
+  }
   double Dist2(int i, double px, double py) const {
     const double ex = x[i] - px, ey = y[i] - py;
     return ex * ex + ey * ey;
   }
+  // A sample index: modulo n on a loop, clamped to [0, n] on an open line.
   int Wrap(long i) const {
+    if (!closed) return static_cast<int>(std::clamp(i, 0L, static_cast<long>(n)));
     long j = i % n;
     return static_cast<int>(j < 0 ? j + n : j);
   }
+  int SampleCount() const { return closed ? n : n + 1; }  // distinct samples to search
   int NearestGlobal(double px, double py) const;
   int NearestLocal(double px, double py, int start, bool* ok) const;
   FrenetPoint Project(double px, double py, int nearest) const;

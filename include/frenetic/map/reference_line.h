@@ -1,13 +1,21 @@
-// The smooth reference line: a closed curve fitted through a track's waypoints with Ceres
-// (stay close to the waypoints, penalise change of curvature; periodic, so smooth across the
-// seam), re-parametrised by its own arc length and sampled densely. All Frenet conversion of
-// the planner happens on it. s is periodic with period length(); d is positive to the right of
-// the driving direction (the simulator's convention). s = 0 at the fit's point for waypoint 0
-// (the map's s is taken relative to waypoint 0's s).
+// The smooth reference line: a curve fitted through a track's waypoints with Ceres (stay close
+// to the waypoints, penalise change of curvature), re-parametrised by its own arc length and
+// sampled densely. All Frenet conversion of the planner happens on it. d is positive to the
+// right of the driving direction (the simulator's convention).
+//
+// Closed (a loop: the Udacity track, Fit): periodic, so smooth across the seam; s is periodic
+// with period length(), s = 0 at the fit's point for waypoint 0 (the map's s is taken relative
+// to waypoint 0's s).
+// Open (a road with two ends: a CommonRoad lane, FitOpen): s = 0 at the first point and
+// length() at the last; s is not wrapped, and beyond either end the line continues straight
+// along its end tangent (ToCartesian, Centre, At and ToFrenet all extend it), so a trajectory
+// that runs past the end still has coordinates.
 #pragma once
 
 #include <cmath>
 #include <memory>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "frenetic/map/track.h"
@@ -59,10 +67,25 @@ class ReferenceLine {
   static StatusOr<std::shared_ptr<const ReferenceLine>> Fit(const Track& track) {
     return Fit(track, Options());
   }
+  // Fits an open line through a polyline (m, map frame; at least 2 distinct points, in driving
+  // order; repeated points are dropped). The polyline is resampled every ~2 m and extended
+  // straight by a few control spacings at both ends before the fit, so that the fitted line
+  // ends straight along the polyline's end directions. Fails (naming `source`) on fewer than
+  // two distinct points, non-finite coordinates, or a degenerate fit.
+  struct Point {
+    double x = 0, y = 0;
+  };
+  static StatusOr<std::shared_ptr<const ReferenceLine>> FitOpen(std::span<const Point> polyline,
+                                                                const Options& options,
+                                                                std::string_view source);
 
-  double length() const;         // loop length in the line's own arc length (≈ track max_s)
-  double WrapS(double s) const;  // s modulo length(), in [0, length())
-  double DiffS(double s_to, double s_from) const;  // signed s_to − s_from in [−L/2, L/2)
+  bool closed() const;  // a loop (Fit) or a line with two ends (FitOpen)
+
+  double length() const;  // loop length (≈ track max_s), or the open line's, in its arc length
+  // Closed: s modulo length(), in [0, length()). Open: s itself (0 when not finite).
+  double WrapS(double s) const;
+  // Closed: signed s_to − s_from in [−L/2, L/2). Open: s_to − s_from.
+  double DiffS(double s_to, double s_from) const;
 
   // Pose of the point at (s, d): x, y, heading of the road there and curvature of the offset
   // curve. Any finite s is wrapped. Never fails.
@@ -79,15 +102,17 @@ class ReferenceLine {
   FrenetPoint ToFrenet(double x, double y, double s_hint) const;
 
   RefSample At(double s) const;  // interpolated centre-line sample at s (wrapped)
-  // The dense samples, uniformly spaced by length() / samples().size() (<= sample_step), from
-  // s = 0; the sample at length() is samples()[0].
+  // The dense samples, uniformly spaced (<= sample_step) from s = 0: closed, length() /
+  // samples().size() apart, the sample at length() being samples()[0]; open, length() /
+  // (samples().size() - 1) apart, the last one at length().
   const std::vector<RefSample>& samples() const;
 
   // The simulator measures every d from the chords between waypoints (udacity-sim.md §5.3), not
   // from this line: a point at (s, d) of the line reads d + offset, where the offset is the
   // chord's distance from the line (up to ~1.3 m outward mid-segment on the Udacity map's left
   // bends). Bounds of that offset for points at d with s in [s_from, s_to] (unwrapped,
-  // s_to >= s_from; at most one loop), conservative where the simulator switches chords.
+  // s_to >= s_from; at most one loop), conservative where the simulator switches chords. An open
+  // line has no such quirk: {0, 0}.
   struct OffsetRange {
     double lo = 0, hi = 0;  // m
   };
@@ -99,9 +124,15 @@ class ReferenceLine {
 
   ~ReferenceLine();
   struct Impl;
+  struct OpenRange {
+    int first = 0, last = 0;  // the waypoints of an open line's own stretch
+  };
   explicit ReferenceLine(std::unique_ptr<Impl> impl);
 
  private:
+  static StatusOr<std::shared_ptr<const ReferenceLine>> FitLine(const Track& track,
+                                                                const Options& options,
+                                                                const OpenRange* open);
   std::unique_ptr<Impl> impl_;
 };
 
