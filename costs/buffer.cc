@@ -23,12 +23,15 @@ class BufferCost : public CostTerm {
   double Evaluate(const CostContext& ctx, const CostInput& in) const override {
     const int n = ctx.num_samples;
     if (n == 0 || ctx.num_cars == 0) return 0.0;
-    // Same lane: the centres are closer laterally than a car width plus a little.
-    const double same_lane = ctx.car_width + 0.6;
-    // No car farther in s than a car length plus the largest desired gap can fall short.
+    // Same lane: the centres are closer laterally than half the ego's width and half the car's,
+    // plus a little.
+    const double ego_hl = 0.5 * ctx.ego_length, ego_hw = 0.5 * ctx.ego_width;
+    const double same_lane = ego_hw + ctx.max_half_width + 0.6;
+    // No car farther in s than the two half lengths plus the largest desired gap can fall short.
     double max_speed = ctx.max_car_speed;
     for (int k = 0; k < n; ++k) max_speed = std::max(max_speed, in.s_d[k]);
-    const NearCars near(ctx, in, same_lane, ctx.car_length + min_gap_ + headway_ * max_speed);
+    const NearCars near(ctx, in, same_lane,
+                        ego_hl + ctx.max_half_length + min_gap_ + headway_ * max_speed);
     if (!near.Any(n)) return 0.0;
     double sum = 0;
     for (int k = 0; k < n; ++k) {
@@ -36,19 +39,20 @@ class BufferCost : public CostTerm {
       // falls shortest), the car itself for one behind.
       double nearest_ahead = std::numeric_limits<double>::infinity(), worst = 0;
       near.ForEach(k, [&](int c) {
-        if (std::abs(ctx.car_d[c * n + k] - in.d[k]) > same_lane) return true;
+        if (std::abs(ctx.car_d[c * n + k] - in.d[k]) > ego_hw + ctx.HalfWidth(c) + 0.6) return true;
         const double ds = ctx.car_s[c * n + k] - in.s[k];
+        const double bumpers = ego_hl + ctx.HalfLength(c);  // centre distance at contact
         if (ds >= 0) {
-          nearest_ahead = std::min(nearest_ahead, ds);
+          nearest_ahead = std::min(nearest_ahead, ds - bumpers);
         } else {
           const double desired = min_gap_ + headway_ * std::max(ctx.car_v[c * n + k], 0.0);
-          worst = std::max(worst, Shortfall(-ds - ctx.car_length, desired));
+          worst = std::max(worst, Shortfall(-ds - bumpers, desired));
         }
         return true;
       });
       if (nearest_ahead < std::numeric_limits<double>::infinity()) {
         const double desired = min_gap_ + headway_ * std::max(in.s_d[k], 0.0);
-        worst = std::max(worst, Shortfall(nearest_ahead - ctx.car_length, desired));
+        worst = std::max(worst, Shortfall(nearest_ahead, desired));
       }
       sum += worst;
     }

@@ -23,19 +23,21 @@ class CollisionCost : public CostTerm {
   double Evaluate(const CostContext& ctx, const CostInput& in) const override {
     const int n = ctx.num_samples;
     if (n == 0 || ctx.num_cars == 0) return 0.0;
-    const double hl = 0.5 * ctx.car_length + margin_, hw = 0.5 * ctx.car_width + margin_;
+    // The ego's box and the largest car's, each inflated by the margin.
+    const double hl = 0.5 * ctx.ego_length + margin_, hw = 0.5 * ctx.ego_width + margin_;
+    const double hl_max = ctx.max_half_length + margin_, hw_max = ctx.max_half_width + margin_;
     // Cheap reject first: no overlap is possible beyond the boxes' circumscribed reach, nor
     // laterally beyond the ego's turned half-extent plus the car's half-width, at most
-    // hl |sin| + 2 hw with |sin| <= |d'|/s' (the heading from the Frenet velocity, s' floored:
-    // no spin at rest).
-    const double reach = 2.0 * std::hypot(hl, hw);
+    // hl |sin| + (hw + hw_max) with |sin| <= |d'|/s' (the heading from the Frenet velocity, s'
+    // floored: no spin at rest).
+    const double reach = std::hypot(hl, hw) + std::hypot(hl_max, hw_max);
     double max_d_d = 0, min_s_d = 1e9;
     for (int k = 0; k < n; ++k) {
       max_d_d = std::max(max_d_d, std::abs(in.d_d[k]));
       min_s_d = std::min(min_s_d, in.s_d[k]);
     }
     const double max_sin = std::min(1.0, max_d_d / std::max(min_s_d, 0.5));
-    const NearCars near(ctx, in, hl * max_sin + 2.0 * hw, reach);
+    const NearCars near(ctx, in, hl * max_sin + (hw + hw_max), reach);
     double sum = 0;
     for (int k = 0; k < n; ++k) {
       if (near.At(k) == 0) continue;
@@ -52,10 +54,11 @@ class CollisionCost : public CostTerm {
         }
         // The car's own axes first (two of the four separating axes, the ones that part most
         // pairs); the full test only when both overlap.
+        const double chl = ctx.HalfLength(c) + margin_, chw = ctx.HalfWidth(c) + margin_;
         const double ex = hl * ch + hw * std::abs(sh), ey = hl * std::abs(sh) + hw * ch;
-        if (std::abs(ds) > ex + hl || std::abs(dd) > ey + hw) return true;
+        if (std::abs(ds) > ex + chl || std::abs(dd) > ey + chw) return true;
         const traj::OrientedBox ego{in.s[k], in.d[k], 0.0, hl, hw};
-        const traj::OrientedBox car{in.s[k] + ds, in.d[k] + dd, 0.0, hl, hw};
+        const traj::OrientedBox car{in.s[k] + ds, in.d[k] + dd, 0.0, chl, chw};
         hit = traj::Overlap(ego, ch, sh, car, 1.0, 0.0);
         return !hit;
       });

@@ -33,7 +33,7 @@ class LaneFlowCost : public CostTerm {
     for (int c = 0; c < ctx.num_cars && n > 0; ++c) {
       const double v = ctx.car_v[c * n];
       if (!(std::abs(ctx.car_d[c * n] - centre) < half) || !(v < flow)) continue;
-      const double gap = ctx.car_s[c * n] - ctx.start_s - ctx.car_length;
+      const double gap = ctx.car_s[c * n] - ctx.start_s - (0.5 * ctx.ego_length + ctx.HalfLength(c));
       if (!(gap > 0)) continue;  // alongside or behind: the trajectory's own terms see it
       const double catch_up = gap / (limit - std::max(v, 0.0));
       if (catch_up >= horizon_) continue;

@@ -40,16 +40,28 @@ const char* ToString(Reject reason) {
 
 std::vector<std::string> PlannerNames() { return {"search", "baseline"}; }
 
+std::shared_ptr<const map::Road> ConfiguredRoad(const PlannerConfig& config,
+                                                std::shared_ptr<const map::ReferenceLine> line) {
+  return map::Road::Uniform(std::move(line), config.int_value("road.num_lanes"),
+                            config.value("road.lane_width"));
+}
+
 StatusOr<std::unique_ptr<Planner>> MakePlanner(std::string_view name, const PlannerConfig& config,
-                                               std::shared_ptr<const map::ReferenceLine> line) {
-  if (line == nullptr) return Status::Error("MakePlanner: no reference line");
+                                               std::shared_ptr<const map::Road> road) {
+  if (road == nullptr) return Status::Error("MakePlanner: no road");
   if (name == "search") {
     auto costs = cost::CostSet::Build(config.cost_terms());
     if (!costs.ok()) return Status::Error(config.source() + ": " + costs.message());
-    return MakeSearchPlanner(config, std::move(line), std::move(costs.value()));
+    return MakeSearchPlanner(config, std::move(road), std::move(costs.value()));
   }
-  if (name == "baseline") return MakeBaselinePlanner(config, std::move(line));
+  if (name == "baseline") return MakeBaselinePlanner(config, road->line_ptr());
   return Status::Error("unknown planner '" + std::string(name) + "' (known: search, baseline)");
+}
+
+StatusOr<std::unique_ptr<Planner>> MakePlanner(std::string_view name, const PlannerConfig& config,
+                                               std::shared_ptr<const map::ReferenceLine> line) {
+  if (line == nullptr) return Status::Error("MakePlanner: no reference line");
+  return MakePlanner(name, config, ConfiguredRoad(config, std::move(line)));
 }
 
 }  // namespace frenetic::plan

@@ -21,11 +21,12 @@ struct Default {
 // Every numeric planner parameter with its default and its valid / tunable range.
 constexpr Default kDefaults[] = {
     {"budget_ms", 15, 1, 200, true},
-    {"limits.max_speed_mph", 49.5, 20, 49.95, false},
+    {"limits.max_speed_mph", 49.5, 5, 115, false},
     {"limits.max_accel", 9, 1, 9.9, false},
     {"limits.max_jerk", 9, 1, 9.9, false},
     {"limits.d_min", 1.0, 0.8, 4, false},
     {"limits.d_max", 11.0, 8, 11.2, false},
+    {"limits.edge_margin", 0.2, 0, 1, false},
     {"road.lane_width", 4, 2.5, 5, false},
     {"road.num_lanes", 3, 1, 8, false},
     {"road.outer_lane_inset", 0.2, 0, 1, false},
@@ -61,6 +62,8 @@ constexpr Default kDefaults[] = {
     {"check.collision_dt", 0.1, 0.02, 0.25, false},
     {"check.car_length", 4.8, 3, 7, false},
     {"check.car_width", 2.4, 1.5, 3.5, false},
+    {"check.ego_length", 4.8, 3, 7, false},
+    {"check.ego_width", 2.4, 1.5, 3.5, false},
     {"check.margin_s", 1.0, 0, 5, false},
     {"check.margin_d", 0.3, 0, 2, false},
     {"check.margin_behind", 8, 0, 30, false},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <utility>
 
 namespace frenetic::plan {
@@ -25,17 +26,24 @@ constexpr double kGhostOnset = 1.0;         // s: the rule holds this long befor
 
 class TrafficPredictor : public Predictor {
  public:
-  TrafficPredictor(std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options,
+  TrafficPredictor(std::shared_ptr<const map::Road> road, const PredictorOptions& options,
                    bool manoeuvres)
-      : line_(std::move(line)), options_(options), manoeuvres_(manoeuvres) {
+      : road_(std::move(road)), line_(road_->line_ptr()), options_(options), manoeuvres_(manoeuvres) {
     cars_.reserve(2 * options_.max_cars);  // room for a ghost per car
+    slot_.reserve(2 * options_.max_cars);
     ghost_seen_.reserve(options_.max_cars);
     ghost_seen_next_.reserve(options_.max_cars);
     memory_.reserve(options_.max_cars);
+    const std::size_t n = static_cast<std::size_t>(options_.max_cars) * kMaxFutureSamples;
+    for (auto* v : {&fut_s_, &fut_d_, &fut_v_, &fut_vd_}) v->assign(n, 0.0);
+    fut_n_.assign(options_.max_cars, 0);
+    fut_dt_.assign(options_.max_cars, 0.0);
   }
 
-  void Observe(std::span<const SensorCar> rows, double ego_s, double now) override {
+  void Observe(std::span<const SensorCar> rows, double ego_s, double now,
+               std::span<const CarFuture> futures) override {
     cars_.clear();
+    slot_.clear();
     if (!std::isfinite(ego_s)) return;
     for (const SensorCar& row : rows) {
       if (static_cast<int>(cars_.size()) >= options_.max_cars) break;
@@ -48,7 +56,7 @@ class TrafficPredictor : public Predictor {
       const double hint = std::isfinite(row.s) ? row.s : ego_s;
       const map::FrenetPoint f = line_->ToFrenet(row.x, row.y, hint);
       if (!std::isfinite(f.s) || !std::isfinite(f.d)) continue;
-      if (f.d < options_.d_min || f.d > options_.d_max) continue;  // parked / off the road
+      if (!OnRoad(f.s, f.d)) continue;  // parked / off the road
       const double rel = line_->DiffS(f.s, line_->WrapS(ego_s));
       if (std::abs(rel) > options_.range) continue;
       const double heading = line_->At(f.s).heading;
@@ -72,17 +80,23 @@ class TrafficPredictor : public Predictor {
       }
       car.v_s = v;
       car.v_d = v_d;
-      car.d_target = manoeuvres_ ? LateralTarget(car.d, v_d) : car.d;
+      car.d_target = manoeuvres_ ? LateralTarget(f.s, car.d, v_d) : car.d;
       if (!manoeuvres_) car.a_s = 0;
+      car.length = row.length > 0 && std::isfinite(row.length) ? row.length : options_.car_length;
+      car.width = row.width > 0 && std::isfinite(row.width) ? row.width : options_.car_width;
+      const int slot = static_cast<int>(cars_.size());
+      car.recorded = LoadFuture(row.id, futures, slot, f.s, ego_s);
       cars_.push_back(car);
+      slot_.push_back(car.recorded ? slot : -1);
     }
-    if (manoeuvres_ && options_.lane_change_ghosts) AddLaneChangeGhosts(now);
+    if (manoeuvres_ && options_.lane_change_ghosts && road_->uniform()) AddLaneChangeGhosts(now);
   }
 
   std::span<const TrackedCar> cars() const override { return cars_; }
 
   Prediction Predict(int i, double t) const override {
     const TrackedCar& c = cars_[i];
+    if (slot_[i] >= 0) return FromFuture(slot_[i], t);
     Prediction p;
     p.s = c.s;
     p.v = c.v_s;
@@ -111,6 +125,7 @@ class TrafficPredictor : public Predictor {
 
   void Reset() override {
     cars_.clear();
+    slot_.clear();
     memory_.clear();
     ghost_seen_.clear();
   }
@@ -198,14 +213,95 @@ class TrafficPredictor : public Predictor {
       g.lat_delay = std::isfinite(now - since) ? std::clamp(kGhostOnset - (now - since), 0.0, kGhostOnset)
                                                : kGhostOnset;
       cars_.push_back(g);
+      slot_.push_back(-1);
     }
     ghost_seen_.swap(ghost_seen_next_);
   }
 
+  // Whether a reading at line coordinates (s, d) is on the carriageway.
+  bool OnRoad(double s, double d) const {
+    if (road_->uniform()) return !(d < options_.d_min || d > options_.d_max);
+    const map::Road::Span e = road_->EdgesAt(s);
+    return e.exists && d >= e.left - options_.edge_slack && d <= e.right + options_.edge_slack;
+  }
+
+  // Loads the future of car `id` (if `futures` has a usable one) into `slot`, s relative to
+  // ego_s as TrackedCar::s; line_s is the car's line coordinate now (the projections' hint).
+  bool LoadFuture(int id, std::span<const CarFuture> futures, int slot, double line_s,
+                  double ego_s) {
+    const CarFuture* fut = nullptr;
+    for (const CarFuture& f : futures) {
+      if (f.id == id) fut = &f;
+    }
+    if (fut == nullptr || slot >= static_cast<int>(fut_n_.size()) || !(fut->dt > 0) ||
+        !std::isfinite(fut->dt)) {
+      return false;
+    }
+    const int n = static_cast<int>(std::min({fut->x.size(), fut->y.size(), fut->v.size(),
+                                             fut->heading.size(),
+                                             static_cast<std::size_t>(kMaxFutureSamples)}));
+    if (n < 1) return false;
+    const double ego_w = line_->WrapS(ego_s);
+    double hint = line_s;
+    const int base = slot * kMaxFutureSamples;
+    for (int k = 0; k < n; ++k) {
+      const double x = fut->x[k], y = fut->y[k], v = fut->v[k], h = fut->heading[k];
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(v) || !std::isfinite(h)) {
+        return false;
+      }
+      const map::FrenetPoint f = line_->ToFrenet(x, y, hint);
+      const double rel = line_->At(f.s).heading - h;  // the car's heading against the line's
+      hint = f.s;
+      fut_s_[base + k] = line_->DiffS(f.s, ego_w);
+      fut_d_[base + k] = f.d;
+      fut_v_[base + k] = v * std::cos(rel);
+      fut_vd_[base + k] = v * std::sin(rel);  // d is to the right: a heading right of the line
+    }
+    fut_n_[slot] = n;
+    fut_dt_[slot] = fut->dt;
+    return true;
+  }
+
+  // A recorded car t s after the observation: its samples interpolated, then straight on at
+  // the last one's speed.
+  Prediction FromFuture(int slot, double t) const {
+    const int base = slot * kMaxFutureSamples, n = fut_n_[slot];
+    const double x = std::max(t, 0.0) / fut_dt_[slot];
+    Prediction p;
+    if (x >= n - 1) {
+      const double extra = (x - (n - 1)) * fut_dt_[slot];
+      p.v = fut_v_[base + n - 1];
+      p.v_d = fut_vd_[base + n - 1];
+      p.s = fut_s_[base + n - 1] + p.v * extra;
+      p.d = fut_d_[base + n - 1] + p.v_d * extra;
+      return p;
+    }
+    const int k = static_cast<int>(x);
+    const double f = x - k;
+    auto lerp = [&](const std::vector<double>& a) {
+      return a[base + k] + f * (a[base + k + 1] - a[base + k]);
+    };
+    p.s = lerp(fut_s_);
+    p.d = lerp(fut_d_);
+    p.v = lerp(fut_v_);
+    p.v_d = lerp(fut_vd_);
+    return p;
+  }
+
   // The centre of the next lane in the direction of a lateral move faster than the threshold,
-  // or d itself (no move predicted, or a move away from that centre: wander).
-  double LateralTarget(double d, double v_d) const {
+  // or d itself (no move predicted, or a move away from that centre: wander). s: the car's line
+  // coordinate.
+  double LateralTarget(double s, double d, double v_d) const {
     if (!(std::abs(v_d) > options_.lateral_threshold)) return d;
+    if (!road_->uniform()) {
+      // The lane holding the point half a lane on in the move's direction, or the outermost one.
+      const double ahead = d + std::copysign(0.5 * road_->lane_width() + 0.01, v_d);
+      int lane = road_->LaneOf(s, ahead);
+      if (lane < 0) lane = road_->LaneOf(s, d);
+      const map::Road::Span span = road_->LaneAt(lane, s);
+      if (!span.exists) return d;
+      return (span.centre() - d) * v_d > 0 ? span.centre() : d;
+    }
     const double w = options_.lane_width;
     const int last = std::max(options_.num_lanes, 1) - 1;
     const double ahead = d + std::copysign(0.5 * w + 0.01, v_d);
@@ -214,10 +310,15 @@ class TrafficPredictor : public Predictor {
     return (centre - d) * v_d > 0 ? centre : d;
   }
 
+  std::shared_ptr<const map::Road> road_;
   std::shared_ptr<const map::ReferenceLine> line_;
   PredictorOptions options_;
   bool manoeuvres_;
   std::vector<TrackedCar> cars_;
+  std::vector<int> slot_;  // per car: its future's slot, -1 when predicted
+  // Recorded futures, kMaxFutureSamples per slot: s (relative, as TrackedCar::s), d, speeds.
+  std::vector<double> fut_s_, fut_d_, fut_v_, fut_vd_, fut_dt_;
+  std::vector<int> fut_n_;
   std::vector<Memory> memory_;
   // Cars that gave a ghost last time, with the time they were first seen so (NaN: unknown).
   std::vector<std::pair<int, double>> ghost_seen_, ghost_seen_next_;
@@ -225,14 +326,26 @@ class TrafficPredictor : public Predictor {
 
 }  // namespace
 
+std::unique_ptr<Predictor> MakeConstantVelocityPredictor(std::shared_ptr<const map::Road> road,
+                                                         const PredictorOptions& options) {
+  return std::make_unique<TrafficPredictor>(std::move(road), options, false);
+}
+
+std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::Road> road,
+                                                  const PredictorOptions& options) {
+  return std::make_unique<TrafficPredictor>(std::move(road), options, true);
+}
+
 std::unique_ptr<Predictor> MakeConstantVelocityPredictor(
     std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options) {
-  return std::make_unique<TrafficPredictor>(std::move(line), options, false);
+  return MakeConstantVelocityPredictor(
+      map::Road::Uniform(std::move(line), options.num_lanes, options.lane_width), options);
 }
 
 std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::ReferenceLine> line,
                                                   const PredictorOptions& options) {
-  return std::make_unique<TrafficPredictor>(std::move(line), options, true);
+  return MakeManoeuvrePredictor(
+      map::Road::Uniform(std::move(line), options.num_lanes, options.lane_width), options);
 }
 
 }  // namespace frenetic::plan

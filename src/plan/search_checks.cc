@@ -70,7 +70,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_near_.assign(n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
   reach_.assign(w, 0.0);
-  lat_reach_.assign(w, 5.0);
+  lat_reach_.assign(w, ws_.reach_d);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   verdicts_.resize(ws_.order.capacity());
@@ -129,6 +129,7 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
   }
   const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
   if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
+    if (lat_reach_[1] != ws_.reach_d) std::fill(lat_reach_.begin(), lat_reach_.end(), ws_.reach_d);
     ReachMasks(&lat_d_[k * w], lat_reach_.data(), ws_.step_d.data(), w, ws_.n_steps, num_cars,
                &lat_near_[k * w]);
     lat_near_stamp_[k] = ws_.traffic_stamp;
@@ -223,6 +224,24 @@ Checker::ReadRange Checker::ReadBetween(const double* s, const double* d, int pr
   return {d_lo + r.lo, d_hi + r.hi};
 }
 
+double Checker::EdgeExcess(double s0, double s1, const ReadRange& read) const {
+  // The bins of the workspace's edge table that [s0, s1] overlaps (clamped to the table).
+  const int bins = static_cast<int>(ws_.edge_lo.size());
+  const double x0 = (std::min(s0, s1) - ws_.edge_s0) / Workspace::kEdgeBin;
+  const double x1 = (std::max(s0, s1) - ws_.edge_s0) / Workspace::kEdgeBin;
+  if (!(x0 == x0) || !(x1 == x1)) return 1e9;  // NaN s: off any road
+  const int b0 = static_cast<int>(std::clamp(std::floor(x0), 0.0, bins - 1.0));
+  const int b1 = static_cast<int>(std::clamp(std::floor(x1), 0.0, bins - 1.0));
+  double lo = -1e9, hi = 1e9;
+  for (int b = b0; b <= b1; ++b) {
+    if (!(ws_.edge_lo[b] == ws_.edge_lo[b])) return 1e9;  // no lane there
+    lo = std::max(lo, ws_.edge_lo[b]);
+    hi = std::min(hi, ws_.edge_hi[b]);
+  }
+  const double inset = 0.5 * cfg_.ego_width + cfg_.edge_margin;
+  return std::max(lo + inset - read.lo, read.hi - (hi - inset));
+}
+
 double Checker::CandidateViolation(int c, Reject* reason) {
   return CandidateMeasure(c, reason, false);
 }
@@ -285,25 +304,32 @@ double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool
   // the previous check point.
   // The lane-line timer runs on, from the start state's count, while the read d may be astride
   // a line; a trajectory still astride at its end would stay there.
-  double dmin = 1e9, dmax = -1e9, sdmin = 1e9;
+  // On a uniform road, the range of d read against d_min / d_max; on another, the largest
+  // excess over the road's edges (EdgeExcess).
+  double dmin = 1e9, dmax = -1e9, sdmin = 1e9, off_road = -1e9;
   int straddle = ws_.straddle_at_start, worst_straddle = straddle;
   for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ticks.sd[i]);
   for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
        prev = i, i = std::min(i + 5, n_ticks)) {
     const ReadRange read = ReadBetween(tk_s, tk_d, prev, i);
-    dmin = std::min(dmin, read.lo);
-    dmax = std::max(dmax, read.hi);
-    straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
-    worst_straddle = std::max(worst_straddle, straddle);
+    if (cfg_.uniform_road) {
+      dmin = std::min(dmin, read.lo);
+      dmax = std::max(dmax, read.hi);
+      straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+      worst_straddle = std::max(worst_straddle, straddle);
+    } else {
+      off_road = std::max(off_road, EdgeExcess(tk_s[prev], tk_s[i], read));
+    }
     if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.d_min - dmin > 0 ||
-                dmax - cfg_.d_max > 0)) {
+                dmax - cfg_.d_max > 0 || off_road > 0)) {
       if (reason != nullptr) *reason = Reject::kCount;  // unknown: not measured in full
       return 1.0;  // a limit is broken (which one is worst is not known)
     }
     if (i == n_ticks) break;
   }
   if (straddle > 0) worst_straddle = 1 << 20;
-  take(std::max(cfg_.d_min - dmin, dmax - cfg_.d_max) / cfg_.lane_width, Reject::kOffRoad);
+  if (cfg_.uniform_road) off_road = std::max(cfg_.d_min - dmin, dmax - cfg_.d_max);
+  take(off_road / cfg_.lane_width, Reject::kOffRoad);
   if (lane_line) {
     take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
          Reject::kLaneLine);

@@ -33,9 +33,11 @@ inline bool StraddlesRead(const Settings& cfg, double lo, double hi) {
   return false;
 }
 // Whether the simulator may read d within kStraddle of a lane line for a point with s in
-// [s0, s1] and d in [d0, d1] (it reads d from chords: ReferenceLine::ChordOffset).
+// [s0, s1] and d in [d0, d1] (it reads d from chords: ReferenceLine::ChordOffset). Never on a
+// road that is not uniform: the lane-line timer is the Udacity simulator's.
 inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, double s0, double s1,
                       double d0, double d1) {
+  if (!cfg.uniform_road) return false;  // the Udacity simulator's timer only
   const map::ReferenceLine::OffsetRange r = line.ChordOffset(s0, s1, 0.5 * (d0 + d1));
   return StraddlesRead(cfg, d0 + r.lo, d1 + r.hi);
 }
@@ -177,6 +179,10 @@ class Checker {
     double lo, hi;
   };
   ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
+  // On a road that is not uniform: how far (m) the read d range of ticks with s from s0 to s1
+  // comes past the road's edges there, less the ego's half width and edge_margin (> 0: off the
+  // road; no lane there counts as far off).
+  double EdgeExcess(double s0, double s1, const ReadRange& read) const;
 
   // What Violation reads of the ticks [1, n_ticks]: s, s', d, and the centre line at s when
   // known (null: from the line, or from lon bundle slot lon_slot's row when that is >= 0,
@@ -220,7 +226,7 @@ class Checker {
   };
   std::vector<std::uint64_t> lon_near_, lat_near_;
   std::vector<double> reach_;      // StepsOf: the lon reach at each step
-  std::vector<double> lat_reach_;  // StepsOf: the lat reach (5 m) at each step
+  std::vector<double> lat_reach_;  // StepsOf: the lat reach (ws.reach_d) at each step
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
@@ -252,7 +258,7 @@ class Checker {
 
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=
 // step_v_max; rounded products and sums are monotone), so a car farther along s than
-// 8 + widest fails its reach test anyway. Only with non-negative factors.
+// ws.reach_s_base + widest fails its reach test anyway. Only with non-negative factors.
 inline double Checker::ReachS(double s_d, double margin_scale, double behind_scale) const {
   const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
                        cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
@@ -261,7 +267,7 @@ inline double Checker::ReachS(double s_d, double margin_scale, double behind_sca
       {margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * std::max(s_d, 0.0)),
        behind_scale * (cfg_.margin_behind + cfg_.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
        margin_scale * cfg_.margin_s});
-  return 8 + widest;
+  return ws_.reach_s_base + widest;
 }
 
 // FirstCollision's ego at one step.
@@ -285,7 +291,7 @@ struct Checker::StepEgo {
 
 inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
                                        double behind_scale) const {
-  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.car_length, 0.5 * cfg_.car_width}, st.s_d,
+  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.ego_length, 0.5 * cfg_.ego_width}, st.s_d,
           std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
 }
 
@@ -294,7 +300,7 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
   const traj::OrientedBox& ego = e.box;
   const int at = c * (ws_.n_steps + 1) + j;
   const double cs = ws_.step_s[at], cd = ws_.step_d[at];
-  if (std::abs(cd - ego.cy) > 5 || std::abs(cs - ego.cx) > e.reach_s) return false;
+  if (std::abs(cd - ego.cy) > ws_.reach_d || std::abs(cs - ego.cx) > e.reach_s) return false;
   // A car behind in another lane than the start's is one the ego would cut in front of:
   // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
   // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
@@ -306,17 +312,20 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
   // The headway to a car ahead is kept in full while the ego is in its lane and tapers
   // to margin_s as the ego moves out of it (pulling out from behind a car is how a
   // lane change starts).
-  const double inside = std::clamp(
-      (cfg_.car_width - std::abs(cd - ego.cy)) / (cfg_.car_width - kFollowerLateral), 0.0, 1.0);
+  const double sep_d = ws_.car_sep_d[c];  // the two half widths: centres this close touch
+  const double inside =
+      std::clamp((sep_d - std::abs(cd - ego.cy)) / (sep_d - kFollowerLateral), 0.0, 1.0);
   const double margin =
       cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d)
       : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                           : margin_scale * cfg_.margin_s;
-  if (std::abs(cs - ego.cx) > 8 + margin || std::abs(cd - ego.cy) > 5) return false;
+  if (std::abs(cs - ego.cx) > ws_.reach_s_base + margin || std::abs(cd - ego.cy) > ws_.reach_d) {
+    return false;
+  }
   const double cu = ws_.step_dir_s[at], cw = ws_.step_dir_d[at];  // the car's unit heading
   e.Direction();
-  const traj::OrientedBox car{cs, cd, 0.0, ego.half_length + margin,
-                              ego.half_width + margin_scale * cfg_.margin_d};
+  const traj::OrientedBox car{cs, cd, 0.0, ws_.car_hl[c] + margin,
+                              ws_.car_hw[c] + margin_scale * cfg_.margin_d};
   // The d axis separates the boxes when their extents along it do not reach (most cars
   // alongside, in the next lane): a gap over 1 mm is one Overlap finds on its axes too.
   const double reach_d = ego.half_length * std::abs(e.dir_d) + ego.half_width * e.dir_s +

@@ -8,6 +8,14 @@
 namespace frenetic::plan::search {
 namespace {
 
+// s of driving, then at most kMaxLaneLookahead m: where a road's lane centres are read.
+constexpr double kLaneLookahead = 2.0;
+constexpr double kMaxLaneLookahead = 60.0;
+// m: FirstCollision's broad reaches for cars no larger than the Udacity footprint (4.8 x 2.4 m,
+// whose half diagonal this is).
+constexpr double kReachS = 8.0, kReachD = 5.0;
+constexpr double kUdacityHalfDiagonal = 2.6832815729997477;
+
 // The lanes' centres for this cycle: the nominal ones, moved just enough that the simulator,
 // which measures d from the chords between waypoints (up to ~1.3 m outward mid-segment on
 // left bends, udacity-sim.md §5.3 and §9.3), reads the ego inside its lane over the next
@@ -25,18 +33,54 @@ void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   }
 }
 
+// The lanes of a road that is not uniform, this cycle: each lane there at the start's s, its
+// centre where a lateral move would end (lookahead), and the road's edges over the stretch the
+// horizons can reach (the off-road check's table). A lane that is not there keeps a centre
+// beside its neighbour, so that the centres stay in order.
+void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
+  const double s0 = ws.start.s;
+  const double look = s0 + std::clamp(ws.start.s_d * kLaneLookahead, 0.0, kMaxLaneLookahead);
+  for (int l = 0; l < cfg.num_lanes; ++l) {
+    const map::Road::Span now = road.LaneAt(l, s0), ahead = road.LaneAt(l, look);
+    ws.lane_exists[l] = now.exists;
+    if (now.exists) {
+      ws.lane_nominal[l] = ahead.exists ? ahead.centre() : now.centre();
+    } else {
+      ws.lane_nominal[l] = l == 0 ? 0.0 : ws.lane_nominal[l - 1] + cfg.lane_width;
+    }
+    ws.lane_center[l] = ws.lane_nominal[l];
+  }
+  const map::Road::Span edges = road.EdgesAt(s0);
+  ws.road_left = edges.exists ? edges.left : 0.0;
+  ws.road_right = edges.exists ? edges.right : cfg.num_lanes * cfg.lane_width;
+  // The edge table: the tightest edges over each bin, from its two ends (borders are linear
+  // between stations; a lane that ends shows at the bin holding its end).
+  ws.edge_s0 = s0 - Workspace::kEdgeBehind;
+  const int bins = static_cast<int>(ws.edge_lo.size());
+  map::Road::Span prev = road.EdgesAt(ws.edge_s0);
+  for (int b = 0; b < bins; ++b) {
+    const map::Road::Span next = road.EdgesAt(ws.edge_s0 + (b + 1) * Workspace::kEdgeBin);
+    const bool both = prev.exists && next.exists;
+    ws.edge_lo[b] = both ? std::max(prev.left, next.left) : NAN;
+    ws.edge_hi[b] = both ? std::min(prev.right, next.right) : NAN;
+    prev = next;
+  }
+}
+
 }  // namespace
 
 int LaneOf(const Settings& cfg, const Workspace& ws, double d) {
-  int best = 0;
-  for (int l = 1; l < cfg.num_lanes; ++l) {
-    if (std::abs(d - ws.lane_center[l]) < std::abs(d - ws.lane_center[best])) best = l;
+  int best = -1;
+  for (int l = 0; l < cfg.num_lanes; ++l) {
+    if (!ws.lane_exists[l]) continue;
+    if (best < 0 || std::abs(d - ws.lane_center[l]) < std::abs(d - ws.lane_center[best])) best = l;
   }
-  return best;
+  return std::max(best, 0);
 }
 
-void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Predictor& predictor,
+void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& predictor,
                   Workspace& ws) {
+  const map::ReferenceLine& line = road.line();
   const traj::FrenetState& start = ws.start;
   const int n_samples = ws.n_samples, n_steps = ws.n_steps;
   cost::CostContext& c = ws.ctx;
@@ -49,11 +93,15 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   c.start_s = start.s;
   c.start_d = start.d;
   c.start_speed = start.s_d;
+  if (cfg.uniform_road) {
+    LaneCentres(cfg, line, ws);
+  } else {
+    RoadLanes(cfg, road, ws);
+  }
   c.current_lane = LaneOf(cfg, ws, start.d);
   c.previous_target_lane = ws.prev_target_lane;
   c.time_since_lane_change = ws.time_since_change;
   c.lane_before_change = ws.lane_before_change;
-  LaneCentres(cfg, line, ws);
   // Lane speed limits: the XY speed of an offset curve is s' (1 + kappa d) with d to the right
   // and kappa positive to the left, so the outer lane of a left bend is faster in XY.
   const double reach = cfg.max_speed * cfg.score_horizon + 20;
@@ -70,7 +118,7 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
     const double d = ws.lane_center[l];
     const double factor = std::max({1.0, 1.0 + kmax * d, 1.0 + kmin * d});
     // A little below the cap: lateral motion and the splice add a few cm/s in XY.
-    c.lane_speed_limit[l] = cfg.max_speed / factor - 0.05;
+    c.lane_speed_limit[l] = std::min(cfg.max_speed, road.SpeedLimit(l)) / factor - 0.05;
   }
   // Previous choice at this cycle's sample times.
   if (ws.have_prev_traj) {
@@ -94,9 +142,15 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   int nc = 0, real = 0;
   for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
     const TrackedCar& car = cars[i];
-    if (car.s < -cfg.car_length && std::abs(car.d - start.d) < kFollowerLateral) continue;
+    const double hl = 0.5 * car.length, hw = 0.5 * car.width;
+    const double sep_s = 0.5 * cfg.ego_length + hl;
+    if (car.s < -sep_s && std::abs(car.d - start.d) < kFollowerLateral) continue;
     if (!car.ghost) real = nc + 1;
     ws.car_index[nc] = i;
+    ws.car_hl[nc] = hl;
+    ws.car_hw[nc] = hw;
+    ws.car_sep_s[nc] = sep_s;
+    ws.car_sep_d[nc] = 0.5 * cfg.ego_width + hw;
     const Predictor::Prediction at_start = predictor.Predict(i, ws.t_keep);
     ws.car_s0[nc] = start.s + at_start.s;  // at the start instant, in the start's s frame
     ws.car_d0[nc] = at_start.d;
@@ -124,6 +178,14 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   }
   c.num_cars = real;
   ws.num_check_cars = nc;
+  // FirstCollision's broad reaches: the Udacity footprints' 8 and 5 m, scaled up with the
+  // half diagonals of the ego and the largest car when they are larger.
+  double car_diag = 0;
+  for (int i = 0; i < nc; ++i) car_diag = std::max(car_diag, std::hypot(ws.car_hl[i], ws.car_hw[i]));
+  const double diag = std::hypot(0.5 * cfg.ego_length, 0.5 * cfg.ego_width) + car_diag;
+  const double scale = std::max(1.0, diag / (2 * kUdacityHalfDiagonal));
+  ws.reach_s_base = kReachS * scale;
+  ws.reach_d = kReachD * scale;
   // Bounds the collision check's margins (Checker::FirstCollision).
   ++ws.traffic_stamp;
   ws.step_v_max = 0;
@@ -141,6 +203,16 @@ void BuildContext(const Settings& cfg, const map::ReferenceLine& line, const Pre
   c.car_s = ws.car_s.data();
   c.car_d = ws.car_d.data();
   c.car_v = ws.car_v.data();
+  c.car_half_length = ws.car_hl.data();
+  c.car_half_width = ws.car_hw.data();
+  c.max_half_length = 0.5 * cfg.car_length;
+  c.max_half_width = 0.5 * cfg.car_width;
+  for (int i = 0; i < real; ++i) {
+    c.max_half_length = std::max(c.max_half_length, ws.car_hl[i]);
+    c.max_half_width = std::max(c.max_half_width, ws.car_hw[i]);
+  }
+  c.ego_length = cfg.ego_length;
+  c.ego_width = cfg.ego_width;
 }
 
 }  // namespace frenetic::plan::search

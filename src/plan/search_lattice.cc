@@ -88,8 +88,7 @@ LatTraj Lattice::MakeLat(int lane, double offset, double T, double delay) const 
   l.traj.duration = T;
   l.traj.delay = delay;
   const traj::FrenetState& s0 = ws_.start;
-  const double target =
-      std::clamp(ws_.lane_center[lane] + offset, 0.0, cfg_.num_lanes * cfg_.lane_width);
+  const double target = std::clamp(ws_.lane_center[lane] + offset, ws_.road_left, ws_.road_right);
   // A delayed move holds still first (only offered when the ego is nearly at rest laterally).
   l.traj.poly = delay > 0 ? traj::SolveQuintic(s0.d, 0.0, 0.0, target, 0.0, 0.0, T)
                           : traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, target, 0.0, 0.0, T);
@@ -151,7 +150,7 @@ void Lattice::Generate() {
   // Lanes within reach: the current one and its neighbours.
   bool reachable[cost::kMaxLanes] = {};
   for (int l = 0; l < cfg_.num_lanes; ++l) {
-    reachable[l] = std::abs(ws_.lane_center[l] - start.d) <= 2.5 * cfg_.lane_width;
+    reachable[l] = ws_.lane_exists[l] && std::abs(ws_.lane_center[l] - start.d) <= 2.5 * cfg_.lane_width;
   }
   double vmax = 0;
   for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);

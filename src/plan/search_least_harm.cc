@@ -71,12 +71,12 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   const int row = kProbes * num_cars;
   lon_done_.assign(ws_.lon.size(), 0);
   lat_done_.assign(ws_.lat.size(), 0);
-  const auto fill = [&](const double* p, const std::vector<double>& car_p, double size,
-                        double* out) {
+  const auto fill = [&](const double* p, const std::vector<double>& car_p,
+                        const std::vector<double>& size, double* out) {
     for (int q = 0; q < kProbes; ++q) {
       const int j = std::clamp(probe[q], 1, n_steps);
       for (int car = 0; car < num_cars; ++car) {
-        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size;
+        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size[car];
       }
     }
   };
@@ -85,8 +85,8 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
     const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
     if (!lon_done_[i] || !lat_done_[k]) {
       const Checker::Rows rows = checker_.StepRows(c);
-      if (!lon_done_[i]) fill(rows.s, ws_.step_s, cfg_.car_length, &lon_sep_[i * row]);
-      if (!lat_done_[k]) fill(rows.d, ws_.step_d, cfg_.car_width, &lat_sep_[k * row]);
+      if (!lon_done_[i]) fill(rows.s, ws_.step_s, ws_.car_sep_s, &lon_sep_[i * row]);
+      if (!lat_done_[k]) fill(rows.d, ws_.step_d, ws_.car_sep_d, &lat_sep_[k * row]);
       lon_done_[i] = lat_done_[k] = 1;
     }
     return MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);

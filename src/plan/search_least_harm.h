@@ -22,8 +22,8 @@
 namespace frenetic::plan::search {
 
 // The smallest separation (m) of the bare boxes of `tr` from any car of ws over the check
-// horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - length,
-// |dd| - width), < 0 on overlap.
+// horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - ws.car_sep_s,
+// |dd| - ws.car_sep_d), < 0 on overlap.
 double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr);
 // The same from the states at the collision-check steps (state_at(tick), Checker::StepsOf).
 template <typename StateAt>
@@ -33,8 +33,8 @@ double ClearanceAt(const Settings& cfg, const Workspace& ws, StateAt state_at) {
     const traj::FrenetState st = state_at(j * ws.collision_step);
     for (int c = 0; c < ws.ctx.num_cars; ++c) {
       const int at = c * (ws.n_steps + 1) + j;
-      const double sep = std::max(std::abs(ws.step_s[at] - st.s) - cfg.car_length,
-                                  std::abs(ws.step_d[at] - st.d) - cfg.car_width);
+      const double sep = std::max(std::abs(ws.step_s[at] - st.s) - ws.car_sep_s[c],
+                                  std::abs(ws.step_d[at] - st.d) - ws.car_sep_d[c]);
       worst = std::min(worst, sep);
     }
   }
@@ -57,9 +57,9 @@ inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepSt
   for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
+    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c];
     for (int j = 1; j <= n_steps; ++j) {
-      const double sep =
-          std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
+      const double sep = std::max(std::abs(cs[j] - s[j]) - len, std::abs(cd[j] - d[j]) - wid);
       col[j] = sep < col[j] ? sep : col[j];
     }
   }
@@ -127,9 +127,9 @@ inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const dou
   for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
+    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c];
     for (int j = 1; j <= n_steps; ++j) {
-      sep[j - 1] =
-          std::max(std::abs(cs[j] - s[j]) - cfg.car_length, std::abs(cd[j] - d[j]) - cfg.car_width);
+      sep[j - 1] = std::max(std::abs(cs[j] - s[j]) - len, std::abs(cd[j] - d[j]) - wid);
     }
     const double row = MinOf(sep, n_steps);
     worst = row < worst ? row : worst;

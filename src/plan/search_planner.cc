@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -39,6 +41,13 @@ constexpr int kCheckRestMin = 4;
 // CheckRest takes this many candidates cheapest bound first, then the rest in any order, when
 // none passed in the last search either.
 constexpr int kRestHeapTests = 64;
+// Lane ends (WithLaneEnds): the id of lane l's car is kLaneEndId - l; it is kLaneEndLength m
+// long; ends within kLaneEndRange m ahead are shown (ends within kLaneEndSlack m of the road's
+// own end are the road's end, not a lane's).
+constexpr int kLaneEndId = -1000;
+constexpr double kLaneEndLength = 1.0;
+constexpr double kLaneEndRange = 250.0;
+constexpr double kLaneEndSlack = 1.0;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -47,7 +56,7 @@ double SteadyMs() {
 }
 
 std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
-                                         std::shared_ptr<const map::ReferenceLine> line,
+                                         std::shared_ptr<const map::Road> road,
                                          const search::Settings& cfg) {
   PredictorOptions po = BasicPredictorOptions(config);
   po.brake_threshold = config.value("prediction.brake_threshold");
@@ -56,20 +65,23 @@ std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
   po.lane_change_ghosts = config.int_value("prediction.lane_change_ghosts") != 0;
   po.lane_width = cfg.lane_width;
   po.num_lanes = cfg.num_lanes;
+  po.car_length = cfg.car_length;
+  po.car_width = cfg.car_width;
   return config.int_value("prediction.manoeuvres") != 0
-             ? MakeManoeuvrePredictor(std::move(line), po)
-             : MakeConstantVelocityPredictor(std::move(line), po);
+             ? MakeManoeuvrePredictor(std::move(road), po)
+             : MakeConstantVelocityPredictor(std::move(road), po);
 }
 
 class SearchPlanner : public Planner {
  public:
-  SearchPlanner(const PlannerConfig& config, std::shared_ptr<const map::ReferenceLine> line,
+  SearchPlanner(const PlannerConfig& config, std::shared_ptr<const map::Road> road,
                 std::shared_ptr<const cost::CostSet> costs, PlannerClock clock)
       : timer_(clock ? std::move(clock) : PlannerClock(SteadyMs)),
-        cfg_(config),
-        line_(std::move(line)),
+        cfg_(config, *road),
+        road_(std::move(road)),
+        line_(road_->line_ptr()),
         costs_(std::move(costs)),
-        predictor_(MakePredictor(config, line_, cfg_)),
+        predictor_(MakePredictor(config, road_, cfg_)),
         ws_(cfg_),
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
@@ -78,6 +90,7 @@ class SearchPlanner : public Planner {
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
+    rows_.reserve(search::kMaxCars + cost::kMaxLanes);
     rest_.reserve(ws_.order.capacity());
     popped_.assign(ws_.order.capacity(), 0);
     result_.x.reserve(cfg_.output_points + 1);
@@ -162,7 +175,9 @@ class SearchPlanner : public Planner {
       start.s_d = std::clamp(start.s_d, 0.0, cfg_.max_speed);
       invalid = invalid || !ego_ok;
     }
-    if (start.s >= line_->length() || start.s < 0) continuity_.Rebase(start, kept);
+    if (line_->closed() && (start.s >= line_->length() || start.s < 0)) {
+      continuity_.Rebase(start, kept);
+    }
     sum.points_kept = kept;
     ws_.kept = kept;
     ws_.start = start;
@@ -170,9 +185,10 @@ class SearchPlanner : public Planner {
     ws_.time_since_change += elapsed;
     if (ws_.have_prev_traj) ws_.prev_elapsed = ws_.prev_base + elapsed;
 
-    // Prediction (relative to the start state's s; the observation is "now").
-    predictor_->Observe(t.sensor_fusion, start.s, sim_time_);
-    search::BuildContext(cfg_, *line_, *predictor_, ws_);
+    // Prediction (relative to the start state's s; the observation is "now"), with the ends of
+    // lanes that end ahead as cars at rest.
+    predictor_->Observe(WithLaneEnds(t.sensor_fusion, start.s), start.s, sim_time_, t.futures);
+    search::BuildContext(cfg_, *road_, *predictor_, ws_);
     continuity_.SetXyPrefix(checker_);
     sum.ms_prepare = Elapsed();
 
@@ -407,6 +423,37 @@ class SearchPlanner : public Planner {
     return best;
   }
 
+  // The sensor rows plus, for every lane that ends ahead before the road does (a lane drop, an
+  // on-ramp's end), a car at rest just past its end: the lattice follows and stops for it, the
+  // costs and checks see the lane as blocked there, as a driver sees a lane drop. Rows are
+  // returned as they are on a road whose lanes never end.
+  std::span<const SensorCar> WithLaneEnds(const std::vector<SensorCar>& rows, double start_s) {
+    if (road_->uniform()) return rows;
+    double road_end = -std::numeric_limits<double>::infinity();
+    for (int l = 0; l < road_->num_lanes(); ++l) road_end = std::max(road_end, road_->LaneEnd(l));
+    rows_.assign(rows.begin(), rows.begin() + std::min<std::size_t>(rows.size(), search::kMaxCars));
+    for (int l = 0; l < road_->num_lanes(); ++l) {
+      const double end = road_->LaneEnd(l);
+      if (!(end < road_end - kLaneEndSlack) || end < start_s - kLaneEndSlack ||
+          end > start_s + kLaneEndRange) {
+        continue;
+      }
+      const map::Road::Span at = road_->LaneAt(l, end - kLaneEndSlack);
+      if (!at.exists) continue;
+      const map::CartesianPose p = line_->ToCartesian(end + 0.5 * kLaneEndLength, at.centre());
+      SensorCar c;
+      c.id = kLaneEndId - l;
+      c.x = p.x;
+      c.y = p.y;
+      c.s = end + 0.5 * kLaneEndLength;
+      c.d = at.centre();
+      c.length = kLaneEndLength;
+      c.width = std::max(at.width() - 0.2, 0.5);
+      rows_.push_back(c);
+    }
+    return rows_;
+  }
+
   // car: context index of the car a collision rejection is against (-1: none), at time t.
   void Trace(int rank, bool winner, int reject, int car = -1, double t = 0) {
     if (trace_ == nullptr || static_cast<int>(trace_->candidates.size()) >= trace_max_) return;
@@ -467,7 +514,8 @@ class SearchPlanner : public Planner {
 
   search::CycleClock timer_;
   search::Settings cfg_;
-  std::shared_ptr<const map::ReferenceLine> line_;
+  std::shared_ptr<const map::Road> road_;
+  std::shared_ptr<const map::ReferenceLine> line_;  // road_'s
   std::shared_ptr<const cost::CostSet> costs_;
   std::unique_ptr<Predictor> predictor_;
   // The stages, in cycle order after the context (search::BuildContext), all on ws_.
@@ -480,6 +528,7 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
+  std::vector<SensorCar> rows_;   // WithLaneEnds' rows
   std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
   std::vector<char> popped_;                  // CheckRest: taken from the heap
   bool none_passed_last_ = false;             // the last search's checks found no candidate passing
@@ -492,11 +541,19 @@ class SearchPlanner : public Planner {
 }  // namespace
 
 std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
+                                           std::shared_ptr<const map::Road> road,
+                                           std::shared_ptr<const cost::CostSet> costs,
+                                           PlannerClock clock) {
+  return std::make_unique<SearchPlanner>(config, std::move(road), std::move(costs),
+                                         std::move(clock));
+}
+
+std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
                                            std::shared_ptr<const map::ReferenceLine> line,
                                            std::shared_ptr<const cost::CostSet> costs,
                                            PlannerClock clock) {
-  return std::make_unique<SearchPlanner>(config, std::move(line), std::move(costs),
-                                         std::move(clock));
+  return MakeSearchPlanner(config, ConfiguredRoad(config, std::move(line)), std::move(costs),
+                           std::move(clock));
 }
 
 }  // namespace frenetic::plan

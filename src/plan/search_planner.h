@@ -24,6 +24,11 @@ namespace frenetic::plan {
 using PlannerClock = std::function<double()>;
 
 std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
+                                           std::shared_ptr<const map::Road> road,
+                                           std::shared_ptr<const cost::CostSet> costs,
+                                           PlannerClock clock = nullptr);
+// On the configured uniform road along `line` (ConfiguredRoad).
+std::unique_ptr<Planner> MakeSearchPlanner(const PlannerConfig& config,
                                            std::shared_ptr<const map::ReferenceLine> line,
                                            std::shared_ptr<const cost::CostSet> costs,
                                            PlannerClock clock = nullptr);

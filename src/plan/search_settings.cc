@@ -22,6 +22,10 @@ Settings::Settings(const PlannerConfig& c) {
   lane_width = c.value("road.lane_width");
   outer_inset = c.value("road.outer_lane_inset");
   num_lanes = std::clamp(c.int_value("road.num_lanes"), 1, cost::kMaxLanes);
+  uniform_road = true;
+  edge_margin = c.value("limits.edge_margin");
+  ego_length = c.value("check.ego_length");
+  ego_width = c.value("check.ego_width");
   keep_points = c.int_value("continuity.keep_points");
   output_points = c.int_value("continuity.output_points");
   resync_tolerance = c.value("continuity.resync_tolerance");
@@ -67,6 +71,12 @@ Settings::Settings(const PlannerConfig& c) {
   fallback_jerk = c.value("fallback.jerk");
   fallback_lat_duration = c.value("fallback.lat_duration");
   budget_ms = c.budget_pinned() ? kInf : c.budget_ms();
+}
+
+Settings::Settings(const PlannerConfig& c, const map::Road& road) : Settings(c) {
+  lane_width = road.lane_width();
+  num_lanes = std::clamp(road.num_lanes(), 1, cost::kMaxLanes);
+  uniform_road = road.uniform();
 }
 
 }  // namespace frenetic::plan::search

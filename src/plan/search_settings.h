@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "frenetic/map/road.h"
 #include "frenetic/plan/planner_config.h"
 
 namespace frenetic::plan::search {
@@ -23,12 +24,20 @@ inline constexpr int kMaxStraddleTicks = 135;  // ticks
 
 inline bool Finite(double v) { return std::isfinite(v); }
 
-// Every key the search planner reads, by its config name (see config/planner.yaml). A pinned
-// deadline (PlannerConfig::PinDeadlines) reads as an infinite budget_ms / refine_budget_ms.
+// Every key the search planner reads, by its config name (see config/planner.yaml), and what it
+// takes from the road. A pinned deadline (PlannerConfig::PinDeadlines) reads as an infinite
+// budget_ms / refine_budget_ms.
 struct Settings {
   double max_speed, max_accel, max_jerk, d_min, d_max;  // m/s, m/s^2, m/s^3, m, m
+  // The road's: its typical lane width and its lane count (clamped to [1, cost::kMaxLanes]), and
+  // whether it is the Udacity layout (map::Road::uniform: d_min / d_max as the simulator reads
+  // d, the lane-line timer, outer_inset); on any other road the ego stays edge_margin inside
+  // its edges.
   double lane_width, outer_inset;
-  int num_lanes;  // clamped to [1, cost::kMaxLanes]
+  int num_lanes;
+  bool uniform_road;
+  double edge_margin;  // m
+  double ego_length, ego_width;  // m: the ego's footprint (check.car_* are the other cars')
   int keep_points, output_points;
   double resync_tolerance;
   int replan_min_ticks;
@@ -56,7 +65,9 @@ struct Settings {
   double fallback_decel, fallback_jerk, fallback_lat_duration;
   double budget_ms;
 
+  // On the configured uniform road (road.num_lanes x road.lane_width).
   explicit Settings(const PlannerConfig& c);
+  Settings(const PlannerConfig& c, const map::Road& road);
 };
 
 }  // namespace frenetic::plan::search

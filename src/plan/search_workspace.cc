@@ -8,9 +8,12 @@
 namespace frenetic::plan::search {
 
 Workspace::Workspace(const Settings& cfg) {
+  // The uniform road's lanes (another road's are read each cycle, BuildContext).
   for (int l = 0; l < cfg.num_lanes; ++l) {
     lane_nominal[l] = lane_center[l] = (l + 0.5) * cfg.lane_width;
+    lane_exists[l] = true;
   }
+  road_right = cfg.num_lanes * cfg.lane_width;
   if (cfg.num_lanes > 1) {
     lane_nominal[cfg.num_lanes - 1] -= cfg.outer_inset;
     lane_center[cfg.num_lanes - 1] -= cfg.outer_inset;
@@ -35,6 +38,12 @@ Workspace::Workspace(const Settings& cfg) {
   order.reserve(max_lon * max_lat);
   for (auto* v : {&car_s, &car_d, &car_v}) v->assign(kMaxCars * n_samples, 0.0);
   car_index.assign(kMaxCars, 0);
+  for (auto* v : {&car_hl, &car_hw, &car_sep_s, &car_sep_d}) v->assign(kMaxCars, 0.0);
+  const int edge_bins =
+      static_cast<int>(std::ceil((cfg.max_speed * std::max(cfg.check_horizon, cfg.score_horizon) +
+                                  kEdgeBehind + kEdgeAhead) / kEdgeBin)) + 2;
+  edge_lo.assign(edge_bins, 0.0);
+  edge_hi.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
   collision_step = std::max(1, static_cast<int>(std::lround(cfg.collision_dt / kTickSeconds)));

@@ -61,8 +61,18 @@ struct Workspace {
   int straddle_at_start = 0;
 
   // Context (BuildContext): the lanes and the traffic the costs read.
-  double lane_nominal[cost::kMaxLanes] = {};  // configured lane centres, m
+  double lane_nominal[cost::kMaxLanes] = {};  // the road's lane centres (uniform: fixed), m
   double lane_center[cost::kMaxLanes] = {};   // this cycle's (moved off the lane lines), m
+  bool lane_exists[cost::kMaxLanes] = {};     // the lane is there at the start's s
+  // The road's edges at the start (the lateral moves' range), m, and for the off-road check on
+  // a road that is not uniform, its edges over the stretch ahead: edge_lo / edge_hi[b] are the
+  // largest left and the smallest right edge over s in edge_s0 + [b, b + 1] * kEdgeBin (NaN
+  // where no lane exists), from kEdgeBehind m behind the start to kEdgeAhead m past the
+  // farthest the ego can get within the horizons.
+  double road_left = 0, road_right = 0;
+  static constexpr double kEdgeBin = 2.0, kEdgeBehind = 10.0, kEdgeAhead = 20.0;  // m
+  double edge_s0 = 0;
+  std::vector<double> edge_lo, edge_hi;
   cost::CostContext ctx;
   // Cars the hard checks test against: ctx.num_cars real ones, then the predictor's lane-change
   // ghosts (a hypothesis the plan must survive, not traffic the costs should weigh).
@@ -74,6 +84,12 @@ struct Workspace {
   // least 0.5.
   std::vector<double> car_s, car_d, car_v, car_s0, car_d0;
   std::vector<int> car_index;
+  // Per car: its half length and half width (m), and the ego's and its together (the
+  // separation of two aligned boxes' centres at contact: 0.5 ego_length + car_hl...).
+  std::vector<double> car_hl, car_hw, car_sep_s, car_sep_d;
+  // FirstCollision's broad reach along s (before margins) and across (m): 8 and 5 for the
+  // Udacity footprints, more with longer cars.
+  double reach_s_base = 8, reach_d = 5;
   std::vector<double> step_s, step_d, step_v, step_vd, step_dir_s, step_dir_d;
   double step_v_max = std::numeric_limits<double>::infinity();  // >= every step_v (inf: unknown)
   std::uint64_t traffic_stamp = 0;  // changes whenever the traffic arrays above are rewritten

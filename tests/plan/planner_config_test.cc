@@ -88,7 +88,7 @@ TEST(PlannerConfigTest, SetGetRangesAndRoundTrip) {
   EXPECT_TRUE(c->Set("weights.efficiency", 7.5).ok());
   EXPECT_DOUBLE_EQ(*c->Get("weights.efficiency"), 7.5);
   EXPECT_TRUE(c->Set("costs.buffer.headway", 2.0).ok());
-  Status bad = c->Set("limits.max_speed_mph", 80);
+  Status bad = c->Set("limits.max_speed_mph", 130);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.message().find("limits.max_speed_mph"), std::string::npos);
   Status unknown = c->Set("weights.nonsense", 1);

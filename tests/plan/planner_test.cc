@@ -189,7 +189,10 @@ TEST(PlannerFactoryTest, NamesAndErrors) {
   EXPECT_EQ(PlannerNames(), (std::vector<std::string>{"search", "baseline"}));
   EXPECT_STREQ(ToString(PlanStatus::kFallbackUsed), "fallback_used");
   EXPECT_STREQ(ToString(Reject::kCollision), "collision");
-  auto none = MakePlanner("search", PlannerConfig::Defaults(), nullptr);
+  auto none = MakePlanner("search", PlannerConfig::Defaults(),
+                          std::shared_ptr<const map::ReferenceLine>());
+  EXPECT_FALSE(none.ok());
+  none = MakePlanner("search", PlannerConfig::Defaults(), std::shared_ptr<const map::Road>());
   EXPECT_FALSE(none.ok());
   REQUIRE_MAP(line);
   auto bad = MakePlanner("teleport", Config(), line);

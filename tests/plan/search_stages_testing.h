@@ -59,6 +59,7 @@ struct Stages {
   explicit Stages(const PlannerConfig& c = DefaultConfig())
       : config(c),
         line(UdacityLine()),
+        road(ConfiguredRoad(c, line)),
         costs(*cost::CostSet::Build(config.cost_terms())),
         cfg(config),
         predictor(MakeConstantVelocityPredictor(line, PredictorOptions{})),
@@ -89,7 +90,7 @@ struct Stages {
     for (size_t i = 0; i < cars.size(); ++i) rows.push_back(Row(static_cast<int>(i), cars[i]));
     predictor->Observe(rows, start.s, NAN);
     clock.Start();
-    BuildContext(cfg, *line, *predictor, ws);
+    BuildContext(cfg, *road, *predictor, ws);
     const map::CartesianPose p = line->ToCartesian(start.s, start.d);
     prefix_x = p.x;
     prefix_y = p.y;
@@ -116,6 +117,7 @@ struct Stages {
 
   PlannerConfig config;
   std::shared_ptr<const map::ReferenceLine> line;
+  std::shared_ptr<const map::Road> road;
   std::shared_ptr<const cost::CostSet> costs;
   Settings cfg;
   std::unique_ptr<Predictor> predictor;

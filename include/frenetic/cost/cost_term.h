@@ -54,7 +54,20 @@ struct CostContext {
   const double* car_v = nullptr;
   // An upper bound of every car_v value (m/s; infinity when unknown): bounds broad-phase reaches.
   double max_car_speed = std::numeric_limits<double>::infinity();
-  double car_length = 4.8, car_width = 2.4;  // footprint of every car, ego included, m
+  double car_length = 4.8, car_width = 2.4;  // footprint of a car without its own, m
+  double ego_length = 4.8, ego_width = 2.4;  // the ego's footprint, m
+  // Per car (nullptr: car_length / 2 and car_width / 2 for every car): half its length and
+  // width, m. HalfLength / HalfWidth read them.
+  const double* car_half_length = nullptr;
+  const double* car_half_width = nullptr;
+  double HalfLength(int c) const {
+    return car_half_length != nullptr ? car_half_length[c] : 0.5 * car_length;
+  }
+  double HalfWidth(int c) const {
+    return car_half_width != nullptr ? car_half_width[c] : 0.5 * car_width;
+  }
+  // The largest HalfLength and HalfWidth of the cars (bounds for broad phases), m.
+  double max_half_length = 2.4, max_half_width = 1.2;
   // Reaches of the broad-phase masks in CostInput (m), tighter first: see NearCars.
   double near_lateral[2] = {0, 0};
   double near_longitudinal[2] = {0, 0};

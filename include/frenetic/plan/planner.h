@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
+#include "frenetic/map/road.h"
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
 
@@ -115,8 +116,17 @@ class PlannerConfig;  // plan/planner_config.h
 // Names accepted by MakePlanner: "search", "baseline".
 std::vector<std::string> PlannerNames();
 
-// Builds the named planner on a reference line with a validated configuration.
+// Builds the named planner on a road with a validated configuration. The `search` planner reads
+// the road's lanes (their number, borders, ends and speed limits); `baseline` (the seeds'
+// Udacity planner) reads only its line and the configured road.lane_width / road.num_lanes.
+StatusOr<std::unique_ptr<Planner>> MakePlanner(std::string_view name, const PlannerConfig& config,
+                                               std::shared_ptr<const map::Road> road);
+// The same on the configured uniform road (road.num_lanes lanes of road.lane_width from d = 0)
+// along `line`: the Udacity layout.
 StatusOr<std::unique_ptr<Planner>> MakePlanner(std::string_view name, const PlannerConfig& config,
                                                std::shared_ptr<const map::ReferenceLine> line);
+// That uniform road.
+std::shared_ptr<const map::Road> ConfiguredRoad(const PlannerConfig& config,
+                                                std::shared_ptr<const map::ReferenceLine> line);
 
 }  // namespace frenetic::plan

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
+#include "frenetic/map/road.h"
 #include "frenetic/plan/telemetry.h"
 
 namespace frenetic::plan {
@@ -27,6 +28,8 @@ struct TrackedCar {
   double d_target = 0;  // m: where a lateral move is predicted to end (= d when none)
   bool ghost = false;   // a lane change the car may start (PredictorOptions::lane_change_ghosts)
   double lat_delay = 0;  // s before a predicted lateral move starts
+  double length = 0, width = 0;  // footprint, m (the row's, else PredictorOptions' defaults)
+  bool recorded = false;  // predicted from its CarFuture
 };
 
 struct PredictorOptions {
@@ -39,8 +42,14 @@ struct PredictorOptions {
   double brake_threshold = 2.0;  // m/s^2: a car decelerating harder is predicted to keep braking
   double brake_horizon = 2.0;    // s: for at most this long (then constant speed, never < 0)
   double lateral_threshold = 0.5;  // m/s: a car moving across faster is changing lanes
-  double lane_width = 4.0;       // m, lanes [0, w), [w, 2w), ...; a lane change ends at a centre
+  // A lane change ends at the next lane centre: of lanes [0, w), [w, 2w), ... on a uniform road
+  // (the line-only factories build one from these two), else the road's lanes at the car's s.
+  double lane_width = 4.0;       // m
   int num_lanes = 3;
+  // The carriageway on a road that is not uniform: rows farther than this outside the road's
+  // edges at their s are dropped (on a uniform road d_min and d_max above rule).
+  double edge_slack = 1.0;  // m
+  double car_length = 4.8, car_width = 2.4;  // m: a row's footprint when it gives none
   // The simulator's traffic changes lane only while braking behind a leader (udacity-sim.md
   // §8.5): left from the middle lane, to the middle from the outer ones, when no car (nor the
   // ego) within 20 m of it in s is in that lane. With this on, every such car faster than
@@ -57,9 +66,13 @@ class Predictor {
   // Replaces the tracked set with the valid rows of `rows`, relative to the ego's line
   // coordinate `ego_s` (wrapped or not). `now` is the simulated time of the readings (s, any
   // origin, increasing between calls; NaN when unknown, e.g. after a resynchronisation): it
-  // dates the readings from which later calls estimate accelerations. Never fails: invalid rows
-  // are skipped.
-  virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now) = 0;
+  // dates the readings from which later calls estimate accelerations. A row with a CarFuture
+  // in `futures` (same id) is predicted from it (its first kMaxFutureSamples samples) instead.
+  // Never fails: invalid rows and future samples are skipped (a future with any non-finite
+  // sample is not used).
+  virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now,
+                       std::span<const CarFuture> futures = {}) = 0;
+  static constexpr int kMaxFutureSamples = 96;
   virtual std::span<const TrackedCar> cars() const = 0;
   // Predicted state of car i, t >= 0 seconds after the observation: s and d (m), speed along
   // the lane v (m/s) and lateral velocity v_d (m/s).
@@ -71,10 +84,15 @@ class Predictor {
 };
 
 // Constant speed along the lane, constant d.
-std::unique_ptr<Predictor> MakeConstantVelocityPredictor(
-    std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options);
+std::unique_ptr<Predictor> MakeConstantVelocityPredictor(std::shared_ptr<const map::Road> road,
+                                                         const PredictorOptions& options);
 // Constant velocity, except a braking car keeps braking for up to brake_horizon and a car moving
 // across lanes keeps its lateral velocity until it reaches the next lane centre.
+std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::Road> road,
+                                                  const PredictorOptions& options);
+// The same on a uniform road of options.num_lanes x options.lane_width along `line`.
+std::unique_ptr<Predictor> MakeConstantVelocityPredictor(
+    std::shared_ptr<const map::ReferenceLine> line, const PredictorOptions& options);
 std::unique_ptr<Predictor> MakeManoeuvrePredictor(std::shared_ptr<const map::ReferenceLine> line,
                                                   const PredictorOptions& options);
 

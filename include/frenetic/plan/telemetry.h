@@ -13,6 +13,19 @@ struct SensorCar {
   double x = 0, y = 0;
   double vx = 0, vy = 0;
   double s = 0, d = 0;
+  // Footprint, m: 0 (the Udacity simulator's rows) means the planner's check.car_length /
+  // check.car_width.
+  double length = 0, width = 0;
+};
+
+// A car's known future (a CommonRoad scenario's recorded trajectory, for `--prediction
+// recorded`): its centre, speed and heading every dt s from the telemetry's instant (sample 0)
+// on. The planner then uses it for that car instead of predicting it; past its last sample the
+// car keeps its last speed and heading.
+struct CarFuture {
+  int id = 0;      // the SensorCar it belongs to
+  double dt = 0.1;  // s
+  std::vector<double> x, y, v, heading;  // m, m, m/s, rad (counter-clockwise from +x)
 };
 
 struct Telemetry {
@@ -24,6 +37,8 @@ struct Telemetry {
   std::vector<double> previous_path_y;
   double end_path_s = 0, end_path_d = 0;  // simulator's Frenet of the last unvisited point (quirky)
   std::vector<SensorCar> sensor_fusion;
+  // Known futures of some sensor_fusion cars (empty from the Udacity simulator).
+  std::vector<CarFuture> futures;
 };
 
 }  // namespace frenetic::plan
