@@ -61,7 +61,11 @@ LonTraj Lattice::MakeLon(cost::LonKind kind, int lane, double param, double T, i
       // s_target = s_lead(T) - (D0 + tau v_lead(T)), minus `param` more.
       const Predictor::Prediction lead_at = predictor_.Predict(lead, ws_.t_keep + T);
       const double s_lead = ws_.start.s + lead_at.s;
-      const double target = s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param;
+      // follow_d0 is between the centres of two configured cars: longer ones need more.
+      const double longer = 0.5 * (predictor_.cars()[lead].length - cfg_.car_length) +
+                            0.5 * (cfg_.ego_length - cfg_.car_length);
+      const double target =
+          s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param - longer;
       l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_at.v, 0.0, T);
       break;
     }

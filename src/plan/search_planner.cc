@@ -424,7 +424,7 @@ class SearchPlanner : public Planner {
   }
 
   // The sensor rows plus, for every lane that ends ahead before the road does (a lane drop, an
-  // on-ramp's end), a car at rest just past its end: the lattice follows and stops for it, the
+  // on-ramp's end), a car at rest in its last metre: the lattice follows and stops for it, the
   // costs and checks see the lane as blocked there, as a driver sees a lane drop. Rows are
   // returned as they are on a road whose lanes never end.
   std::span<const SensorCar> WithLaneEnds(const std::vector<SensorCar>& rows, double start_s) {
@@ -438,14 +438,17 @@ class SearchPlanner : public Planner {
           end > start_s + kLaneEndRange) {
         continue;
       }
-      const map::Road::Span at = road_->LaneAt(l, end - kLaneEndSlack);
+      // The car fills the lane's last kLaneEndLength m (inside the road, where the predictor
+      // keeps it).
+      const double s_car = end - 0.5 * kLaneEndLength;
+      const map::Road::Span at = road_->LaneAt(l, s_car);
       if (!at.exists) continue;
-      const map::CartesianPose p = line_->ToCartesian(end + 0.5 * kLaneEndLength, at.centre());
+      const map::CartesianPose p = line_->ToCartesian(s_car, at.centre());
       SensorCar c;
       c.id = kLaneEndId - l;
       c.x = p.x;
       c.y = p.y;
-      c.s = end + 0.5 * kLaneEndLength;
+      c.s = s_car;
       c.d = at.centre();
       c.length = kLaneEndLength;
       c.width = std::max(at.width() - 0.2, 0.5);
