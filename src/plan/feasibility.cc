@@ -12,6 +12,7 @@ namespace {
 constexpr double kDt = 0.02;
 constexpr int kBlock = 10;  // ticks per acceleration sample (0.2 s)
 constexpr int kJerkBlocks = 5;  // acceleration samples per jerk sample (1 s)
+constexpr int kVehicleBlock = 5;  // ticks per VehicleLimits sample (0.1 s, CommonRoad's step)
 
 double Norm(double x, double y) { return std::sqrt(x * x + y * y); }
 
@@ -69,13 +70,43 @@ void MengerCurvatures(const double* x, const double* y, int first, int n, double
   }
 }
 
-XyChecker::XyChecker(int capacity) {
+XyChecker::XyChecker(int capacity, const VehicleLimits& vehicle) : vehicle_(vehicle) {
   for (auto* v : {&v_, &kappa_, &vsum_, &ksum_, &acc_, &asum_}) v->assign(capacity + 1, 0.0);
+  if (vehicle_.any()) ksigned_sum_.assign(capacity + 1, 0.0);
 }
 
 XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first) {
   n = Compute(x, y, n, 1);
   return n < 2 ? XyMeasure{} : Worst(n, first);
+}
+
+void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
+  const VehicleLimits& lim = vehicle_;
+  constexpr int b = kVehicleBlock;
+  constexpr double bt = b * kDt;
+  // Block means over ticks j-4..j: speed, and the signed curvature of the triples centred there.
+  auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - b]) / b; };
+  auto kmean = [&](int j) { return (ksigned_sum_[j + 1] - ksigned_sum_[j + 1 - b]) / b; };
+  auto steer = [&](int j) { return std::atan(lim.wheelbase * kmean(j)); };
+  // The last point's curvature is not known (0): blocks end at n - 2.
+  for (int j = std::max(b, first); j <= n - 2; ++j) {
+    if (lim.max_steer > 0) {
+      m->steer_ratio = std::max(m->steer_ratio, std::abs(steer(j)) / lim.max_steer);
+    }
+    if (j < 2 * b) continue;  // the rates need the block before (from tick 1 on)
+    if (lim.max_steer_rate > 0) {
+      const double rate = std::abs(steer(j) - steer(j - b)) / bt;
+      m->steer_rate_ratio = std::max(m->steer_rate_ratio, rate / lim.max_steer_rate);
+    }
+    if (lim.max_accel > 0) {
+      const double v0 = vmean(j - b), a = (vmean(j) - v0) / bt;
+      const double limit =
+          lim.switch_speed > 0 && v0 > lim.switch_speed ? lim.max_accel * lim.switch_speed / v0
+                                                         : lim.max_accel;
+      m->forward_accel_ratio = std::max(m->forward_accel_ratio, a / limit);
+    }
+  }
+  if (std::isnan(v_[n - 1])) m->steer_ratio = m->steer_rate_ratio = m->forward_accel_ratio = NAN;
 }
 
 void XyChecker::SetPrefix(const double* x, const double* y, int n) {
@@ -104,6 +135,18 @@ int XyChecker::Compute(const double* x, const double* y, int n, int from) {
   for (int i = std::max(0, from - 1); i < n; ++i) {
     vsum_[i + 1] = vsum_[i] + v_[i];
     ksum_[i + 1] = ksum_[i] + kappa_[i];
+  }
+  if (vehicle_.any()) {
+    // The curvature's sign (left positive) from the triple's cross product.
+    ksigned_sum_[0] = 0;
+    for (int i = std::max(0, from - 1); i < n; ++i) {
+      double k = kappa_[i];
+      if (i >= 1 && i + 1 < n) {
+        const double cross = (x[i] - x[i - 1]) * (y[i + 1] - y[i]) - (y[i] - y[i - 1]) * (x[i + 1] - x[i]);
+        if (cross < 0) k = -k;
+      }
+      ksigned_sum_[i + 1] = ksigned_sum_[i] + k;
+    }
   }
   auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock; };
   // Block ending at tick j holds ticks j-9..j; its triples are centred at j-8..j-1.
@@ -135,6 +178,7 @@ XyMeasure XyChecker::Worst(int n, int first) const {
     const double jerk = std::abs(now - before) / kJerkBlocks / (span * kDt);
     m.max_jerk = std::max(m.max_jerk, jerk);
   }
+  if (vehicle_.any()) WorstVehicle(n, first, &m);
   return m;
 }
 

@@ -55,7 +55,8 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
       line_(line),
       ws_(ws),
       xy_(kHistory + 64 + static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds)) +
-          cfg.output_points) {
+              cfg.output_points,
+          cfg.vehicle) {
   const int path_cap = kHistory + cfg.output_points + ws_.n_ticks + 8;
   chk_x_.assign(path_cap, 0.0);
   chk_y_.assign(path_cap, 0.0);
@@ -353,6 +354,13 @@ double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool
   take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
   take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
+  if (cfg_.vehicle.any()) {
+    // A vehicle's limits count as acceleration (steering angle: lateral; forward) and jerk
+    // (the steering rate) limits.
+    if (cfg_.vehicle.max_steer > 0) take(m.steer_ratio - 1.0, Reject::kAcceleration);
+    if (cfg_.vehicle.max_accel > 0) take(m.forward_accel_ratio - 1.0, Reject::kAcceleration);
+    if (cfg_.vehicle.max_steer_rate > 0) take(m.steer_rate_ratio - 1.0, Reject::kJerk);
+  }
   if (reason != nullptr) *reason = worst > 0 ? why : Reject::kCount;
   return worst;
 }

@@ -26,6 +26,11 @@ Settings::Settings(const PlannerConfig& c) {
   edge_margin = c.value("limits.edge_margin");
   ego_length = c.value("check.ego_length");
   ego_width = c.value("check.ego_width");
+  vehicle.wheelbase = c.value("vehicle.wheelbase");
+  vehicle.max_steer = c.value("vehicle.max_steer");
+  vehicle.max_steer_rate = c.value("vehicle.max_steer_rate");
+  vehicle.max_accel = c.value("vehicle.max_accel");
+  vehicle.switch_speed = c.value("vehicle.switch_speed");
   keep_points = c.int_value("continuity.keep_points");
   output_points = c.int_value("continuity.output_points");
   resync_tolerance = c.value("continuity.resync_tolerance");

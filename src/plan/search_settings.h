@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "frenetic/map/road.h"
+#include "frenetic/plan/feasibility.h"
 #include "frenetic/plan/planner_config.h"
 
 namespace frenetic::plan::search {
@@ -38,6 +39,7 @@ struct Settings {
   bool uniform_road;
   double edge_margin;  // m
   double ego_length, ego_width;  // m: the ego's footprint (check.car_* are the other cars')
+  VehicleLimits vehicle;  // vehicle.*: a real vehicle's steering and forward limits (0: none)
   int keep_points, output_points;
   double resync_tolerance;
   int replan_min_ticks;

@@ -16,6 +16,20 @@ struct XyLimits {
   double max_jerk = 9.0;      // m/s^3
 };
 
+// A real vehicle's kinematic limits, those of CommonRoad's single-track models (the Udacity
+// simulator has none): the steering angle delta = atan(wheelbase kappa) and its rate, and the
+// forward acceleration, a_max up to switch_speed and a_max switch_speed / v above it. Measured
+// on 0.1 s block means (speed, signed curvature) of the path, every alignment. A limit of 0 is
+// not measured.
+struct VehicleLimits {
+  double wheelbase = 0;       // m
+  double max_steer = 0;       // rad
+  double max_steer_rate = 0;  // rad/s
+  double max_accel = 0;       // m/s^2, forward
+  double switch_speed = 0;    // m/s
+  bool any() const { return max_steer > 0 || max_steer_rate > 0 || max_accel > 0; }
+};
+
 // The Menger curvature of three points as the simulator computes it, 2 sin(theta) / |p3 - p1|
 // (0 when a leg has no length, 1e6 for a reversal or a zero chord), and the same of every
 // triple (i - 1, i, i + 1) for i in [first, n - 1) into kappa[i]: bit for bit the same values
@@ -23,14 +37,16 @@ struct XyLimits {
 double MengerCurvature(double x1, double y1, double x2, double y2, double x3, double y3);
 void MengerCurvatures(const double* x, const double* y, int first, int n, double* kappa);
 
-// Worst values found (m/s, m/s^2, m/s^3).
+// Worst values found (m/s, m/s^2, m/s^3), and with VehicleLimits the worst ratio of each of
+// its measures to its limit (<= 1: within it; 0 when not measured).
 struct XyMeasure {
   double max_speed = 0, max_accel = 0, max_jerk = 0;
+  double steer_ratio = 0, steer_rate_ratio = 0, forward_accel_ratio = 0;
 };
 
 class XyChecker {
  public:
-  explicit XyChecker(int capacity = 1024);
+  explicit XyChecker(int capacity = 1024, const VehicleLimits& vehicle = {});
   // Worst speed, acceleration and jerk of the path (points 0.02 s apart) over all windows that
   // end at or after index `first`. Windows reaching before index 0 are skipped. Does not
   // allocate for n <= capacity (larger n is truncated to capacity). NaN points give NaN values.
@@ -46,8 +62,11 @@ class XyChecker {
   // entries are those of the same path; returns the path length used.
   int Compute(const double* x, const double* y, int n, int from);
   XyMeasure Worst(int n, int first) const;
+  void WorstVehicle(int n, int first, XyMeasure* m) const;
   int prefix_ = 0;
+  VehicleLimits vehicle_;
   std::vector<double> v_, kappa_, vsum_, ksum_, acc_, asum_;
+  std::vector<double> ksigned_sum_;  // prefix sums of the signed curvature (VehicleLimits)
 };
 
 // The simulator's own measure for tests: fixed blocks starting at tick `phase`, with
