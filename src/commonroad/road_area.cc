@@ -9,6 +9,10 @@
 
 #include "commonroad/boost_geometry.h"
 
+// Boost.Geometry 1.74's rescale policy (get_rescale_policy.hpp) trips GCC 12's
+// -Wmaybe-uninitialized once inlined into Build(); the value is set on every path that reads it.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
 namespace frenetic::commonroad {
 
 namespace bg = boost::geometry;
@@ -36,6 +40,35 @@ BoostMultiPolygon Buffered(const BoostPolygon& polygon, double distance) {
   return out;
 }
 
+// The quadrilateral that continues a lanelet beyond one end: `a` and `b` the bounds' end points,
+// `da` and `db` the bounds' directions there (unit vectors pointing away from the lanelet).
+std::vector<Vec2> EndExtension(Vec2 a, Vec2 da, Vec2 b, Vec2 db, double margin) {
+  return {a, a + margin * da, b + margin * db, b};
+}
+
+Vec2 Unit(Vec2 from, Vec2 to) {
+  const Vec2 d = to - from;
+  const double n = Norm(d);
+  return n > 0 ? (1.0 / n) * d : Vec2{};
+}
+
+// The rings that make up a lanelet's area: its polygon and the extensions of its open ends.
+std::vector<std::vector<Vec2>> LaneletRings(const Lanelet& lanelet, double open_end_margin) {
+  std::vector<std::vector<Vec2>> rings{lanelet.Polygon()};
+  const std::vector<Vec2> left = lanelet.CleanLeft(), right = lanelet.CleanRight();
+  if (open_end_margin <= 0 || left.size() < 2 || right.size() < 2) return rings;
+  if (lanelet.predecessors.empty()) {
+    rings.push_back(EndExtension(left[0], Unit(left[1], left[0]), right[0],
+                                 Unit(right[1], right[0]), open_end_margin));
+  }
+  if (lanelet.successors.empty()) {
+    const size_t l = left.size() - 1, r = right.size() - 1;
+    rings.push_back(EndExtension(left[l], Unit(left[l - 1], left[l]), right[r],
+                                 Unit(right[r - 1], right[r]), open_end_margin));
+  }
+  return rings;
+}
+
 }  // namespace
 
 struct RoadArea::Impl {
@@ -46,33 +79,40 @@ struct RoadArea::Impl {
 
 RoadArea::RoadArea() : impl_(std::make_shared<Impl>()) {}
 
-RoadArea RoadArea::Build(std::span<const Lanelet> lanelets, double tolerance) {
+RoadArea RoadArea::Build(std::span<const Lanelet> lanelets, double tolerance,
+                         double open_end_margin) {
   auto impl = std::make_shared<Impl>();
   tolerance = std::isfinite(tolerance) ? std::max(tolerance, 0.0) : 0.0;
+  open_end_margin = std::isfinite(open_end_margin) ? std::max(open_end_margin, 0.0) : 0.0;
   for (const Lanelet& lanelet : lanelets) {
-    const std::vector<Vec2> ring = lanelet.Polygon();
-    if (ring.size() < 3 || !std::all_of(ring.begin(), ring.end(), Finite)) {
-      impl->skipped.push_back(lanelet.id);
-      continue;
-    }
-    const BoostPolygon polygon = ToBoostPolygon(ring);
-    bool united = false;
-    // Boost.Geometry reports input it cannot handle with exceptions: fall back to the unbuffered
-    // polygon, then to leaving the lanelet out.
-    for (const double distance : {tolerance, 0.0}) {
-      try {
-        const BoostMultiPolygon grown = Buffered(polygon, distance);
-        if (grown.empty()) continue;
-        BoostMultiPolygon merged;
-        bg::union_(impl->area, grown, merged);
-        if (merged.empty()) continue;
-        impl->area = std::move(merged);
-        united = true;
-        break;
-      } catch (const std::exception&) {
+    bool lanelet_ok = true;
+    for (const std::vector<Vec2>& ring : LaneletRings(lanelet, open_end_margin)) {
+      if (ring.size() < 3 || !std::all_of(ring.begin(), ring.end(), Finite)) {
+        lanelet_ok = false;
+        continue;
       }
+      // A degenerate extension (a lane that ends in a point) adds nothing.
+      const BoostPolygon polygon = ToBoostPolygon(ring);
+      if (std::abs(bg::area(polygon)) < 1e-9) continue;
+      bool united = false;
+      // Boost.Geometry reports input it cannot handle with exceptions: fall back to the
+      // unbuffered polygon, then to leaving the ring out.
+      for (const double distance : {tolerance, 0.0}) {
+        try {
+          const BoostMultiPolygon grown = Buffered(polygon, distance);
+          if (grown.empty()) continue;
+          BoostMultiPolygon merged;
+          bg::union_(impl->area, grown, merged);
+          if (merged.empty()) continue;
+          impl->area = std::move(merged);
+          united = true;
+          break;
+        } catch (const std::exception&) {
+        }
+      }
+      lanelet_ok = lanelet_ok && united;
     }
-    if (!united) impl->skipped.push_back(lanelet.id);
+    if (!lanelet_ok) impl->skipped.push_back(lanelet.id);
   }
   for (BoostPolygon& p : impl->area) {
     auto& inners = p.inners();

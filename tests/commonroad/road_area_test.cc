@@ -38,13 +38,19 @@ TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {
   // A 2 m wide box whose left side is 1 cm beyond the bound: on the road; 3 cm: off.
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, 1.01}, 0, 4, 2)));
   EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 1.03}, 0, 4, 2)));
-  // Beyond the lanelet's end.
-  EXPECT_TRUE(road.ContainsConvex(BoxCorners({97.5, 0}, 0, 4, 2)));
-  EXPECT_FALSE(road.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
+  // Across the lanelet's open end, up to the margin.
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({103, 0}, 0, 4, 2)));
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({103.1, 0}, 0, 4, 2)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({-2.5, 0}, 0, 4, 2)));  // across the start
+  // Closed ends.
+  const RoadArea closed = RoadArea::Build(lane, 0.02, 0.0);
+  EXPECT_TRUE(closed.ContainsConvex(BoxCorners({97.5, 0}, 0, 4, 2)));
+  EXPECT_FALSE(closed.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
   // Entirely outside.
   EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 10}, 0, 4, 2)));
   EXPECT_TRUE(road.Contains({1, 1}));
-  EXPECT_FALSE(road.Contains({-1, 1}));
+  EXPECT_FALSE(road.Contains({-6, 1}));  // beyond the open start's margin
 }
 
 TEST(RoadAreaTest, AnOncomingLaneIsRoad) {
@@ -56,16 +62,16 @@ TEST(RoadAreaTest, AnOncomingLaneIsRoad) {
                                       Make(2, left, right)};
   const RoadArea road = RoadArea::Build(lanes);
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, -1.75}, 0, 4.5, 1.8)));
-  EXPECT_NEAR(road.Area(), 700 + 214 * 0.02, 0.01);  // grown by the tolerance all round
+  EXPECT_NEAR(RoadArea::Build(lanes, 0.02, 0).Area(), 700 + 214 * 0.02, 0.01);  // grown all round
 }
 
 TEST(RoadAreaTest, ALargeHoleIsKept) {
-  // Four lanes around a 10 m x 10 m island.
+  // Four lanes around a 10 m x 10 m island (closed ends: the lanes end in each other).
   const std::vector<Lanelet> ring = {Make(1, Line(0, 20, 5), Line(0, 20, 0)),
                                      Make(2, Line(0, 20, 20), Line(0, 20, 15)),
                                      Make(3, {{5, 5}, {5, 15}}, {{0, 5}, {0, 15}}),
                                      Make(4, {{20, 5}, {20, 15}}, {{15, 5}, {15, 15}})};
-  const RoadArea road = RoadArea::Build(ring);
+  const RoadArea road = RoadArea::Build(ring, 0.02, 0.0);
   EXPECT_EQ(road.PolygonCount(), 1);
   EXPECT_EQ(road.HoleCount(), 1);
   EXPECT_FALSE(road.Contains({10, 10}));

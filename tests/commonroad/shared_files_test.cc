@@ -99,11 +99,14 @@ TEST(SharedFilesTest, EveryExampleIsReadWithTheExpectedContents) {
         EXPECT_EQ(o.trajectory[i].time_step, static_cast<int>(i) + 1);
       }
     }
-    // The road is one piece without gaps between its lanelets.
+    // The road is one piece without gaps between its lanelets. (With its open ends extended,
+    // DEU_Hhr-1_1's network encloses one area.)
     const RoadArea road = RoadArea::Build(s->lanelets);
     EXPECT_EQ(road.PolygonCount(), 1);
-    EXPECT_EQ(road.HoleCount(), 0);
     EXPECT_TRUE(road.SkippedLanelets().empty());
+    const RoadArea closed = RoadArea::Build(s->lanelets, RoadArea::kDefaultTolerance, 0.0);
+    EXPECT_EQ(closed.PolygonCount(), 1);
+    EXPECT_EQ(closed.HoleCount(), 0);
     for (const PlanningProblem& p : s->problems) EXPECT_TRUE(road.Contains(p.initial.position));
   }
 }

@@ -11,6 +11,13 @@
 // given point for point leave slivers up to ~2 cm wide between them (the US-101 and DEU_Muc
 // examples), and a car straddling the lane line there is on the road. So a box counts as on the
 // road when it sticks out over the road's edge by at most `tolerance`.
+//
+// Open ends: a lanelet without predecessors is extended backwards, one without successors forwards,
+// by `open_end_margin` along its bounds' end directions, so a car may stand across the road's start
+// or end (ZAM_Ramp-1_1-T-1's ego starts at rest with its rear half behind the road's start). The
+// drivability checker's obb_rectangles road boundary leaves these ends open
+// (construct_boundary_obstacle_obb_rectangles, open_lane_ends=True); the triangulated boundary its
+// solution checker builds appears to close them, which would fail that ramp scenario at step 0.
 #pragma once
 
 #include <memory>
@@ -23,14 +30,16 @@ namespace frenetic::commonroad {
 
 class RoadArea {
  public:
-  static constexpr double kDefaultTolerance = 0.02;  // m
+  static constexpr double kDefaultTolerance = 0.02;      // m
+  static constexpr double kDefaultOpenEndMargin = 5.0;   // m
 
   // An empty area (contains nothing).
   RoadArea();
   // The union of the lanelets' polygons as described above. Never fails: a lanelet whose polygon
   // Boost.Geometry cannot buffer (e.g. a bound that folds back on itself) is taken unbuffered, and
   // one it cannot unite at all is left out and listed in SkippedLanelets().
-  static RoadArea Build(std::span<const Lanelet> lanelets, double tolerance = kDefaultTolerance);
+  static RoadArea Build(std::span<const Lanelet> lanelets, double tolerance = kDefaultTolerance,
+                        double open_end_margin = kDefaultOpenEndMargin);
 
   // True when the convex polygon (e.g. BoxCorners of the ego) lies inside the area: no boundary
   // segment of the area touches it and its vertex mean is inside.
