@@ -159,6 +159,7 @@ struct BadSolution {
   std::string at;        // text on the line the error names
   std::string message;
 };
+void PrintTo(const BadSolution& c, std::ostream* os) { *os << c.name; }
 
 class BadSolutionTest : public ::testing::TestWithParam<BadSolution> {};
 
