@@ -1,0 +1,360 @@
+#include "frenetic/commonroad/verdict.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "frenetic/check.h"
+
+namespace frenetic::commonroad {
+
+const char* ToString(FailureKind kind) {
+  switch (kind) {
+    case FailureKind::kTrajectory: return "trajectory";
+    case FailureKind::kStart: return "start";
+    case FailureKind::kGoal: return "goal";
+    case FailureKind::kCollision: return "collision";
+    case FailureKind::kOffRoad: return "off_road";
+    case FailureKind::kSteeringAngle: return "steering_angle";
+    case FailureKind::kSteeringRate: return "steering_rate";
+    case FailureKind::kVelocity: return "velocity";
+    case FailureKind::kAcceleration: return "acceleration";
+    case FailureKind::kFrictionCircle: return "friction_circle";
+    case FailureKind::kDynamics: return "dynamics";
+  }
+  return "unknown";
+}
+
+const Failure* Verdict::Find(FailureKind kind) const {
+  for (const Failure& f : failures) {
+    if (f.kind == kind) return &f;
+  }
+  return nullptr;
+}
+
+std::string Verdict::Summary() const {
+  std::string out;
+  if (solved) {
+    out = "solved: goal at step " + std::to_string(*goal_step);
+    return out;
+  }
+  out = "failed:";
+  for (size_t i = 0; i < failures.size(); ++i) {
+    const Failure& f = failures[i];
+    out += (i ? "; " : " ") + std::string(ToString(f.kind)) + " at step " +
+           std::to_string(f.step) + " (" + f.detail + ")";
+  }
+  return out;
+}
+
+Status VerdictOptions::Validate() const {
+  const struct {
+    const char* name;
+    double value;
+  } values[] = {{"road_tolerance", road_tolerance},
+                {"open_end_margin", open_end_margin},
+                {"position_tolerance", position_tolerance},
+                {"orientation_tolerance", orientation_tolerance},
+                {"limit_tolerance", limit_tolerance},
+                {"start_position_tolerance", start_position_tolerance},
+                {"start_orientation_tolerance", start_orientation_tolerance},
+                {"start_velocity_tolerance", start_velocity_tolerance}};
+  for (const auto& v : values) {
+    if (!std::isfinite(v.value) || v.value < 0) {
+      return Status::Error(std::string("verdict option ") + v.name +
+                           " must be finite and >= 0");
+    }
+  }
+  if (integration_substeps < 1 || integration_substeps > 10000) {
+    return Status::Error("verdict option integration_substeps must be in [1, 10000]");
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+std::string Fmt(const char* format, double a, double b = 0, double c = 0, double d = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c, d);
+  return buffer;
+}
+
+bool Finite(const KsState& s) {
+  return std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.steering_angle) &&
+         std::isfinite(s.velocity) && std::isfinite(s.orientation);
+}
+
+// Which parts of a goal state a state meets.
+struct GoalParts {
+  bool time = true, position = true, velocity = true, orientation = true;
+  int Count() const { return time + position + velocity + orientation; }
+  bool All() const { return Count() == 4; }
+};
+
+GoalParts EvaluateGoal(const GoalState& goal, const KsState& s,
+                       const std::map<int, std::vector<Vec2>>& lanelet_polygons) {
+  GoalParts parts;
+  if (goal.time) parts.time = goal.time->Contains(s.time_step);
+  if (goal.HasPosition()) {
+    const Vec2 p{s.x, s.y};
+    parts.position = std::any_of(goal.shapes.begin(), goal.shapes.end(),
+                                 [&](const Shape& shape) { return shape.Contains(p); });
+    for (int id : goal.lanelets) {
+      if (parts.position) break;
+      const auto it = lanelet_polygons.find(id);
+      parts.position = it != lanelet_polygons.end() && PolygonContains(it->second, p);
+    }
+  }
+  if (goal.velocity) parts.velocity = goal.velocity->Contains(s.velocity);
+  if (goal.orientation) {
+    parts.orientation =
+        AngleInInterval(s.orientation, goal.orientation->start, goal.orientation->end);
+  }
+  return parts;
+}
+
+std::map<int, std::vector<Vec2>> GoalLaneletPolygons(const Scenario& scenario,
+                                                     std::span<const GoalState> goals) {
+  std::map<int, std::vector<Vec2>> polygons;
+  for (const GoalState& g : goals) {
+    for (int id : g.lanelets) {
+      if (polygons.count(id)) continue;
+      if (const Lanelet* l = scenario.FindLanelet(id)) polygons[id] = l->Polygon();
+    }
+  }
+  return polygons;
+}
+
+// Why no state met a goal: per goal state, the parts missing at the step that met the most.
+std::string GoalMissDetail(std::span<const GoalState> goals, std::span<const KsState> traj,
+                           const std::map<int, std::vector<Vec2>>& polygons) {
+  std::string out = "no state meets a goal state";
+  for (size_t g = 0; g < goals.size() && g < 3; ++g) {
+    const GoalState& goal = goals[g];
+    size_t best = 0;
+    GoalParts best_parts = EvaluateGoal(goal, traj[0], polygons);
+    for (size_t i = 1; i < traj.size(); ++i) {
+      const GoalParts parts = EvaluateGoal(goal, traj[i], polygons);
+      if (parts.Count() > best_parts.Count()) {
+        best = i;
+        best_parts = parts;
+      }
+    }
+    const KsState& s = traj[best];
+    out += "; goal " + std::to_string(g) + " closest at step " + std::to_string(s.time_step) +
+           ":";
+    if (!best_parts.time) {
+      out += " time not in [" + std::to_string(goal.time->start) + ", " +
+             std::to_string(goal.time->end) + "]";
+    }
+    if (!best_parts.position) out += Fmt(" position (%.2f, %.2f) outside the region", s.x, s.y);
+    if (!best_parts.velocity) {
+      out += Fmt(" velocity %.2f m/s not in [%.2f, %.2f]", s.velocity, goal.velocity->start,
+                 goal.velocity->end);
+    }
+    if (!best_parts.orientation) {
+      out += Fmt(" orientation %.3f rad not in [%.3f, %.3f]", s.orientation,
+                 goal.orientation->start, goal.orientation->end);
+    }
+  }
+  if (goals.size() > 3) out += "; ...";
+  return out;
+}
+
+}  // namespace
+
+bool MeetsGoal(const Scenario& scenario, const GoalState& goal, const KsState& state) {
+  return EvaluateGoal(goal, state, GoalLaneletPolygons(scenario, {&goal, 1})).All();
+}
+
+VerdictChecker::VerdictChecker(const Scenario& scenario, const VehicleParams& vehicle,
+                               const VerdictOptions& options)
+    : scenario_(&scenario),
+      vehicle_(vehicle),
+      options_(options),
+      road_(RoadArea::Build(scenario.lanelets, options.road_tolerance, options.open_end_margin)) {
+  FRENETIC_CHECK(options.Validate().ok());
+}
+
+Verdict VerdictChecker::Check(const PlanningProblem& problem,
+                              std::span<const KsState> trajectory) const {
+  Verdict verdict;
+  verdict.problem_id = problem.id;
+  std::vector<Failure> found;
+  std::vector<bool> have(static_cast<int>(FailureKind::kDynamics) + 1, false);
+  const auto fail = [&](FailureKind kind, int step, std::string detail,
+                        std::optional<int> obstacle = std::nullopt) {
+    if (have[static_cast<int>(kind)]) return;
+    have[static_cast<int>(kind)] = true;
+    found.push_back({kind, step, std::move(detail), obstacle});
+  };
+  const auto finish = [&]() {
+    std::stable_sort(found.begin(), found.end(), [](const Failure& a, const Failure& b) {
+      return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+    });
+    verdict.failures = std::move(found);
+    verdict.solved = verdict.goal_step.has_value() && verdict.failures.empty();
+    return verdict;
+  };
+
+  // The trajectory itself; the other checks see its valid prefix.
+  if (trajectory.empty()) {
+    fail(FailureKind::kTrajectory, problem.initial.time_step, "the trajectory has no state");
+    fail(FailureKind::kGoal, problem.initial.time_step, "the trajectory has no state");
+    return finish();
+  }
+  size_t valid = trajectory.size();
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    const KsState& s = trajectory[i];
+    if (!Finite(s)) {
+      fail(FailureKind::kTrajectory, s.time_step, "a value is not finite");
+      valid = i;
+      break;
+    }
+    if (i > 0 && s.time_step != trajectory[i - 1].time_step + 1) {
+      fail(FailureKind::kTrajectory, s.time_step,
+           "time step " + std::to_string(s.time_step) + " follows step " +
+               std::to_string(trajectory[i - 1].time_step));
+      valid = i;
+      break;
+    }
+  }
+  const std::span<const KsState> traj = trajectory.first(valid);
+  if (traj.empty()) {
+    fail(FailureKind::kGoal, problem.initial.time_step, "no valid state");
+    return finish();
+  }
+
+  // Start.
+  const KsState& s0 = traj.front();
+  const State& init = problem.initial;
+  if (s0.time_step != init.time_step) {
+    fail(FailureKind::kStart, s0.time_step,
+         "starts at step " + std::to_string(s0.time_step) + ", the problem at step " +
+             std::to_string(init.time_step));
+  } else if (std::abs(s0.x - init.position.x) > options_.start_position_tolerance ||
+             std::abs(s0.y - init.position.y) > options_.start_position_tolerance) {
+    fail(FailureKind::kStart, s0.time_step,
+         Fmt("starts at (%.3f, %.3f), the problem at (%.3f, %.3f)", s0.x, s0.y,
+             init.position.x, init.position.y));
+  } else if (init.orientation &&
+             std::abs(WrapAngle(s0.orientation - *init.orientation)) >
+                 options_.start_orientation_tolerance) {
+    fail(FailureKind::kStart, s0.time_step,
+         Fmt("starts with orientation %.4f rad, the problem with %.4f rad", s0.orientation,
+             *init.orientation));
+  } else if (init.velocity &&
+             std::abs(s0.velocity - *init.velocity) > options_.start_velocity_tolerance) {
+    fail(FailureKind::kStart, s0.time_step,
+         Fmt("starts at %.3f m/s, the problem at %.3f m/s", s0.velocity, *init.velocity));
+  }
+
+  // Goal.
+  const auto polygons = GoalLaneletPolygons(*scenario_, problem.goals);
+  for (const KsState& s : traj) {
+    const bool met = std::any_of(problem.goals.begin(), problem.goals.end(),
+                                 [&](const GoalState& g) {
+                                   return EvaluateGoal(g, s, polygons).All();
+                                 });
+    if (met) {
+      verdict.goal_step = s.time_step;
+      break;
+    }
+  }
+  if (!verdict.goal_step) {
+    fail(FailureKind::kGoal, traj.back().time_step,
+         GoalMissDetail(problem.goals, traj, polygons));
+  }
+
+  // Collision and road, per state.
+  const VehicleParams& p = vehicle_;
+  const double ego_radius = std::hypot(p.length, p.width) / 2;
+  for (const KsState& s : traj) {
+    const Vec2 center{s.x, s.y};
+    const auto box = BoxCorners(center, s.orientation, p.length, p.width);
+    if (!have[static_cast<int>(FailureKind::kCollision)]) {
+      for (const Obstacle& o : scenario_->obstacles) {
+        const std::optional<State> state = o.StateAt(s.time_step);
+        if (!state) continue;
+        const ShapeGroup occupancy =
+            o.shape.Transformed(state->position, state->orientation.value_or(0.0));
+        const bool near = std::any_of(
+            occupancy.shapes.begin(), occupancy.shapes.end(), [&](const Shape& shape) {
+              return Distance(shape.Centroid(), center) <= ego_radius + shape.BoundingRadius();
+            });
+        if (near && occupancy.Overlaps(box)) {
+          fail(FailureKind::kCollision, s.time_step,
+               "the ego overlaps obstacle " + std::to_string(o.id) + " (" + o.type +
+                   Fmt(") at (%.2f, %.2f)", state->position.x, state->position.y),
+               o.id);
+          break;
+        }
+      }
+    }
+    if (!have[static_cast<int>(FailureKind::kOffRoad)] && !road_.ContainsConvex(box)) {
+      fail(FailureKind::kOffRoad, s.time_step,
+           Fmt("the ego's box at (%.2f, %.2f), orientation %.3f rad, leaves the lanelets",
+               s.x, s.y, s.orientation));
+    }
+  }
+
+  // Kinematic limits and the KS model.
+  const double tol = options_.limit_tolerance;
+  const double dt = scenario_->dt;
+  for (size_t i = 0; i < traj.size(); ++i) {
+    const KsState& s = traj[i];
+    if (s.steering_angle < p.steering_min - tol || s.steering_angle > p.steering_max + tol) {
+      fail(FailureKind::kSteeringAngle, s.time_step,
+           Fmt("steering angle %.4f rad outside [%.3f, %.3f]", s.steering_angle,
+               p.steering_min, p.steering_max));
+    }
+    if (s.velocity < p.v_min - tol || s.velocity > p.v_max + tol) {
+      fail(FailureKind::kVelocity, s.time_step,
+           Fmt("velocity %.3f m/s outside [%.2f, %.2f]", s.velocity, p.v_min, p.v_max));
+    }
+    if (i + 1 == traj.size()) break;
+    const KsState& n = traj[i + 1];
+    const KsInput u{(n.steering_angle - s.steering_angle) / dt, (n.velocity - s.velocity) / dt};
+    if (u.steering_rate < p.steering_rate_min - tol ||
+        u.steering_rate > p.steering_rate_max + tol) {
+      fail(FailureKind::kSteeringRate, s.time_step,
+           Fmt("steering rate %.4f rad/s to step %.0f outside [%.2f, %.2f]", u.steering_rate,
+               n.time_step, p.steering_rate_min, p.steering_rate_max));
+    }
+    const double a_limit = p.MaxAcceleration(s.velocity);
+    if (u.acceleration < -p.a_max - tol || u.acceleration > a_limit + tol) {
+      fail(FailureKind::kAcceleration, s.time_step,
+           Fmt("acceleration %.3f m/s^2 at %.2f m/s outside [%.2f, %.3f]", u.acceleration,
+               s.velocity, -p.a_max, a_limit));
+    }
+    const double lateral = s.velocity * s.velocity / p.Wheelbase() * std::tan(s.steering_angle);
+    if (std::hypot(u.acceleration, lateral) > p.a_max + tol) {
+      fail(FailureKind::kFrictionCircle, s.time_step,
+           Fmt("longitudinal %.3f and lateral %.3f m/s^2 exceed a_max %.2f m/s^2",
+               u.acceleration, lateral, p.a_max));
+    }
+    if (!have[static_cast<int>(FailureKind::kDynamics)]) {
+      const KsState sim = SimulateKs(s, u, dt, p, options_.integration_substeps);
+      const Vec2 rear_sim = RearAxle(sim, p), rear_next = RearAxle(n, p);
+      const double ex = std::abs(rear_sim.x - rear_next.x);
+      const double ey = std::abs(rear_sim.y - rear_next.y);
+      const double epsi = std::abs(WrapAngle(sim.orientation - n.orientation));
+      if (ex > options_.position_tolerance || ey > options_.position_tolerance ||
+          epsi > options_.orientation_tolerance) {
+        fail(FailureKind::kDynamics, s.time_step,
+             Fmt("one KS step from here misses step %.0f by %.3f m (x), %.3f m (y), %.4f rad",
+                 n.time_step, ex, ey, epsi));
+      }
+    }
+  }
+  return finish();
+}
+
+Verdict CheckTrajectory(const Scenario& scenario, const PlanningProblem& problem,
+                        const VehicleParams& vehicle, std::span<const KsState> trajectory,
+                        const VerdictOptions& options) {
+  return VerdictChecker(scenario, vehicle, options).Check(problem, trajectory);
+}
+
+}  // namespace frenetic::commonroad

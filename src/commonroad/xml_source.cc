@@ -1,0 +1,158 @@
+#include "commonroad/xml_source.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace frenetic::commonroad {
+
+namespace {
+
+std::string_view Trim(std::string_view s) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  while (!s.empty() && space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// Element text shortened for a message (a mangled file may hold anything there).
+std::string Quote(std::string_view text) {
+  std::string out;
+  for (char c : text.substr(0, 40)) out += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;
+  if (text.size() > 40) out += "...";
+  return "'" + out + "'";
+}
+
+}  // namespace
+
+std::optional<double> ParseFiniteDouble(std::string_view text) {
+  text = Trim(text);
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  if (text.empty()) return std::nullopt;
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v)) {
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<int> ParseInt(std::string_view text) {
+  text = Trim(text);
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  if (text.empty()) return std::nullopt;
+  int v = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || ptr != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+XmlSource::XmlSource(std::string_view text, std::string_view source)
+    : text_(text), source_(source) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') line_starts_.push_back(i + 1);
+  }
+}
+
+Status XmlSource::Parse(pugi::xml_document* doc) const {
+  const pugi::xml_parse_result result =
+      doc->load_buffer(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
+  if (result) return Status::Ok();
+  const size_t offset = result.offset < 0 ? 0 : static_cast<size_t>(result.offset);
+  const int line =
+      1 + static_cast<int>(std::upper_bound(line_starts_.begin(), line_starts_.end(), offset) -
+                           line_starts_.begin());
+  return Status::Error(source_ + ":" + std::to_string(line) + ": XML syntax error: " +
+                       result.description());
+}
+
+int XmlSource::Line(const pugi::xml_node& node) const {
+  const ptrdiff_t offset = node.offset_debug();
+  if (offset < 0) return 0;
+  return 1 + static_cast<int>(std::upper_bound(line_starts_.begin(), line_starts_.end(),
+                                               static_cast<size_t>(offset)) -
+                              line_starts_.begin());
+}
+
+std::string XmlSource::Path(const pugi::xml_node& node) const {
+  std::vector<std::string> parts;
+  for (pugi::xml_node n = node; n && n.type() == pugi::node_element && n.parent() &&
+                                n.parent().type() == pugi::node_element;
+       n = n.parent()) {
+    std::string part = n.name();
+    if (const pugi::xml_attribute id = n.attribute("id")) part += std::string(" ") + id.value();
+    parts.push_back(std::move(part));
+  }
+  if (parts.empty()) return node.type() == pugi::node_element ? node.name() : "document";
+  std::string path;
+  for (auto it = parts.rbegin(); it != parts.rend(); ++it) {
+    if (!path.empty()) path += "/";
+    path += *it;
+  }
+  return path;
+}
+
+Status XmlSource::Error(const pugi::xml_node& node, std::string_view message) const {
+  std::string text = source_ + ":" + std::to_string(Line(node)) + ": " + Path(node) + ": ";
+  text += message;
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return Status::Error(std::move(text));
+}
+
+Status XmlSource::Child(const pugi::xml_node& node, const char* name, pugi::xml_node* out) const {
+  *out = node.child(name);
+  if (!*out) return Error(node, std::string("missing <") + name + ">");
+  return Status::Ok();
+}
+
+Status XmlSource::Number(const pugi::xml_node& node, double* out) const {
+  const char* text = node.child_value();
+  const std::optional<double> v = ParseFiniteDouble(text);
+  if (!v) return Error(node, Quote(text) + " is not a finite number");
+  *out = *v;
+  return Status::Ok();
+}
+
+Status XmlSource::Integer(const pugi::xml_node& node, int* out) const {
+  const char* text = node.child_value();
+  const std::optional<int> v = ParseInt(text);
+  if (!v) return Error(node, Quote(text) + " is not an integer");
+  *out = *v;
+  return Status::Ok();
+}
+
+Status XmlSource::ChildNumber(const pugi::xml_node& node, const char* name, double* out) const {
+  pugi::xml_node child;
+  FRENETIC_CR_TRY(Child(node, name, &child));
+  return Number(child, out);
+}
+
+Status XmlSource::AttrInt(const pugi::xml_node& node, const char* name, int* out) const {
+  const pugi::xml_attribute a = node.attribute(name);
+  if (!a) return Error(node, std::string("missing attribute ") + name);
+  const std::optional<int> v = ParseInt(a.value());
+  if (!v) return Error(node, std::string("attribute ") + name + " " + Quote(a.value()) +
+                                 " is not an integer");
+  *out = *v;
+  return Status::Ok();
+}
+
+Status XmlSource::AttrNumber(const pugi::xml_node& node, const char* name, double* out) const {
+  const pugi::xml_attribute a = node.attribute(name);
+  if (!a) return Error(node, std::string("missing attribute ") + name);
+  const std::optional<double> v = ParseFiniteDouble(a.value());
+  if (!v) return Error(node, std::string("attribute ") + name + " " + Quote(a.value()) +
+                                 " is not a finite number");
+  *out = *v;
+  return Status::Ok();
+}
+
+Status XmlSource::AttrString(const pugi::xml_node& node, const char* name,
+                             std::string* out) const {
+  const pugi::xml_attribute a = node.attribute(name);
+  if (!a) return Error(node, std::string("missing attribute ") + name);
+  *out = a.value();
+  return Status::Ok();
+}
+
+}  // namespace frenetic::commonroad

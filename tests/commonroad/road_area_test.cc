@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include "commonroad/scenario_xml.h"
+#include "frenetic/commonroad/road_area.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+using testing::Line;
+
+Lanelet Make(int id, std::vector<Vec2> left, std::vector<Vec2> right) {
+  Lanelet l;
+  l.id = id;
+  l.left = std::move(left);
+  l.right = std::move(right);
+  return l;
+}
+
+TEST(RoadAreaTest, TwoLanesWithASliverBetweenThemAreOneRoad) {
+  // The left lane's right bound sits 1.5 cm above the right lane's left bound.
+  const std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
+                                      Make(2, Line(0, 100, 3.515), Line(0, 100, 0.015))};
+  const RoadArea road = RoadArea::Build(lanes);
+  EXPECT_EQ(road.PolygonCount(), 1);
+  EXPECT_EQ(road.HoleCount(), 0);
+  // A car straddling the lane line is on the road.
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
+  // Without the tolerance the sliver splits the road.
+  const RoadArea strict = RoadArea::Build(lanes, 0.0);
+  EXPECT_EQ(strict.PolygonCount(), 2);
+  EXPECT_FALSE(strict.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
+}
+
+TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {
+  const std::vector<Lanelet> lane = {Make(1, Line(0, 100, 2), Line(0, 100, -2))};
+  const RoadArea road = RoadArea::Build(lane, 0.02);
+  EXPECT_DOUBLE_EQ(road.tolerance(), 0.02);
+  // A 2 m wide box whose left side is 1 cm beyond the bound: on the road; 3 cm: off.
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, 1.01}, 0, 4, 2)));
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 1.03}, 0, 4, 2)));
+  // Across the lanelet's open end, up to the margin.
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({103, 0}, 0, 4, 2)));
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({103.1, 0}, 0, 4, 2)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({-2.5, 0}, 0, 4, 2)));  // across the start
+  // Closed ends.
+  const RoadArea closed = RoadArea::Build(lane, 0.02, 0.0);
+  EXPECT_TRUE(closed.ContainsConvex(BoxCorners({97.5, 0}, 0, 4, 2)));
+  EXPECT_FALSE(closed.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
+  // Entirely outside.
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 10}, 0, 4, 2)));
+  EXPECT_TRUE(road.Contains({1, 1}));
+  EXPECT_FALSE(road.Contains({-6, 1}));  // beyond the open start's margin
+}
+
+TEST(RoadAreaTest, AnOncomingLaneIsRoad) {
+  // Lanelet 2 runs the other way (its bounds from x = 100 to 0).
+  std::vector<Vec2> left = Line(0, 100, -3.5), right = Line(0, 100, 0);
+  std::reverse(left.begin(), left.end());
+  std::reverse(right.begin(), right.end());
+  const std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 3.5), Line(0, 100, 0)),
+                                      Make(2, left, right)};
+  const RoadArea road = RoadArea::Build(lanes);
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, -1.75}, 0, 4.5, 1.8)));
+  EXPECT_NEAR(RoadArea::Build(lanes, 0.02, 0).Area(), 700 + 214 * 0.02, 0.01);  // grown all round
+}
+
+TEST(RoadAreaTest, ALargeHoleIsKept) {
+  // Four lanes around a 10 m x 10 m island (closed ends: the lanes end in each other).
+  const std::vector<Lanelet> ring = {Make(1, Line(0, 20, 5), Line(0, 20, 0)),
+                                     Make(2, Line(0, 20, 20), Line(0, 20, 15)),
+                                     Make(3, {{5, 5}, {5, 15}}, {{0, 5}, {0, 15}}),
+                                     Make(4, {{20, 5}, {20, 15}}, {{15, 5}, {15, 15}})};
+  const RoadArea road = RoadArea::Build(ring, 0.02, 0.0);
+  EXPECT_EQ(road.PolygonCount(), 1);
+  EXPECT_EQ(road.HoleCount(), 1);
+  EXPECT_FALSE(road.Contains({10, 10}));
+  // A box that spans the island is not on the road, although its centre and corners are not
+  // in it: the island's boundary runs through the box.
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({10, 2.5}, 0, 4, 9)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({10, 2.5}, 0, 4, 2)));
+}
+
+TEST(RoadAreaTest, DegenerateInputDoesNotBreakIt) {
+  Lanelet nan = Make(7, {{0, 0}, {std::nan(""), 1}}, {{0, -1}, {1, -1}});
+  const RoadArea road = RoadArea::Build(std::vector<Lanelet>{nan});
+  EXPECT_EQ(road.SkippedLanelets().size(), 1u);
+  EXPECT_FALSE(road.Contains({0.5, -0.5}));
+  const RoadArea empty;
+  EXPECT_FALSE(empty.ContainsConvex(BoxCorners({0, 0}, 0, 1, 1)));
+  const std::vector<Lanelet> lane = {Make(1, Line(0, 100, 2), Line(0, 100, -2))};
+  EXPECT_FALSE(RoadArea::Build(lane).ContainsConvex(BoxCorners({std::nan(""), 0}, 0, 4, 2)));
+}
+
+}  // namespace
+}  // namespace frenetic::commonroad

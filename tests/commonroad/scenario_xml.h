@@ -1,0 +1,226 @@
+// Builds small CommonRoad 2020a scenario files in the tests (straight, curved and lane-drop roads,
+// obstacles, planning problems with goals by lanelet, rectangle or time only), one element per
+// line so that a test can name the line an error must point at.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "frenetic/commonroad/geometry.h"
+
+namespace frenetic::commonroad::testing {
+
+inline std::string Num(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", v);
+  return buffer;
+}
+
+inline std::string PointXml(Vec2 p) {
+  return "<point><x>" + Num(p.x) + "</x><y>" + Num(p.y) + "</y></point>";
+}
+
+struct LaneletXml {
+  int id = 1;
+  std::vector<Vec2> left, right;
+  std::vector<int> predecessors, successors;
+  std::optional<std::pair<int, bool>> adjacent_left, adjacent_right;  // id, same direction
+  std::string left_marking = "dashed", right_marking = "solid";
+  std::vector<int> signs;
+};
+
+inline LaneletXml Lane(int id, std::vector<Vec2> left, std::vector<Vec2> right) {
+  LaneletXml l;
+  l.id = id;
+  l.left = std::move(left);
+  l.right = std::move(right);
+  return l;
+}
+
+// An obstacle state: time step, position, orientation, velocity.
+struct StateXml {
+  int time = 0;
+  Vec2 position;
+  double orientation = 0, velocity = 0;
+};
+
+// Goal states as XML fragments.
+inline std::string GoalTimeXml(int start, int end) {
+  return "<time><intervalStart>" + std::to_string(start) + "</intervalStart><intervalEnd>" +
+         std::to_string(end) + "</intervalEnd></time>";
+}
+inline std::string GoalLaneletXml(int lanelet, int start, int end) {
+  return "<goalState>\n" + GoalTimeXml(start, end) + "\n<position><lanelet ref=\"" +
+         std::to_string(lanelet) + "\"/></position>\n</goalState>";
+}
+inline std::string GoalRectangleXml(Vec2 center, double length, double width, double orientation,
+                                    int start, int end, std::string extra = "") {
+  return "<goalState>\n" + GoalTimeXml(start, end) + "\n<position><rectangle><length>" +
+         Num(length) + "</length><width>" + Num(width) + "</width><orientation>" +
+         Num(orientation) + "</orientation><center><x>" + Num(center.x) + "</x><y>" +
+         Num(center.y) + "</y></center></rectangle></position>\n" + extra + "</goalState>";
+}
+inline std::string GoalTimeOnlyXml(int start, int end, std::string extra = "") {
+  return "<goalState>\n" + GoalTimeXml(start, end) + "\n" + extra + "</goalState>";
+}
+inline std::string IntervalXml(const char* name, double start, double end) {
+  return std::string("<") + name + "><intervalStart>" + Num(start) + "</intervalStart><intervalEnd>" +
+         Num(end) + "</intervalEnd></" + name + ">\n";
+}
+
+class ScenarioXml {
+ public:
+  explicit ScenarioXml(std::string benchmark_id = "ZAM_Test-1_1_T-1", double dt = 0.1)
+      : benchmark_id_(std::move(benchmark_id)), dt_(dt) {}
+
+  ScenarioXml& Lanelet(const LaneletXml& l) {
+    std::string s = "<lanelet id=\"" + std::to_string(l.id) + "\">\n<leftBound>\n";
+    for (Vec2 p : l.left) s += PointXml(p) + "\n";
+    s += "<lineMarking>" + l.left_marking + "</lineMarking>\n</leftBound>\n<rightBound>\n";
+    for (Vec2 p : l.right) s += PointXml(p) + "\n";
+    s += "<lineMarking>" + l.right_marking + "</lineMarking>\n</rightBound>\n";
+    for (int id : l.predecessors) s += "<predecessor ref=\"" + std::to_string(id) + "\"/>\n";
+    for (int id : l.successors) s += "<successor ref=\"" + std::to_string(id) + "\"/>\n";
+    if (l.adjacent_left) {
+      s += "<adjacentLeft ref=\"" + std::to_string(l.adjacent_left->first) + "\" drivingDir=\"" +
+           (l.adjacent_left->second ? "same" : "opposite") + "\"/>\n";
+    }
+    if (l.adjacent_right) {
+      s += "<adjacentRight ref=\"" + std::to_string(l.adjacent_right->first) +
+           "\" drivingDir=\"" + (l.adjacent_right->second ? "same" : "opposite") + "\"/>\n";
+    }
+    s += "<laneletType>interstate</laneletType>\n";
+    for (int id : l.signs) s += "<trafficSignRef ref=\"" + std::to_string(id) + "\"/>\n";
+    s += "</lanelet>\n";
+    body_ += s;
+    return *this;
+  }
+
+  // A German maximum-speed sign (274) in m/s.
+  ScenarioXml& SpeedSign(int id, double speed) {
+    body_ += "<trafficSign id=\"" + std::to_string(id) +
+             "\">\n<trafficSignElement><trafficSignID>274</trafficSignID><additionalValue>" +
+             Num(speed) + "</additionalValue></trafficSignElement>\n<virtual>false</virtual>\n"
+             "</trafficSign>\n";
+    return *this;
+  }
+
+  ScenarioXml& StaticObstacle(int id, double length, double width, Vec2 position,
+                              double orientation) {
+    body_ += "<staticObstacle id=\"" + std::to_string(id) + "\">\n<type>parkedVehicle</type>\n" +
+             RectangleShape(length, width) + InitialState(StateXml{0, position, orientation, 0}) +
+             "</staticObstacle>\n";
+    return *this;
+  }
+
+  // states.front() is the initial state; the rest form the trajectory.
+  ScenarioXml& DynamicObstacle(int id, double length, double width,
+                               const std::vector<StateXml>& states) {
+    std::string s = "<dynamicObstacle id=\"" + std::to_string(id) + "\">\n<type>car</type>\n" +
+                    RectangleShape(length, width) + InitialState(states.front());
+    if (states.size() > 1) {
+      s += "<trajectory>\n";
+      for (size_t i = 1; i < states.size(); ++i) s += "<state>\n" + StateBody(states[i]) + "</state>\n";
+      s += "</trajectory>\n";
+    }
+    body_ += s + "</dynamicObstacle>\n";
+    return *this;
+  }
+
+  ScenarioXml& Problem(int id, Vec2 position, double orientation, double velocity,
+                       const std::vector<std::string>& goals) {
+    std::string s = "<planningProblem id=\"" + std::to_string(id) + "\">\n<initialState>\n" +
+                    "<position>" + PointXml(position) + "</position>\n<orientation><exact>" +
+                    Num(orientation) + "</exact></orientation>\n<time><exact>0</exact></time>\n" +
+                    "<velocity><exact>" + Num(velocity) + "</exact></velocity>\n" +
+                    "<yawRate><exact>0</exact></yawRate>\n<slipAngle><exact>0</exact></slipAngle>\n" +
+                    "</initialState>\n";
+    for (const std::string& g : goals) s += g + "\n";
+    body_ += s + "</planningProblem>\n";
+    return *this;
+  }
+
+  // Raw text appended to the body (for malformed cases).
+  ScenarioXml& Raw(std::string_view text) {
+    body_ += text;
+    return *this;
+  }
+
+  std::string Str() const {
+    return "<?xml version='1.0' encoding='UTF-8'?>\n<commonRoad timeStepSize=\"" + Num(dt_) +
+           "\" commonRoadVersion=\"2020a\" author=\"test\" affiliation=\"test\" source=\"hand-made\" "
+           "benchmarkID=\"" +
+           benchmark_id_ + "\" date=\"2024-01-01\">\n<location>\n<geoNameId>-999</geoNameId>\n"
+           "</location>\n<scenarioTags>\n<highway/>\n<multi_lane/>\n</scenarioTags>\n" +
+           body_ + "</commonRoad>\n";
+  }
+
+ private:
+  static std::string RectangleShape(double length, double width) {
+    return "<shape>\n<rectangle><length>" + Num(length) + "</length><width>" + Num(width) +
+           "</width></rectangle>\n</shape>\n";
+  }
+  static std::string StateBody(const StateXml& s) {
+    return "<position>" + PointXml(s.position) + "</position>\n<orientation><exact>" +
+           Num(s.orientation) + "</exact></orientation>\n<time><exact>" + std::to_string(s.time) +
+           "</exact></time>\n<velocity><exact>" + Num(s.velocity) + "</exact></velocity>\n";
+  }
+  static std::string InitialState(const StateXml& s) {
+    return "<initialState>\n" + StateBody(s) + "</initialState>\n";
+  }
+
+  std::string benchmark_id_;
+  double dt_;
+  std::string body_;
+};
+
+// Points along x from x0 to x1 every `step` m at height y.
+inline std::vector<Vec2> Line(double x0, double x1, double y, double step = 10) {
+  std::vector<Vec2> out;
+  const int n = static_cast<int>(std::round((x1 - x0) / step));
+  for (int i = 0; i <= n; ++i) out.push_back({x0 + (x1 - x0) * i / n, y});
+  return out;
+}
+
+// Two lanes along +x from x = 0 to `length`, 3.5 m wide: lanelet 1 (right, y in [-3.5, 0]) and
+// lanelet 2 (left, y in [0, 3.5]), adjacent in the same direction.
+inline ScenarioXml& AddStraightRoad(ScenarioXml& xml, double length = 300) {
+  LaneletXml right = Lane(1, Line(0, length, 0), Line(0, length, -3.5));
+  right.adjacent_left = {{2, true}};
+  LaneletXml left = Lane(2, Line(0, length, 3.5), Line(0, length, 0));
+  left.adjacent_right = {{1, true}};
+  left.left_marking = "solid";
+  left.right_marking = "dashed";
+  return xml.Lanelet(right).Lanelet(left);
+}
+
+// One lane of width 4 m along a left-turning arc about (0, radius): the centre line has the
+// given radius, from angle 0 (at the origin, heading +x) through `sweep` rad.
+inline ScenarioXml& AddCurvedRoad(ScenarioXml& xml, double radius, double sweep, int id = 1) {
+  LaneletXml l = Lane(id, {}, {});
+  const int n = 60;
+  for (int i = 0; i <= n; ++i) {
+    const double a = sweep * i / n;
+    const Vec2 center{0, radius};
+    const Vec2 out{std::sin(a), -std::cos(a)};  // from the arc's centre to the road
+    l.left.push_back(center + (radius - 2) * out);
+    l.right.push_back(center + (radius + 2) * out);
+  }
+  return xml.Lanelet(l);
+}
+
+// The 1-based line of the first occurrence of `needle` in `text` (0 when absent).
+inline int LineOf(std::string_view text, std::string_view needle) {
+  const size_t at = text.find(needle);
+  if (at == std::string_view::npos) return 0;
+  int line = 1;
+  for (size_t i = 0; i < at; ++i) line += text[i] == '\n';
+  return line;
+}
+
+}  // namespace frenetic::commonroad::testing
