@@ -1,0 +1,48 @@
+// The road a CommonRoad planning problem is driven on: the lanelets joined along successors and
+// adjacency into one map::Road (lanes side by side along a smooth reference line).
+//
+//  1. Start: the lanelet holding the initial position (of several, the one whose direction is
+//     closest to the initial orientation; none holding it: the nearest within kMaxStartDistance).
+//  2. Route: the cheapest path over the lanelet graph (successors cost their length, a move to an
+//     adjacent lanelet of the same direction kLaneChangeCost) from the start to a goal lanelet
+//     (one the goal lists, or one holding a goal shape's centre); without a goal position, the
+//     longest chain of successors ahead.
+//  3. Skeleton: one lanelet per cross-section along the route, successor to successor (it keeps
+//     its lane while the route changes lanes, and moves over only where its lane ends), extended
+//     by up to kExtendBehind m of predecessors and kExtendAhead m of successors. The reference
+//     line is fitted (ReferenceLine::FitOpen) through the skeleton's centre lines.
+//  4. Lanes: every lanelet beside a skeleton lanelet (adjacency, same direction, any number of
+//     lanes over) at its lateral position; a lane is the lanelets at one lateral position, their
+//     borders projected onto the reference line. Lanelets of the opposite direction are not
+//     part of the road (the verdict still counts them as road surface).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "frenetic/commonroad/scenario.h"
+#include "frenetic/map/road.h"
+#include "frenetic/status.h"
+
+namespace frenetic::commonroad {
+
+struct BuiltRoad {
+  std::shared_ptr<const map::Road> road;
+  std::vector<int> route;     // lanelet ids from the start to the goal (or the chain ahead)
+  std::vector<int> skeleton;  // the lanelets the reference line follows
+  // Per road lane (left to right), the lanelets it is made of.
+  std::vector<std::vector<int>> lane_lanelets;
+  int start_lanelet = 0;
+};
+
+inline constexpr double kMaxStartDistance = 5.0;  // m
+inline constexpr double kLaneChangeCost = 30.0;   // m of route
+inline constexpr double kExtendBehind = 60.0;     // m
+inline constexpr double kExtendAhead = 250.0;     // m
+
+// Fails, naming the scenario and the problem, when no lanelet is near the start, when a goal
+// position lies on no lanelet the start can reach, or when the geometry is degenerate.
+StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& problem);
+
+}  // namespace frenetic::commonroad

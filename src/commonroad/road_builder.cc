@@ -1,0 +1,434 @@
+#include "frenetic/commonroad/road_builder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <queue>
+#include <set>
+#include <unordered_map>
+#include <utility>
+
+#include "frenetic/commonroad/geometry.h"
+#include "frenetic/map/reference_line.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// m: where the skeleton moves to a neighbour lane (its own ends), the reference polyline leaves
+// out this much on both sides of the junction, so that it crosses over gently.
+constexpr double kJumpBlend = 25.0;
+// m: lanelets of one lane this far apart along s (or closer) are one stretch of it.
+constexpr double kLaneGap = 1.0;
+// m: narrower stations (a lanelet's pointed end) are left out of a lane's profile.
+constexpr double kMinWidth = 0.05;
+
+// The lanelet network by index, with what the search needs of each lanelet.
+class Network {
+ public:
+  explicit Network(const Scenario& sc) : sc_(sc) {
+    for (int i = 0; i < static_cast<int>(sc.lanelets.size()); ++i) {
+      index_[sc.lanelets[i].id] = i;
+      centre_.push_back(sc.lanelets[i].CenterLine());
+      length_.push_back(PolylineLength(centre_.back()));
+      polygon_.push_back(sc.lanelets[i].Polygon());
+    }
+    InferNeighbours();
+  }
+  int size() const { return static_cast<int>(sc_.lanelets.size()); }
+  const Lanelet& at(int i) const { return sc_.lanelets[i]; }
+  int Index(int id) const {
+    const auto it = index_.find(id);
+    return it == index_.end() ? -1 : it->second;
+  }
+  const std::vector<Vec2>& centre(int i) const { return centre_[i]; }
+  double length(int i) const { return length_[i]; }
+  const std::vector<Vec2>& polygon(int i) const { return polygon_[i]; }
+
+  std::vector<int> Successors(int i) const { return Indices(at(i).successors); }
+  std::vector<int> Predecessors(int i) const { return Indices(at(i).predecessors); }
+  // The neighbour on one side (-1: left, +1: right) driven the same way, or -1: the one the
+  // file gives, else one whose bound runs along this one's (InferNeighbours).
+  int Beside(int i, int side) const {
+    const std::optional<Adjacent>& a = side < 0 ? at(i).adjacent_left : at(i).adjacent_right;
+    if (a.has_value()) return a->same_direction ? Index(a->id) : -1;
+    return side < 0 ? inferred_left_[i] : inferred_right_[i];
+  }
+  // Every lanelet beside i (either side, any number of lanes over) with its lateral position
+  // relative to i (left negative), i itself at 0.
+  std::vector<std::pair<int, int>> CrossSection(int i) const {
+    std::vector<std::pair<int, int>> out = {{i, 0}};
+    for (int side : {-1, 1}) {
+      std::set<int> seen = {i};
+      int j = Beside(i, side), pos = side;
+      while (j >= 0 && seen.insert(j).second) {
+        out.push_back({j, pos});
+        j = Beside(j, side);
+        pos += side;
+      }
+    }
+    return out;
+  }
+  double HeadingAt(int i, Vec2 p) const { return ProjectOntoPolyline(centre_[i], p).heading; }
+
+ private:
+  std::vector<int> Indices(const std::vector<int>& ids) const {
+    std::vector<int> out;
+    for (int id : ids) {
+      if (const int j = Index(id); j >= 0) out.push_back(j);
+    }
+    return out;
+  }
+
+  // Some files leave out adjacency between lanelets that share a bound (DEU_Muc-2: two lanes
+  // side by side, neither naming the other). A lanelet without a neighbour on its left gets the
+  // one whose right bound runs along its left bound (every sample of it that lies within the
+  // other's length closer than kSharedBound, at least kSharedSamples of them, same direction)
+  // and that has no neighbour on its right.
+  void InferNeighbours() {
+    constexpr double kSharedBound = 0.5;  // m
+    constexpr int kSamples = 9, kSharedSamples = 3;
+    constexpr double kSameDirection = 0.35;  // rad
+    const int n = size();
+    inferred_left_.assign(n, -1);
+    inferred_right_.assign(n, -1);
+    for (int i = 0; i < n; ++i) {
+      if (at(i).adjacent_left.has_value()) continue;
+      const std::vector<Vec2> left = ResamplePolyline(at(i).CleanLeft(), kSamples);
+      for (int j = 0; j < n && inferred_left_[i] < 0; ++j) {
+        if (j == i || at(j).adjacent_right.has_value() || inferred_right_[j] >= 0) continue;
+        const std::vector<Vec2> right = at(j).CleanRight();
+        const double len = PolylineLength(right);
+        int shared = 0;
+        bool apart = false;
+        for (const Vec2& p : left) {
+          const PolylineProjection pr = ProjectOntoPolyline(right, p);
+          if (pr.s < 0 || pr.s > len) continue;
+          if (std::abs(pr.d) > kSharedBound) {
+            apart = true;
+            break;
+          }
+          const double di = ProjectOntoPolyline(centre_[i], p).heading;
+          if (std::abs(WrapAngle(di - pr.heading)) > kSameDirection) {
+            apart = true;
+            break;
+          }
+          ++shared;
+        }
+        if (!apart && shared >= kSharedSamples) {
+          inferred_left_[i] = j;
+          inferred_right_[j] = i;
+        }
+      }
+    }
+  }
+
+  const Scenario& sc_;
+  std::vector<int> inferred_left_, inferred_right_;
+  std::unordered_map<int, int> index_;
+  std::vector<std::vector<Vec2>> centre_;
+  std::vector<double> length_;
+  std::vector<std::vector<Vec2>> polygon_;
+};
+
+int StartLanelet(const Network& net, const State& init) {
+  int best = -1;
+  double best_score = kInf;
+  for (int i = 0; i < net.size(); ++i) {
+    if (!PolygonContains(net.polygon(i), init.position)) continue;
+    const double score =
+        init.orientation ? std::abs(WrapAngle(net.HeadingAt(i, init.position) - *init.orientation))
+                         : 0.0;
+    if (score < best_score) {
+      best_score = score;
+      best = i;
+    }
+  }
+  if (best >= 0) return best;
+  double best_dist = kMaxStartDistance;
+  for (int i = 0; i < net.size(); ++i) {
+    const double d = PolygonDistance(net.polygon(i), init.position);
+    if (d <= best_dist) {
+      best_dist = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+// The lanelets a goal position lies on: those it lists, and those holding a shape's centre (or
+// overlapping the shape when none holds it).
+std::set<int> GoalLanelets(const Network& net, const PlanningProblem& problem) {
+  std::set<int> out;
+  for (const GoalState& g : problem.goals) {
+    for (int id : g.lanelets) {
+      if (const int i = net.Index(id); i >= 0) out.insert(i);
+    }
+    for (const Shape& shape : g.shapes) {
+      const Vec2 c = shape.Centroid();
+      bool found = false;
+      for (int i = 0; i < net.size(); ++i) {
+        if (PolygonContains(net.polygon(i), c)) {
+          out.insert(i);
+          found = true;
+        }
+      }
+      if (found) continue;
+      const std::vector<Vec2> v = shape.Vertices();
+      for (int i = 0; i < net.size() && v.size() >= 3; ++i) {
+        if (PolygonsOverlap(net.polygon(i), v)) out.insert(i);
+      }
+    }
+  }
+  return out;
+}
+
+// Dijkstra from `start` to the nearest lanelet of `goals` (successor: its length; neighbour:
+// kLaneChangeCost). Empty when none is reachable.
+std::vector<int> RouteTo(const Network& net, int start, const std::set<int>& goals) {
+  std::vector<double> dist(net.size(), kInf);
+  std::vector<int> from(net.size(), -1);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  dist[start] = 0;
+  open.push({0.0, start});
+  int reached = -1;
+  while (!open.empty()) {
+    const auto [d, i] = open.top();
+    open.pop();
+    if (d > dist[i]) continue;
+    if (goals.count(i)) {
+      reached = i;
+      break;
+    }
+    auto relax = [&](int j, double cost) {
+      if (j >= 0 && d + cost < dist[j]) {
+        dist[j] = d + cost;
+        from[j] = i;
+        open.push({dist[j], j});
+      }
+    };
+    for (int j : net.Successors(i)) relax(j, net.length(i));
+    relax(net.Beside(i, -1), kLaneChangeCost);
+    relax(net.Beside(i, 1), kLaneChangeCost);
+  }
+  std::vector<int> route;
+  for (int i = reached; i >= 0; i = from[i]) route.push_back(i);
+  std::reverse(route.begin(), route.end());
+  return route;
+}
+
+// The longest chain of successors from i (m), at most `budget` m, without revisiting.
+double ChainLength(const Network& net, int i, double budget, std::set<int>& on_path) {
+  if (budget <= 0 || !on_path.insert(i).second) return 0;
+  double best = 0;
+  for (int j : net.Successors(i)) best = std::max(best, ChainLength(net, j, budget - net.length(i), on_path));
+  on_path.erase(i);
+  return net.length(i) + best;
+}
+
+// The successor of i that leads on longest (ties: the first), or -1.
+int LongestSuccessor(const Network& net, int i, double budget) {
+  int best = -1;
+  double best_len = -1;
+  for (int j : net.Successors(i)) {
+    std::set<int> on_path = {i};
+    const double len = ChainLength(net, j, budget, on_path);
+    if (len > best_len) {
+      best_len = len;
+      best = j;
+    }
+  }
+  return best;
+}
+
+// The projected borders of a lanelet: stations (s increasing) with the left and right d.
+struct Stations {
+  std::vector<double> s, left, right;
+};
+
+Stations Project(const Lanelet& l, const map::ReferenceLine& line) {
+  std::vector<Vec2> left = l.left, right = l.right;
+  if (left.size() != right.size()) {
+    const int n = static_cast<int>(std::max(l.CleanLeft().size(), l.CleanRight().size()));
+    left = ResamplePolyline(l.left, n);
+    right = ResamplePolyline(l.right, n);
+  }
+  Stations out;
+  double hint = NAN;
+  for (size_t i = 0; i < left.size(); ++i) {
+    const map::FrenetPoint fl = std::isfinite(hint) ? line.ToFrenet(left[i].x, left[i].y, hint)
+                                                    : line.ToFrenet(left[i].x, left[i].y);
+    const map::FrenetPoint fr = line.ToFrenet(right[i].x, right[i].y, fl.s);
+    hint = fl.s;
+    const double s = 0.5 * (fl.s + fr.s);
+    if (!(fr.d - fl.d > kMinWidth) || (!out.s.empty() && !(s > out.s.back() + 1e-6))) continue;
+    out.s.push_back(s);
+    out.left.push_back(fl.d);
+    out.right.push_back(fr.d);
+  }
+  return out;
+}
+
+std::string Where(const Scenario& sc, const PlanningProblem& p) {
+  return sc.source + ": planning problem " + std::to_string(p.id) + ": ";
+}
+
+}  // namespace
+
+StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& problem) {
+  const Network net(scenario);
+  const std::string where = Where(scenario, problem);
+  if (net.size() == 0) return Status::Error(where + "the scenario has no lanelets");
+  const int start = StartLanelet(net, problem.initial);
+  if (start < 0) {
+    return Status::Error(where + "no lanelet within " + std::to_string(kMaxStartDistance) +
+                         " m of the initial position");
+  }
+  // 1-2. The route.
+  const std::set<int> goals = GoalLanelets(net, problem);
+  bool any_position = false;
+  for (const GoalState& g : problem.goals) any_position = any_position || g.HasPosition();
+  std::vector<int> route;
+  if (!goals.empty()) {
+    route = RouteTo(net, start, goals);
+    if (route.empty()) {
+      return Status::Error(where + "no route from lanelet " + std::to_string(net.at(start).id) +
+                           " to a goal lanelet");
+    }
+  } else if (any_position) {
+    return Status::Error(where + "the goal position lies on no lanelet");
+  } else {
+    route = {start};
+  }
+  // 3. The skeleton: successor to successor, over the route's cross-sections. offset[k]: the
+  // lateral position of skeleton lanelet k in the road's lanes (its neighbours' are relative).
+  std::vector<int> skeleton = {route.front()};
+  std::vector<int> offset = {0};
+  std::vector<bool> jump_before = {false};
+  int lateral = 0;  // the route's lanelet's position relative to the skeleton's, this section
+  for (size_t r = 1; r < route.size(); ++r) {
+    const int prev = route[r - 1], cur = route[r];
+    const int side = net.Beside(prev, -1) == cur ? -1 : net.Beside(prev, 1) == cur ? 1 : 0;
+    if (side != 0) {  // a lane change within the section
+      lateral += side;
+      continue;
+    }
+    // `cur` follows `prev` (at `lateral` from the skeleton): the next cross-section.
+    std::set<int> section;
+    for (const auto& [j, pos] : net.CrossSection(cur)) section.insert(j);
+    int next = -1;
+    for (int j : net.Successors(skeleton.back())) {
+      if (section.count(j)) next = j;
+    }
+    if (next >= 0) {
+      skeleton.push_back(next);
+      offset.push_back(offset.back());
+      jump_before.push_back(false);
+      // The route's lanelet relative to the new skeleton lanelet.
+      lateral = 0;
+      for (const auto& [j, pos] : net.CrossSection(next)) {
+        if (j == cur) lateral = pos;
+      }
+    } else {  // the skeleton's lane ends here: it moves to the route's lane
+      skeleton.push_back(cur);
+      offset.push_back(offset.back() + lateral);
+      jump_before.push_back(true);
+      lateral = 0;
+    }
+  }
+  // Road ahead of the goal and behind the start, for the horizon and the cars behind.
+  std::set<int> used(skeleton.begin(), skeleton.end());
+  for (double ahead = 0; ahead < kExtendAhead;) {
+    const int j = LongestSuccessor(net, skeleton.back(), kExtendAhead);
+    if (j < 0 || used.count(j)) break;
+    ahead += net.length(j);
+    skeleton.push_back(j);
+    offset.push_back(offset.back());
+    jump_before.push_back(false);
+    used.insert(j);
+  }
+  for (double behind = 0; behind < kExtendBehind;) {
+    const std::vector<int> preds = net.Predecessors(skeleton.front());
+    if (preds.empty() || used.count(preds.front())) break;
+    behind += net.length(preds.front());
+    skeleton.insert(skeleton.begin(), preds.front());
+    offset.insert(offset.begin(), offset.front());
+    jump_before.insert(jump_before.begin(), false);
+    used.insert(preds.front());
+  }
+  // The reference polyline: the skeleton's centre lines, crossing over gently at jumps.
+  std::vector<map::ReferenceLine::Point> poly;
+  for (size_t k = 0; k < skeleton.size(); ++k) {
+    const std::vector<Vec2>& c = net.centre(skeleton[k]);
+    const bool jump_after = k + 1 < skeleton.size() && jump_before[k + 1];
+    const double len = net.length(skeleton[k]);
+    double along = 0;
+    for (size_t i = 0; i < c.size(); ++i) {
+      if (i > 0) along += Distance(c[i], c[i - 1]);
+      if (jump_before[k] && along < kJumpBlend && len > 2 * kJumpBlend) continue;
+      if (jump_after && along > len - kJumpBlend && len > 2 * kJumpBlend) continue;
+      poly.push_back({c[i].x, c[i].y});
+    }
+  }
+  auto line = map::ReferenceLine::FitOpen(poly, map::ReferenceLine::Options(),
+                                          where + "reference line");
+  if (!line.ok()) return line.status();
+  // 4. Lanes: each skeleton lanelet's cross-section, at the road's lateral positions.
+  struct Piece {
+    int lanelet;
+    Stations st;
+  };
+  std::map<int, std::vector<Piece>> by_position;
+  std::set<int> placed;
+  for (size_t k = 0; k < skeleton.size(); ++k) {
+    for (const auto& [j, pos] : net.CrossSection(skeleton[k])) {
+      if (!placed.insert(j).second) continue;
+      Stations st = Project(net.at(j), **line);
+      if (st.s.size() < 2) continue;
+      by_position[offset[k] + pos].push_back({j, std::move(st)});
+    }
+  }
+  BuiltRoad out;
+  std::vector<map::LaneProfile> lanes;
+  for (auto& [pos, pieces] : by_position) {
+    std::sort(pieces.begin(), pieces.end(),
+              [](const Piece& a, const Piece& b) { return a.st.s.front() < b.st.s.front(); });
+    // Contiguous pieces make one lane; a gap starts another at the same position.
+    map::LaneProfile lane;
+    std::vector<int> ids;
+    auto flush = [&] {
+      if (lane.s.size() >= 2) {
+        lanes.push_back(std::move(lane));
+        out.lane_lanelets.push_back(ids);
+      }
+      lane = map::LaneProfile();
+      ids.clear();
+    };
+    for (const Piece& p : pieces) {
+      if (!lane.s.empty() && p.st.s.front() > lane.s.back() + kLaneGap) flush();
+      ids.push_back(net.at(p.lanelet).id);
+      if (const auto& lim = net.at(p.lanelet).speed_limit; lim.has_value()) {
+        lane.speed_limit = std::min(lane.speed_limit, *lim);
+      }
+      for (size_t i = 0; i < p.st.s.size(); ++i) {
+        if (!lane.s.empty() && !(p.st.s[i] > lane.s.back() + 1e-6)) continue;
+        lane.s.push_back(p.st.s[i]);
+        lane.left.push_back(p.st.left[i]);
+        lane.right.push_back(p.st.right[i]);
+      }
+    }
+    flush();
+  }
+  auto road = map::Road::Make(*line, std::move(lanes), where + "road");
+  if (!road.ok()) return road.status();
+  out.road = *road;
+  for (int i : route) out.route.push_back(net.at(i).id);
+  for (int i : skeleton) out.skeleton.push_back(net.at(i).id);
+  out.start_lanelet = net.at(start).id;
+  return out;
+}
+
+}  // namespace frenetic::commonroad

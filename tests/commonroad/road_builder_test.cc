@@ -1,0 +1,185 @@
+// BuildRoad: lanelets joined into a map::Road (route, skeleton, lanes), on hand-made scenarios
+// and on every shared example file.
+#include "frenetic/commonroad/road_builder.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "commonroad/scenario_xml.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+using testing::AddCurvedRoad;
+using testing::AddStraightRoad;
+using testing::GoalLaneletXml;
+using testing::GoalRectangleXml;
+using testing::GoalTimeOnlyXml;
+using testing::Lane;
+using testing::LaneletXml;
+using testing::Line;
+using testing::ScenarioXml;
+
+Scenario Parse(const ScenarioXml& xml) {
+  auto sc = ParseScenario(xml.Str(), "test.xml");
+  EXPECT_TRUE(sc.ok()) << sc.message();
+  return sc.ok() ? *sc : Scenario{};
+}
+
+BuiltRoad Build(const Scenario& sc, int problem = 0) {
+  auto r = BuildRoad(sc, sc.problems.at(problem));
+  EXPECT_TRUE(r.ok()) << r.message();
+  return r.ok() ? *r : BuiltRoad{};
+}
+
+TEST(RoadBuilderTest, TwoLanesOfAStraightRoad) {
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(50, 50)});
+  const Scenario sc = Parse(xml);
+  const BuiltRoad b = Build(sc);
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.start_lanelet, 1);
+  EXPECT_EQ(b.route, std::vector<int>{1});
+  ASSERT_EQ(b.road->num_lanes(), 2);
+  EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2}, {1}}));
+  // The reference is lanelet 1's centre (y = -1.75): lanelet 2 is left of it.
+  const map::Road::Span left = b.road->LaneAt(0, 100), right = b.road->LaneAt(1, 100);
+  ASSERT_TRUE(left.exists && right.exists);
+  EXPECT_NEAR(left.left, -5.25, 0.01);
+  EXPECT_NEAR(left.right, -1.75, 0.01);
+  EXPECT_NEAR(right.left, -1.75, 0.01);
+  EXPECT_NEAR(right.right, 1.75, 0.01);
+  EXPECT_NEAR(b.road->line().length(), 300, 0.5);
+  EXPECT_NEAR(b.road->lane_width(), 3.5, 0.01);
+}
+
+TEST(RoadBuilderTest, ALaneDropMovesTheSkeletonOver) {
+  // Right lane 1 (0-150 m) ends; the left lane is 2 (0-150) then 3 (150-300). The ego starts in
+  // lane 1; the goal is lanelet 3.
+  ScenarioXml xml;
+  LaneletXml r1 = Lane(1, Line(0, 150, 0), Line(0, 150, -3.5));
+  r1.adjacent_left = {{2, true}};
+  LaneletXml l2 = Lane(2, Line(0, 150, 3.5), Line(0, 150, 0));
+  l2.adjacent_right = {{1, true}};
+  l2.successors = {3};
+  LaneletXml l3 = Lane(3, Line(150, 300, 3.5), Line(150, 300, 0));
+  l3.predecessors = {2};
+  xml.Lanelet(r1).Lanelet(l2).Lanelet(l3).Problem(1, {10, -1.75}, 0, 20,
+                                                  {GoalLaneletXml(3, 0, 100)});
+  const Scenario sc = Parse(xml);
+  const BuiltRoad b = Build(sc);
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.route, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(b.skeleton, (std::vector<int>{1, 3}));
+  ASSERT_EQ(b.road->num_lanes(), 2);
+  EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1}}));
+  EXPECT_NEAR(b.road->LaneEnd(1), 150, 1.0);  // the right lane ends where lanelet 1 does
+  EXPECT_GT(b.road->LaneEnd(0), 290);
+  // The left lane's centre is y = 1.75 in XY everywhere, wherever the line crosses over.
+  for (double s : {20.0, 120.0, 160.0, 250.0}) {
+    const map::Road::Span a = b.road->LaneAt(0, s);
+    ASSERT_TRUE(a.exists) << s;
+    const map::CartesianPose p = b.road->line().ToCartesian(s, a.centre());
+    EXPECT_NEAR(p.y, 1.75, 0.05) << "s " << s;
+    EXPECT_NEAR(a.width(), 3.5, 0.1) << "s " << s;
+  }
+}
+
+TEST(RoadBuilderTest, CurvedRoadKeepsItsWidth) {
+  ScenarioXml xml;
+  AddCurvedRoad(xml, 150, 1.2).Problem(1, {0, 0}, 0, 15, {GoalTimeOnlyXml(40, 40)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  ASSERT_EQ(b.road->num_lanes(), 1);
+  for (double s = 10; s < 170; s += 20) {
+    const map::Road::Span a = b.road->LaneAt(0, s);
+    ASSERT_TRUE(a.exists) << s;
+    EXPECT_NEAR(a.width(), 4.0, 0.05) << s;
+    EXPECT_NEAR(a.centre(), 0.0, 0.2) << s;
+  }
+}
+
+TEST(RoadBuilderTest, GoalByRectangleRoutesIntoItsLane) {
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20,
+                                    {GoalRectangleXml({200, 1.75}, 10, 3, 0, 0, 100)});
+  const BuiltRoad b = Build(Parse(xml));
+  EXPECT_EQ(b.route, (std::vector<int>{1, 2}));
+  EXPECT_EQ(b.skeleton, std::vector<int>{1});
+}
+
+TEST(RoadBuilderTest, LanesSharingABoundAreNeighboursWhenTheFileSaysNothing) {
+  // As in DEU_Muc-2: two lanes side by side, neither naming the other; the goal is in the left
+  // one, the ego in the right one.
+  ScenarioXml xml;
+  xml.Lanelet(Lane(1, Line(0, 300, 0), Line(0, 300, -3.5)))
+      .Lanelet(Lane(2, Line(0, 300, 3.5), Line(0, 300, 0)))
+      .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, 0, 100)});
+  const BuiltRoad b = Build(Parse(xml));
+  EXPECT_EQ(b.route, (std::vector<int>{1, 2}));
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.road->num_lanes(), 2);
+  // Lanes 10 m apart are not neighbours.
+  ScenarioXml apart;
+  apart.Lanelet(Lane(1, Line(0, 300, 0), Line(0, 300, -3.5)))
+      .Lanelet(Lane(2, Line(0, 300, 13.5), Line(0, 300, 10)))
+      .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, 0, 100)});
+  const Scenario sc = Parse(apart);
+  EXPECT_FALSE(BuildRoad(sc, sc.problems[0]).ok());
+}
+
+TEST(RoadBuilderTest, FailuresNameTheProblem) {
+  ScenarioXml far;
+  AddStraightRoad(far, 300).Problem(7, {10, 50}, 0, 20, {GoalTimeOnlyXml(50, 50)});
+  Scenario sc = Parse(far);
+  auto r = BuildRoad(sc, sc.problems[0]);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.message(), "test.xml: planning problem 7: no lanelet within 5.000000 m of the initial position");
+  // A goal on a lanelet the start cannot reach (the other direction's road).
+  ScenarioXml apart;
+  AddStraightRoad(apart, 300);
+  std::vector<Vec2> l9 = Line(0, 300, -10), r9 = Line(0, 300, -6.5);
+  std::reverse(l9.begin(), l9.end());
+  std::reverse(r9.begin(), r9.end());
+  apart.Lanelet(Lane(9, l9, r9))
+      .Problem(8, {10, -1.75}, 0, 20, {GoalLaneletXml(9, 0, 100)});
+  sc = Parse(apart);
+  r = BuildRoad(sc, sc.problems[0]);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("planning problem 8: no route from lanelet 1"), std::string::npos)
+      << r.message();
+}
+
+TEST(RoadBuilderTest, EverySharedFileGivesARoadHoldingItsStartAndGoal) {
+  const std::filesystem::path dir = std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".xml") continue;
+    ++files;
+    auto sc = LoadScenario(entry.path().string());
+    ASSERT_TRUE(sc.ok()) << sc.message();
+    for (const PlanningProblem& p : sc->problems) {
+      auto b = BuildRoad(*sc, p);
+      ASSERT_TRUE(b.ok()) << b.message();
+      const map::Road& road = *b->road;
+      const map::FrenetPoint f = road.line().ToFrenet(p.initial.position.x, p.initial.position.y);
+      EXPECT_GE(road.LaneOf(f.s, f.d), 0) << entry.path() << ": the start is on no lane";
+      for (const GoalState& g : p.goals) {
+        for (const Shape& shape : g.shapes) {
+          const Vec2 c = shape.Centroid();
+          const map::FrenetPoint fg = road.line().ToFrenet(c.x, c.y);
+          EXPECT_GE(road.LaneOf(fg.s, fg.d), 0) << entry.path() << ": the goal is on no lane";
+        }
+      }
+    }
+  }
+  EXPECT_GE(files, 13);
+}
+
+}  // namespace
+}  // namespace frenetic::commonroad
