@@ -213,6 +213,8 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   }
   c.ego_length = cfg.ego_length;
   c.ego_width = cfg.ego_width;
+  c.num_goals = ws.num_goals;
+  c.goals = ws.goals;
 }
 
 }  // namespace frenetic::plan::search

@@ -183,6 +183,12 @@ class SearchPlanner : public Planner {
     ws_.start = start;
     ws_.t_keep = kept * kTickSeconds;
     ws_.time_since_change += elapsed;
+    ws_.num_goals = static_cast<int>(std::min<std::size_t>(t.goals.size(), cost::kMaxGoalRegions));
+    for (int g = 0; g < ws_.num_goals; ++g) {
+      ws_.goals[g] = t.goals[g];
+      ws_.goals[g].t_lo -= ws_.t_keep;
+      ws_.goals[g].t_hi -= ws_.t_keep;
+    }
     if (ws_.have_prev_traj) ws_.prev_elapsed = ws_.prev_base + elapsed;
 
     // Prediction (relative to the start state's s; the observation is "now"), with the ends of

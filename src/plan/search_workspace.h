@@ -74,6 +74,9 @@ struct Workspace {
   double edge_s0 = 0;
   std::vector<double> edge_lo, edge_hi;
   cost::CostContext ctx;
+  // The goals of this cycle (Telemetry::goals), times relative to the start state.
+  cost::GoalRegion goals[cost::kMaxGoalRegions];
+  int num_goals = 0;
   // Cars the hard checks test against: ctx.num_cars real ones, then the predictor's lane-change
   // ghosts (a hypothesis the plan must survive, not traffic the costs should weigh).
   int num_check_cars = 0;

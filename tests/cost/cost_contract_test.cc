@@ -22,6 +22,7 @@ constexpr int kN = 25;
 // A candidate with its sample storage.
 struct Fixture {
   std::vector<double> s, s_d, s_dd, d, d_d, d_dd, car_s, car_d, car_v, prev_s, prev_d;
+  std::vector<GoalRegion> goals;
   CostContext ctx;
   CostInput in;
 
@@ -32,6 +33,8 @@ struct Fixture {
     ctx.num_cars = static_cast<int>(car_d.size()) / kN;
     ctx.previous_s = prev_s.empty() ? nullptr : prev_s.data();
     ctx.previous_d = prev_d.empty() ? nullptr : prev_d.data();
+    ctx.num_goals = static_cast<int>(goals.size());
+    ctx.goals = goals.empty() ? nullptr : goals.data();
   }
 };
 
@@ -121,6 +124,28 @@ Fixture RandomFixture(std::mt19937& rng) {
   f.in.lon_duration = 1.5 + 4.5 * u(rng);
   f.in.lat_duration = 2 + 2 * u(rng);
   f.in.kind = static_cast<LonKind>(static_cast<int>(u(rng) * 3));
+  // Goal regions (a CommonRoad problem's) half the time, with any of their parts absent.
+  if (u(rng) < 0.5) {
+    const int goals = 1 + static_cast<int>(u(rng) * 2);
+    for (int g = 0; g < goals; ++g) {
+      GoalRegion r;
+      if (u(rng) < 0.7) {
+        r.s_lo = 300 * u(rng);
+        r.s_hi = r.s_lo + 40 * u(rng);
+        r.d_lo = 12 * u(rng);
+        r.d_hi = r.d_lo + 4 * u(rng);
+      }
+      if (u(rng) < 0.8) {
+        r.t_lo = -2 + 12 * u(rng);
+        r.t_hi = r.t_lo + 5 * u(rng);
+      }
+      if (u(rng) < 0.5) {
+        r.v_lo = 25 * u(rng);
+        r.v_hi = r.v_lo + 10 * u(rng);
+      }
+      f.goals.push_back(r);
+    }
+  }
   f.Wire();
   return f;
 }

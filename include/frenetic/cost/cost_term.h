@@ -14,6 +14,8 @@
 #include <span>
 #include <string>
 #include <vector>
+
+#include "frenetic/cost/goal_region.h"
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -68,6 +70,9 @@ struct CostContext {
   }
   // The largest HalfLength and HalfWidth of the cars (bounds for broad phases), m.
   double max_half_length = 2.4, max_half_width = 1.2;
+  // The goals to reach (none on the Udacity track), times relative to the start state.
+  int num_goals = 0;
+  const GoalRegion* goals = nullptr;
   // Reaches of the broad-phase masks in CostInput (m), tighter first: see NearCars.
   double near_lateral[2] = {0, 0};
   double near_longitudinal[2] = {0, 0};

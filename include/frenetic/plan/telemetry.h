@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "frenetic/cost/goal_region.h"
+
 namespace frenetic::plan {
 
 // One sensor_fusion row. vx, vy in m/s in the map frame; s, d as the simulator reported them
@@ -39,6 +41,9 @@ struct Telemetry {
   std::vector<SensorCar> sensor_fusion;
   // Known futures of some sensor_fusion cars (empty from the Udacity simulator).
   std::vector<CarFuture> futures;
+  // Goals to reach, times relative to this telemetry's instant, in the planner's line's Frenet
+  // frame (the first cost::kMaxGoalRegions are used; none from the Udacity simulator).
+  std::vector<cost::GoalRegion> goals;
 };
 
 }  // namespace frenetic::plan

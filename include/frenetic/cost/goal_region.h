@@ -1,0 +1,21 @@
+// A goal the ego must reach (a CommonRoad planning problem's goal state), in the Frenet frame of
+// the planner's reference line: a box in (s, d), a time window and a speed interval. Absent parts
+// are infinite intervals. The planner is told its goals with each telemetry (plan::Telemetry::goals)
+// and the `goal` cost term steers toward them.
+#pragma once
+
+#include <limits>
+
+namespace frenetic::cost {
+
+struct GoalRegion {
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  double s_lo = -kInf, s_hi = kInf;  // m along the line (unwrapped)
+  double d_lo = -kInf, d_hi = kInf;  // m, right positive
+  double t_lo = -kInf, t_hi = kInf;  // s from the instant it is given for
+  double v_lo = -kInf, v_hi = kInf;  // m/s
+};
+
+inline constexpr int kMaxGoalRegions = 8;
+
+}  // namespace frenetic::cost

@@ -1,0 +1,123 @@
+// The goal term: how far a candidate misses a goal region within its time window.
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "frenetic/cost/cost_registry.h"
+#include "frenetic/cost/cost_term.h"
+
+namespace frenetic::cost {
+namespace {
+
+constexpr int kN = 25;  // 6 s at 0.25 s
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A candidate at constant speed v along d = 2 from s = 0, with `goals`.
+struct Case {
+  std::vector<double> s, s_d, s_dd, d, d_d, d_dd;
+  std::vector<GoalRegion> goals;
+  CostContext ctx;
+  CostInput in;
+  explicit Case(double v, std::vector<GoalRegion> g, double a = 0) : goals(std::move(g)) {
+    for (int k = 0; k < kN; ++k) {
+      const double t = 0.25 * k;
+      s.push_back(v * t + 0.5 * a * t * t);
+      s_d.push_back(v + a * t);
+      s_dd.push_back(a);
+      d.push_back(2);
+      d_d.push_back(0);
+      d_dd.push_back(0);
+    }
+    ctx.num_samples = kN;
+    ctx.dt = 0.25;
+    ctx.num_goals = static_cast<int>(goals.size());
+    ctx.goals = goals.data();
+    in.s = s.data();
+    in.s_d = s_d.data();
+    in.s_dd = s_dd.data();
+    in.d = d.data();
+    in.d_d = d_d.data();
+    in.d_dd = d_dd.data();
+  }
+};
+
+GoalRegion Box(double s_lo, double s_hi, double t_lo, double t_hi) {
+  GoalRegion g;
+  g.s_lo = s_lo;
+  g.s_hi = s_hi;
+  g.d_lo = 0;
+  g.d_hi = 4;
+  g.t_lo = t_lo;
+  g.t_hi = t_hi;
+  return g;
+}
+
+class GoalCostTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto made = CostRegistry::Global().Make("goal");
+    ASSERT_TRUE(made.ok()) << made.message();
+    term_ = std::move(made.value());
+    const std::vector<double> params = {10.0, 1.75, 5.0, 10.0};
+    term_->Configure(params);
+  }
+  double Eval(const Case& c) const { return term_->Evaluate(c.ctx, c.in); }
+  std::unique_ptr<CostTerm> term_;
+};
+
+TEST_F(GoalCostTest, NothingWithoutAGoal) { EXPECT_EQ(Eval(Case(20, {})), 0.0); }
+
+TEST_F(GoalCostTest, PassingThroughWithinTheWindowCostsNothing) {
+  // At 20 m/s the ego is in [95, 105] from 4.75 s to 5.25 s.
+  EXPECT_EQ(Eval(Case(20, {Box(95, 105, 4.0, 5.0)})), 0.0);
+}
+
+TEST_F(GoalCostTest, AShortBoxBetweenTwoSamplesIsStillPassed) {
+  // A 2 m box: the samples at 20 m/s are 5 m apart (90.0 at 4.5 s, 95.0 at 4.75 s).
+  EXPECT_EQ(Eval(Case(20, {Box(91.5, 93.5, 4.6, 4.65)})), 0.0);
+}
+
+TEST_F(GoalCostTest, TooEarlyOrTooLateCostsTheDistanceOverTheScale) {
+  // The window [2, 3] s: at 20 m/s the ego is at 40-60 m then; the box starts at 100 m.
+  EXPECT_NEAR(Eval(Case(20, {Box(100, 110, 2, 3)})), (100 - 60) / 10.0, 1e-9);
+  // Past it already at the window's start (t = 1 s: 20 m, the box ends at 10 m).
+  EXPECT_NEAR(Eval(Case(20, {Box(0, 10, 1, 2)})), 1.0, 1e-9);
+}
+
+TEST_F(GoalCostTest, BeyondTheSamplesTheCandidateGoesOnAtItsLastSpeed) {
+  // The samples end at 6 s (120 m); at 20 m/s it reaches [200, 210] at 10-10.5 s.
+  EXPECT_EQ(Eval(Case(20, {Box(200, 210, 10.2, 12)})), 0.0);
+  EXPECT_NEAR(Eval(Case(20, {Box(200, 210, 7, 8)})), (200 - 160) / 10.0, 1e-9);
+}
+
+TEST_F(GoalCostTest, SpeedAndLateralMissesAddUp) {
+  GoalRegion g = Box(95, 105, 4, 6);
+  g.v_lo = 25;
+  g.v_hi = 30;
+  g.d_lo = 3.75;  // the candidate is at d = 2: 1.75 m off
+  EXPECT_NEAR(Eval(Case(20, {g})), 5.0 / 5.0 + 1.75 / 1.75, 1e-9);
+}
+
+TEST_F(GoalCostTest, ThePassedWindowAndTheNearestGoalCount) {
+  EXPECT_EQ(Eval(Case(20, {Box(500, 510, -3, -1)})), 0.0);  // over: nothing to steer for
+  // Of two goals, the one missed least.
+  EXPECT_NEAR(Eval(Case(20, {Box(300, 310, 2, 3), Box(100, 110, 2, 3)})), 4.0, 1e-9);
+  // Capped.
+  EXPECT_EQ(Eval(Case(20, {Box(5000, 5010, 2, 3)})), 10.0);
+}
+
+TEST_F(GoalCostTest, NoPositionMeansTimeAndSpeedOnly) {
+  GoalRegion g;
+  g.t_lo = g.t_hi = 8.0;
+  EXPECT_EQ(Eval(Case(20, {g})), 0.0);
+  g.v_lo = 0;
+  g.v_hi = 5;
+  // Braking at 2 m/s^2 from 20: 8 m/s at 6 s, held: 3 m/s too fast at 8 s.
+  EXPECT_NEAR(Eval(Case(20, {g}, -2)), 3.0 / 5.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace frenetic::cost
