@@ -13,6 +13,7 @@ void RegisterServe(CLI::App& app);      // cmd_serve.cc
 void RegisterTune(CLI::App& app);       // cmd_tune.cc
 void RegisterReport(CLI::App& app);     // cmd_report.cc
 void RegisterFidelity(CLI::App& app);   // cmd_fidelity.cc
+void RegisterCommonRoad(CLI::App& app);  // cmd_commonroad.cc
 
 // Exit with `code` from inside a subcommand callback (no-op for 0).
 void ExitWith(int code);

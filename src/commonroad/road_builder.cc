@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/road_area.h"
 #include "frenetic/map/reference_line.h"
 
 namespace frenetic::commonroad {
@@ -24,6 +25,8 @@ constexpr double kJumpBlend = 25.0;
 constexpr double kLaneGap = 1.0;
 // m: narrower stations (a lanelet's pointed end) are left out of a lane's profile.
 constexpr double kMinWidth = 0.05;
+// m: how far a lane goes on past an open end of the lanelet network (RoadArea's margin).
+constexpr double kOpenEnd = RoadArea::kDefaultOpenEndMargin;
 
 // The lanelet network by index, with what the search needs of each lanelet.
 class Network {
@@ -401,6 +404,19 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     std::vector<int> ids;
     auto flush = [&] {
       if (lane.s.size() >= 2) {
+        // Open ends (a first lanelet without predecessors, a last one without successors) go on
+        // kOpenEnd m, as the verdict's road area does: a car may start there with its rear
+        // past the end of the map.
+        if (net.at(net.Index(ids.front())).predecessors.empty()) {
+          lane.s.insert(lane.s.begin(), lane.s.front() - kOpenEnd);
+          lane.left.insert(lane.left.begin(), lane.left.front());
+          lane.right.insert(lane.right.begin(), lane.right.front());
+        }
+        if (net.at(net.Index(ids.back())).successors.empty()) {
+          lane.s.push_back(lane.s.back() + kOpenEnd);
+          lane.left.push_back(lane.left.back());
+          lane.right.push_back(lane.right.back());
+        }
         lanes.push_back(std::move(lane));
         out.lane_lanelets.push_back(ids);
       }

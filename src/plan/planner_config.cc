@@ -41,6 +41,7 @@ constexpr Default kDefaults[] = {
     {"grid.min_duration", 1.5, 1, 6, false},
     {"grid.max_duration", 6, 1.5, 8, false},
     {"grid.follow_gaps", 3, 1, 8, false},
+    {"grid.gap_targets", 0, 0, 8, false},
     {"grid.follow_d0", 8, 2, 30, false},
     {"grid.follow_tau", 1.0, 0.3, 3, false},
     {"grid.follow_tau_step", 0.5, 0.1, 2, false},
@@ -313,6 +314,69 @@ StatusOr<PlannerConfig> PlannerConfig::Parse(std::string_view yaml, std::string_
   Status s = c.Validate();
   if (!s.ok()) return s;
   return c;
+}
+
+Status PlannerConfig::Overlay(std::string_view yaml, std::string_view source) {
+  const std::string src(source);
+  auto err = [&](const std::string& m) { return Status::Error(src + ": " + m); };
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml));
+  } catch (const YAML::Exception& e) {
+    return err(std::string("YAML error: ") + e.what());
+  }
+  if (root.IsNull()) return Status::Ok();  // nothing to change
+  if (!root.IsMap()) return err("expected a mapping at the top level");
+  // Flattened to dotted keys first, so that an error changes nothing.
+  std::vector<std::pair<std::string, YAML::Node>> items;
+  for (const auto& section : root) {
+    const std::string name = section.first.as<std::string>();
+    if (section.second.IsScalar()) {
+      items.emplace_back(name, section.second);
+      continue;
+    }
+    if (!section.second.IsMap()) return err("'" + name + "' must be a mapping or a number");
+    for (const auto& kv : section.second) {
+      const std::string k = kv.first.as<std::string>();
+      if (name != "costs") {
+        items.emplace_back(name + "." + k, kv.second);
+        continue;
+      }
+      if (!kv.second.IsMap()) return err("'costs." + k + "' must be a mapping");
+      for (const auto& p : kv.second) {
+        const std::string pk = p.first.as<std::string>();
+        items.emplace_back(pk == "weight" ? "weights." + k : "costs." + k + "." + pk, p.second);
+      }
+    }
+  }
+  PlannerConfig next = *this;
+  next.source_ = src;
+  for (const auto& [key, node] : items) {
+    if (key == "refine.algorithm") {
+      if (!node.IsScalar()) return err("'refine.algorithm' must be a name");
+      next.refine_algorithm_ = node.Scalar();
+      continue;
+    }
+    if (next.Find(key) == nullptr) return err("unknown key '" + key + "'");
+    double v = 0;
+    try {
+      v = node.as<double>();
+    } catch (const YAML::Exception&) {
+      return err("'" + key + "' must be a number");
+    }
+    if (Status st = next.Set(key, v); !st.ok()) return st;
+  }
+  next.source_ = source_;
+  *this = std::move(next);
+  return Status::Ok();
+}
+
+Status PlannerConfig::OverlayFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open configuration");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return Overlay(ss.str(), path);
 }
 
 StatusOr<PlannerConfig> PlannerConfig::Load(const std::string& path) {

@@ -129,6 +129,55 @@ void Lattice::AddBraking() {
   }
 }
 
+// Into the gaps between consecutive cars of `lane` (the cfg_.gap_targets nearest the ego along
+// s): a following trajectory of the car ahead whose end point is the gap's middle at T, kept
+// clear of both cars (their footprints and margin_s), at its speed. A merge into a line of
+// traffic needs such a slot; the following law alone puts the ego its own gap behind a car.
+void Lattice::AddGapTargets(int lane, double T) {
+  int cars[kMaxCars];
+  int n = 0;
+  for (int c = 0; c < ws_.ctx.num_cars && n < kMaxCars; ++c) {
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    // Insertion by s at the start instant (ties: index).
+    int k = n++;
+    while (k > 0 && ws_.car_s0[cars[k - 1]] > ws_.car_s0[c]) {
+      cars[k] = cars[k - 1];
+      --k;
+    }
+    cars[k] = c;
+  }
+  // The gaps (behind car i - 1, ahead of car i... i.e. between cars[i - 1] and cars[i]), nearest
+  // the ego first: by the distance of the gap's middle now.
+  int gaps[kMaxCars];
+  int m = 0;
+  for (int i = 1; i < n; ++i) {
+    const double mid = 0.5 * (ws_.car_s0[cars[i - 1]] + ws_.car_s0[cars[i]]) - ws_.start.s;
+    int k = m++;
+    while (k > 0) {
+      const int j = gaps[k - 1];
+      const double other = 0.5 * (ws_.car_s0[cars[j - 1]] + ws_.car_s0[cars[j]]) - ws_.start.s;
+      if (std::abs(other) <= std::abs(mid)) break;
+      gaps[k] = gaps[k - 1];
+      --k;
+    }
+    gaps[k] = i;
+  }
+  for (int g = 0; g < std::min(m, cfg_.gap_targets); ++g) {
+    const int ahead = cars[gaps[g]], behind = cars[gaps[g] - 1];
+    const Predictor::Prediction pa = predictor_.Predict(ws_.car_index[ahead], ws_.t_keep + T);
+    const Predictor::Prediction pb = predictor_.Predict(ws_.car_index[behind], ws_.t_keep + T);
+    const double lo = pb.s + ws_.car_sep_s[behind] + cfg_.margin_s;
+    const double hi = pa.s - ws_.car_sep_s[ahead] - cfg_.margin_s;
+    if (!(hi > lo)) continue;
+    // The following law's target, shifted (param) to the gap's middle.
+    const double longer = 0.5 * (predictor_.cars()[ws_.car_index[ahead]].length - cfg_.car_length) +
+                          0.5 * (cfg_.ego_length - cfg_.car_length);
+    const double law = pa.s - (cfg_.follow_d0 + cfg_.follow_tau * pa.v) - longer;
+    AddLon(MakeLon(cost::LonKind::kFollowing, lane, law - 0.5 * (lo + hi), T,
+                   ws_.car_index[ahead]));
+  }
+}
+
 // The car in `lane` nearest to the ego along s within kAlongside at the start instant (context
 // index), or -1: the one a lane change into that lane must pass behind or in front of.
 int Lattice::Alongside(int lane) const {
@@ -189,6 +238,7 @@ void Lattice::Generate() {
           AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, ws_.car_index[lead]));
         }
       }
+      if (cfg_.gap_targets > 0) AddGapTargets(l, T);
     }
   }
   // Laterally at rest (keeping a lane): one duration stands for all for the own lane (they

@@ -53,6 +53,7 @@ class Lattice {
   void AddLon(const LonTraj& l);
   void AddLat(const LatTraj& l);
   void AddBraking();
+  void AddGapTargets(int lane, double T);
   int Leader(int lane) const;
   int Alongside(int lane) const;
 

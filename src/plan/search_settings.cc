@@ -42,6 +42,7 @@ Settings::Settings(const PlannerConfig& c) {
   min_duration = c.value("grid.min_duration");
   max_duration = c.value("grid.max_duration");
   follow_gaps = c.int_value("grid.follow_gaps");
+  gap_targets = c.int_value("grid.gap_targets");
   follow_d0 = c.value("grid.follow_d0");
   follow_tau = c.value("grid.follow_tau");
   follow_tau_step = c.value("grid.follow_tau_step");

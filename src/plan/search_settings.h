@@ -48,6 +48,7 @@ struct Settings {
   bool lane_limit_speeds;
   double min_duration, max_duration;
   int follow_gaps;
+  int gap_targets;  // gaps between a lane's cars the lattice aims into, per lane (0: none)
   double follow_d0, follow_tau, follow_tau_step;
   bool stop;
   int brake_decels, brake_targets;

@@ -77,7 +77,9 @@ TEST(RoadBuilderTest, ALaneDropMovesTheSkeletonOver) {
   EXPECT_EQ(b.skeleton, (std::vector<int>{1, 3}));
   ASSERT_EQ(b.road->num_lanes(), 2);
   EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1}}));
-  EXPECT_NEAR(b.road->LaneEnd(1), 150, 1.0);  // the right lane ends where lanelet 1 does
+  // The right lane ends where lanelet 1 does, plus the open end's 5 m.
+  EXPECT_NEAR(b.road->LaneEnd(1), 155, 1.0);
+  EXPECT_NEAR(b.road->LaneBegin(1), -5, 1.0);
   EXPECT_GT(b.road->LaneEnd(0), 290);
   // The left lane's centre is y = 1.75 in XY everywhere, wherever the line crosses over.
   for (double s : {20.0, 120.0, 160.0, 250.0}) {

@@ -61,7 +61,7 @@ class GoalCostTest : public ::testing::Test {
     auto made = CostRegistry::Global().Make("goal");
     ASSERT_TRUE(made.ok()) << made.message();
     term_ = std::move(made.value());
-    const std::vector<double> params = {10.0, 1.75, 5.0, 10.0};
+    const std::vector<double> params = {10.0, 1.75, 5.0, 0.05, 1.0, 10.0};
     term_->Configure(params);
   }
   double Eval(const Case& c) const { return term_->Evaluate(c.ctx, c.in); }
@@ -82,15 +82,15 @@ TEST_F(GoalCostTest, AShortBoxBetweenTwoSamplesIsStillPassed) {
 
 TEST_F(GoalCostTest, TooEarlyOrTooLateCostsTheDistanceOverTheScale) {
   // The window [2, 3] s: at 20 m/s the ego is at 40-60 m then; the box starts at 100 m.
-  EXPECT_NEAR(Eval(Case(20, {Box(100, 110, 2, 3)})), (100 - 60) / 10.0, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {Box(100, 110, 2, 3)})), 1 + (100 - 60) / 10.0, 1e-9);
   // Past it already at the window's start (t = 1 s: 20 m, the box ends at 10 m).
-  EXPECT_NEAR(Eval(Case(20, {Box(0, 10, 1, 2)})), 1.0, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {Box(0, 10, 1, 2)})), 1 + 1.0, 1e-9);
 }
 
 TEST_F(GoalCostTest, BeyondTheSamplesTheCandidateGoesOnAtItsLastSpeed) {
   // The samples end at 6 s (120 m); at 20 m/s it reaches [200, 210] at 10-10.5 s.
   EXPECT_EQ(Eval(Case(20, {Box(200, 210, 10.2, 12)})), 0.0);
-  EXPECT_NEAR(Eval(Case(20, {Box(200, 210, 7, 8)})), (200 - 160) / 10.0, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {Box(200, 210, 7, 8)})), 1 + (200 - 160) / 10.0, 1e-9);
 }
 
 TEST_F(GoalCostTest, SpeedAndLateralMissesAddUp) {
@@ -98,15 +98,31 @@ TEST_F(GoalCostTest, SpeedAndLateralMissesAddUp) {
   g.v_lo = 25;
   g.v_hi = 30;
   g.d_lo = 3.75;  // the candidate is at d = 2: 1.75 m off
-  EXPECT_NEAR(Eval(Case(20, {g})), 5.0 / 5.0 + 1.75 / 1.75, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {g})), 1 + 5.0 / 5.0 + 1.75 / 1.75, 1e-9);
 }
 
 TEST_F(GoalCostTest, ThePassedWindowAndTheNearestGoalCount) {
   EXPECT_EQ(Eval(Case(20, {Box(500, 510, -3, -1)})), 0.0);  // over: nothing to steer for
   // Of two goals, the one missed least.
-  EXPECT_NEAR(Eval(Case(20, {Box(300, 310, 2, 3), Box(100, 110, 2, 3)})), 4.0, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {Box(300, 310, 2, 3), Box(100, 110, 2, 3)})), 1 + 4.0, 1e-9);
   // Capped.
   EXPECT_EQ(Eval(Case(20, {Box(5000, 5010, 2, 3)})), 10.0);
+}
+
+TEST_F(GoalCostTest, HeadingOutsideItsIntervalCounts) {
+  // The candidate moves across at 1 m/s at 20 m/s: heading atan(1 / 20) = 0.04996 rad.
+  Case c(20, {});
+  for (double& dd : c.d_d) dd = 1.0;
+  GoalRegion g = Box(95, 105, 4, 6);
+  g.d_hi = 1e9;
+  g.h_lo = -0.01;
+  g.h_hi = 0.01;
+  c.goals = {g};
+  c.ctx.num_goals = 1;
+  c.ctx.goals = c.goals.data();
+  EXPECT_NEAR(Eval(c), 1 + (std::atan(1.0 / 20) - 0.01) / 0.05, 1e-6);
+  c.goals[0].h_hi = 0.06;
+  EXPECT_EQ(Eval(c), 0.0);
 }
 
 TEST_F(GoalCostTest, NoPositionMeansTimeAndSpeedOnly) {
@@ -116,7 +132,7 @@ TEST_F(GoalCostTest, NoPositionMeansTimeAndSpeedOnly) {
   g.v_lo = 0;
   g.v_hi = 5;
   // Braking at 2 m/s^2 from 20: 8 m/s at 6 s, held: 3 m/s too fast at 8 s.
-  EXPECT_NEAR(Eval(Case(20, {g}, -2)), 3.0 / 5.0, 1e-9);
+  EXPECT_NEAR(Eval(Case(20, {g}, -2)), 1 + 3.0 / 5.0, 1e-9);
 }
 
 }  // namespace

@@ -13,8 +13,10 @@
 //     line is fitted (ReferenceLine::FitOpen) through the skeleton's centre lines.
 //  4. Lanes: every lanelet beside a skeleton lanelet (adjacency, same direction, any number of
 //     lanes over) at its lateral position; a lane is the lanelets at one lateral position, their
-//     borders projected onto the reference line. Lanelets of the opposite direction are not
-//     part of the road (the verdict still counts them as road surface).
+//     borders projected onto the reference line; a lane goes on RoadArea::kDefaultOpenEndMargin
+//     (5 m) past an open end of the network (a lanelet without predecessor or successor), as the
+//     verdict's road area does. Lanelets of the opposite direction are not part of the road (the
+//     verdict still counts them as road surface).
 #pragma once
 
 #include <memory>

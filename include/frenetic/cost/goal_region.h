@@ -1,6 +1,6 @@
 // A goal the ego must reach (a CommonRoad planning problem's goal state), in the Frenet frame of
-// the planner's reference line: a box in (s, d), a time window and a speed interval. Absent parts
-// are infinite intervals. The planner is told its goals with each telemetry (plan::Telemetry::goals)
+// the planner's reference line: a box in (s, d), a time window, a speed interval and a heading
+// interval. Absent parts are infinite intervals. The planner is told its goals with each telemetry (plan::Telemetry::goals)
 // and the `goal` cost term steers toward them.
 #pragma once
 
@@ -14,6 +14,9 @@ struct GoalRegion {
   double d_lo = -kInf, d_hi = kInf;  // m, right positive
   double t_lo = -kInf, t_hi = kInf;  // s from the instant it is given for
   double v_lo = -kInf, v_hi = kInf;  // m/s
+  // The heading relative to the line's (atan2(d', s'), rad, right positive as d): a goal
+  // orientation interval less the road's heading there.
+  double h_lo = -kInf, h_hi = kInf;
 };
 
 inline constexpr int kMaxGoalRegions = 8;

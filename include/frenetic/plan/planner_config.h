@@ -21,6 +21,12 @@ class PlannerConfig {
   static std::string DefaultPath();  // FRENETIC_SOURCE_DIR "/config/planner.yaml"
   static StatusOr<PlannerConfig> LoadDefault();
 
+  // Changes some values: YAML laid out as planner.yaml (sections of keys, `costs` of terms with
+  // weight and parameters), any subset of it. Errors name `source` and the key (unknown, not a
+  // number, out of range); on an error nothing is changed.
+  Status Overlay(std::string_view yaml, std::string_view source);
+  Status OverlayFile(const std::string& path);
+
   // Dotted keys: "section.key" (e.g. "limits.max_speed_mph"), "weights.<term>" and
   // "costs.<term>.<param>". Set rejects unknown keys and values outside the declared range.
   Status Set(std::string_view key, double value);

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   frenetic::apps::RegisterMapCheck(app);
   frenetic::apps::RegisterTrack(app);
   frenetic::apps::RegisterDrive(app);
+  frenetic::apps::RegisterCommonRoad(app);
   frenetic::apps::RegisterServe(app);
   frenetic::apps::RegisterTune(app);
   frenetic::apps::RegisterReport(app);

@@ -1,0 +1,89 @@
+// Closed-loop planning through a CommonRoad scenario (`frenetic commonroad`): for each planning
+// problem, the road is built from the lanelets (BuildRoad), the search planner plans at every time
+// step from the ego's state, the ego follows the plan for one step as the benchmark's KS vehicle,
+// and the other traffic follows its recording (non-reactive). The run's KS trajectory is then
+// judged by the verdict (verdict.h), independently of the planner.
+//
+// Each step (dt, 0.1 s in the benchmark) the planner gets, as from a simulator: the ego's centre,
+// orientation and speed; the rest of its last path (its 0.02 s points after the dt driven); the
+// obstacles there at that step as sensor rows (centre, velocity, footprint); with
+// --prediction recorded, each dynamic obstacle's recorded future (the benchmark's convention for
+// "T" scenarios), else nothing beyond the present (the planner's constant-velocity predictor); and
+// the goal states as regions of its road's Frenet frame. The ego then moves dt with the constant
+// KS input (steering rate, acceleration) that best lands it on the planned state dt ahead
+// (position, orientation, steering angle, speed: a few Gauss-Newton steps on SimulateKs, the
+// inputs within the vehicle's limits), so the trajectory is a KS trajectory by construction.
+// The run ends at the first step that meets a goal state, or after the last goal time window (or,
+// for goals without one, the scenario's last recorded step), at most kMaxSteps.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "frenetic/commonroad/ks_model.h"
+#include "frenetic/commonroad/scenario.h"
+#include "frenetic/commonroad/vehicle_params.h"
+#include "frenetic/commonroad/verdict.h"
+#include "frenetic/plan/planner.h"
+#include "frenetic/plan/planner_config.h"
+#include "frenetic/status.h"
+
+namespace frenetic::commonroad {
+
+enum class PredictionMode { kRecorded, kConstantVelocity };
+const char* ToString(PredictionMode mode);  // "recorded", "constant-velocity"
+StatusOr<PredictionMode> ParsePredictionMode(std::string_view text);
+
+inline constexpr int kMaxSteps = 3000;
+
+struct RunOptions {
+  PredictionMode prediction = PredictionMode::kRecorded;
+  int vehicle_type = 2;  // CommonRoad vehicle 1, 2 or 3 (KS1..KS3)
+  bool timing = true;    // false: planning times are recorded as 0 (byte-stable output)
+  Status Validate() const;
+};
+
+// One planning cycle of a run.
+struct RunCycle {
+  int step = 0;
+  double plan_ms = 0;
+  int candidates = 0, checked = 0;
+  plan::PlanStatus status = plan::PlanStatus::kOk;
+  double tracking_error = 0;  // m: the ego's centre after the step from the planned one
+};
+
+struct ProblemRun {
+  int problem_id = 0;
+  Status road;  // why no road could be built (then nothing ran)
+  int lanes = 0;
+  double road_length = 0;  // m
+  std::vector<int> route;  // lanelet ids
+  std::vector<KsState> trajectory;
+  std::vector<RunCycle> cycles;
+  std::string stop_reason;  // "goal", "time"
+  Verdict verdict;
+  double computation_s = 0;  // planning time of the whole run (0 without timing)
+};
+
+struct ScenarioRun {
+  std::string source, benchmark_id;
+  std::vector<ProblemRun> problems;
+};
+
+// The planner configuration for CommonRoad: `base` (config/planner.yaml with
+// config/commonroad.yaml on top, as the command loads it) with the ego's footprint and the
+// vehicle's kinematic limits (vehicle.*, 15% inside the verdict's), the wall-clock deadlines
+// pinned, and the constant-velocity predictor for PredictionMode::kConstantVelocity. Each problem
+// raises limits.max_speed_mph to 2 m/s above its initial speed when that is faster (the planner's
+// speed limit is hard); the lanes' signs limit it further.
+inline constexpr const char* kCommonRoadConfig = "config/commonroad.yaml";  // in the source tree
+StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const VehicleParams& vehicle,
+                                               PredictionMode prediction);
+
+// Runs every planning problem of the scenario. `config` is used as given (see CommonRoadConfig).
+// Never fails: a problem whose road cannot be built reports it in ProblemRun::road.
+ScenarioRun RunScenario(const Scenario& scenario, const plan::PlannerConfig& config,
+                        const RunOptions& options);
+
+}  // namespace frenetic::commonroad

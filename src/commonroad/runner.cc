@@ -1,0 +1,485 @@
+#include "frenetic/commonroad/runner.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/road_builder.h"
+#include "frenetic/cost/goal_region.h"
+#include "frenetic/plan/telemetry.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+constexpr double kTick = plan::kTickSeconds;
+// The planner's limits sit this far inside the verdict's: it measures them on its own path,
+// which the KS ego follows to within centimetres, not exactly.
+constexpr double kLimitMargin = 0.85;
+// Recorded futures the planner is given: enough samples for its horizons (6 s and a little).
+constexpr int kFutureSteps = 80;
+constexpr double kMphToMps = 0.44704;
+// m/s: the ego's speed limit is at least this much above its initial speed (the planner's
+// speed limit is hard).
+constexpr double kStartSpeedRoom = 2.0;
+
+// An obstacle's footprint at a step: centre, heading, length and width (its shape's bounding
+// box in its own frame).
+struct Footprint {
+  Vec2 centre;
+  double heading = 0, length = 0, width = 0;
+};
+
+Footprint FootprintOf(const Obstacle& o, const State& st) {
+  double x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
+  for (const Shape& sh : o.shape.shapes) {
+    if (sh.kind == Shape::Kind::kCircle) {
+      x0 = std::min(x0, sh.center.x - sh.radius);
+      x1 = std::max(x1, sh.center.x + sh.radius);
+      y0 = std::min(y0, sh.center.y - sh.radius);
+      y1 = std::max(y1, sh.center.y + sh.radius);
+      continue;
+    }
+    for (const Vec2& v : sh.Vertices()) {
+      x0 = std::min(x0, v.x);
+      x1 = std::max(x1, v.x);
+      y0 = std::min(y0, v.y);
+      y1 = std::max(y1, v.y);
+    }
+  }
+  Footprint f;
+  f.heading = st.orientation.value_or(0.0);
+  if (!(x1 > x0) || !(y1 > y0)) {
+    f.centre = st.position;
+    return f;
+  }
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  const double c = std::cos(f.heading), s = std::sin(f.heading);
+  f.centre = {st.position.x + c * cx - s * cy, st.position.y + s * cx + c * cy};
+  f.length = x1 - x0;
+  f.width = y1 - y0;
+  return f;
+}
+
+// An obstacle's speed at a step: its state's, else from its positions a step apart.
+double SpeedAt(const Obstacle& o, int step, double dt) {
+  const std::optional<State> st = o.StateAt(step);
+  if (!st) return 0;
+  if (st->velocity) return *st->velocity;
+  if (o.role == ObstacleRole::kStatic) return 0;
+  const std::optional<State> next = o.StateAt(step + 1), prev = o.StateAt(step - 1);
+  if (next) return Distance(next->position, st->position) / dt;
+  if (prev) return Distance(st->position, prev->position) / dt;
+  return 0;
+}
+
+// The goal states as regions of the road's Frenet frame (times in steps; shifted per cycle).
+struct FrenetGoal {
+  cost::GoalRegion region;  // times: steps (absolute), converted per cycle
+  bool timed_lo = false, timed_hi = false;
+};
+
+void AddBox(const map::ReferenceLine& line, const std::vector<Vec2>& pts, cost::GoalRegion* r) {
+  r->s_lo = r->d_lo = std::numeric_limits<double>::infinity();
+  r->s_hi = r->d_hi = -std::numeric_limits<double>::infinity();
+  for (const Vec2& p : pts) {
+    const map::FrenetPoint f = line.ToFrenet(p.x, p.y);
+    r->s_lo = std::min(r->s_lo, f.s);
+    r->s_hi = std::max(r->s_hi, f.s);
+    r->d_lo = std::min(r->d_lo, f.d);
+    r->d_hi = std::max(r->d_hi, f.d);
+  }
+}
+
+// The goal's orientation interval as a heading against the road's in the region (its s mid):
+// a vehicle turned left of the road moves toward smaller d, so h = road - orientation.
+void AddHeading(const map::ReferenceLine& line, const GoalState& g, cost::GoalRegion* r) {
+  if (!g.orientation || !(g.orientation->end - g.orientation->start < 2 * 3.141592653589793)) {
+    return;
+  }
+  const double road = line.At(0.5 * (r->s_lo + r->s_hi)).heading;
+  const double half = 0.5 * (g.orientation->end - g.orientation->start);
+  const double mid = WrapAngle(road - g.orientation->Mid());
+  r->h_lo = mid - half;
+  r->h_hi = mid + half;
+}
+
+std::vector<FrenetGoal> FrenetGoals(const Scenario& sc, const PlanningProblem& p,
+                                    const map::ReferenceLine& line) {
+  std::vector<FrenetGoal> out;
+  for (const GoalState& g : p.goals) {
+    FrenetGoal base;
+    if (g.time) {
+      base.region.t_lo = g.time->start;
+      base.region.t_hi = g.time->end;
+      base.timed_lo = base.timed_hi = true;
+    }
+    if (g.velocity) {
+      base.region.v_lo = g.velocity->start;
+      base.region.v_hi = g.velocity->end;
+    }
+    if (!g.HasPosition()) {
+      out.push_back(base);
+      continue;
+    }
+    for (const Shape& sh : g.shapes) {
+      FrenetGoal fg = base;
+      std::vector<Vec2> pts = sh.Vertices();
+      if (sh.kind == Shape::Kind::kCircle) {
+        for (int i = 0; i < 8; ++i) {
+          const double a = i * 0.25 * 3.141592653589793;
+          pts.push_back({sh.center.x + sh.radius * std::cos(a), sh.center.y + sh.radius * std::sin(a)});
+        }
+      }
+      AddBox(line, pts, &fg.region);
+      AddHeading(line, g, &fg.region);
+      out.push_back(fg);
+    }
+    for (int id : g.lanelets) {
+      const Lanelet* l = sc.FindLanelet(id);
+      if (l == nullptr) continue;
+      FrenetGoal fg = base;
+      AddBox(line, l->Polygon(), &fg.region);
+      AddHeading(line, g, &fg.region);
+      out.push_back(fg);
+    }
+  }
+  return out;
+}
+
+// The step after which the run ends: the last goal window's end, else the last step an
+// obstacle is recorded at (at least 10 s), capped.
+int EndStep(const Scenario& sc, const PlanningProblem& p) {
+  int end = -1;
+  bool untimed = false;
+  for (const GoalState& g : p.goals) {
+    if (g.time) {
+      end = std::max(end, g.time->end);
+    } else {
+      untimed = true;
+    }
+  }
+  if (untimed || end < 0) {
+    int last = p.initial.time_step + static_cast<int>(std::lround(10.0 / sc.dt));
+    for (const Obstacle& o : sc.obstacles) {
+      if (o.role == ObstacleRole::kDynamic) last = std::max(last, o.LastStep());
+    }
+    end = std::max(end, last);
+  }
+  return std::min(end, p.initial.time_step + kMaxSteps);
+}
+
+// Signed Menger curvature of three points (left positive).
+double Curvature(double x1, double y1, double x2, double y2, double x3, double y3) {
+  const double ax = x2 - x1, ay = y2 - y1, bx = x3 - x2, by = y3 - y2, cx = x3 - x1, cy = y3 - y1;
+  const double den = std::sqrt((ax * ax + ay * ay) * (bx * bx + by * by) * (cx * cx + cy * cy));
+  return den > 1e-12 ? 2.0 * (ax * by - ay * bx) / den : 0.0;
+}
+
+// The ego after one step toward the planned path (x, y: 0.02 s points from the step's start,
+// the first one 0.02 s in): the constant KS input whose step lands closest to the planned
+// state there (position, orientation, steering angle, speed, weighted), found by Gauss-Newton
+// from the feed-forward input.
+KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
+               double dt, const VehicleParams& vp) {
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
+  const int n = static_cast<int>(std::min(x.size(), y.size()));
+  if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
+  const int j = ticks - 1;  // the point dt in
+  const double tx = x[j], ty = y[j];
+  const int a = std::max(0, j - 1), b = j + 1;
+  const double theta = std::atan2(y[b] - y[a], x[b] - x[a]);
+  const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * kTick);
+  const double kappa = Curvature(x[a], y[a], x[j], y[j], x[b], y[b]);
+  const double l_wb = vp.Wheelbase();
+  const double delta = std::atan(l_wb * kappa);
+  // The centre moves at the slip angle beta off the vehicle's axis.
+  const double beta = std::atan(vp.b * std::tan(delta) / l_wb);
+  const double psi = theta - beta;
+  const double v = speed * std::cos(beta);
+  // Residuals, scaled by what counts as 1: 1 cm, 5 mrad of orientation, 10 mrad of steering,
+  // 0.1 m/s.
+  auto residual = [&](const KsInput& u, double r[5]) {
+    const KsState s = SimulateKs(ego, u, dt, vp);
+    r[0] = (s.x - tx) / 0.01;
+    r[1] = (s.y - ty) / 0.01;
+    r[2] = WrapAngle(s.orientation - psi) / 0.005;
+    r[3] = (s.steering_angle - delta) / 0.01;
+    r[4] = (s.velocity - v) / 0.1;
+  };
+  KsInput u{(delta - ego.steering_angle) / dt, (v - ego.velocity) / dt};
+  // Within the steering rate and acceleration limits, and the friction circle a^2 + (v psi')^2
+  // <= a_max^2 at the step's start (with kLimitMargin to spare).
+  const double yaw_acc = ego.velocity * ego.velocity / l_wb * std::tan(ego.steering_angle);
+  const double a_room = std::sqrt(std::max(0.0, std::pow(kLimitMargin * vp.a_max, 2) - yaw_acc * yaw_acc));
+  auto clip = [&](KsInput w) {
+    w.steering_rate = std::clamp(w.steering_rate, vp.steering_rate_min, vp.steering_rate_max);
+    w.acceleration = std::clamp(w.acceleration, -a_room,
+                                std::min(a_room, kLimitMargin * vp.MaxAcceleration(ego.velocity)));
+    return w;
+  };
+  u = clip(u);
+  for (int it = 0; it < 4; ++it) {
+    double r[5], r1[5], r2[5];
+    residual(u, r);
+    const double h1 = 1e-4, h2 = 1e-3;
+    residual({u.steering_rate + h1, u.acceleration}, r1);
+    residual({u.steering_rate, u.acceleration + h2}, r2);
+    double jtj[3] = {0, 0, 0}, jtr[2] = {0, 0};  // [a b; b c]
+    for (int k = 0; k < 5; ++k) {
+      const double j1 = (r1[k] - r[k]) / h1, j2 = (r2[k] - r[k]) / h2;
+      jtj[0] += j1 * j1;
+      jtj[1] += j1 * j2;
+      jtj[2] += j2 * j2;
+      jtr[0] += j1 * r[k];
+      jtr[1] += j2 * r[k];
+    }
+    const double det = jtj[0] * jtj[2] - jtj[1] * jtj[1];
+    if (!(std::abs(det) > 1e-12)) break;
+    const double d1 = (jtj[2] * jtr[0] - jtj[1] * jtr[1]) / det;
+    const double d2 = (jtj[0] * jtr[1] - jtj[1] * jtr[0]) / det;
+    u = clip({u.steering_rate - d1, u.acceleration - d2});
+    if (std::abs(d1) < 1e-7 && std::abs(d2) < 1e-6) break;
+  }
+  return SimulateKs(ego, u, dt, vp);
+}
+
+}  // namespace
+
+const char* ToString(PredictionMode mode) {
+  return mode == PredictionMode::kRecorded ? "recorded" : "constant-velocity";
+}
+
+StatusOr<PredictionMode> ParsePredictionMode(std::string_view text) {
+  if (text == "recorded") return PredictionMode::kRecorded;
+  if (text == "constant-velocity") return PredictionMode::kConstantVelocity;
+  return Status::Error("unknown prediction '" + std::string(text) +
+                       "' (known: recorded, constant-velocity)");
+}
+
+Status RunOptions::Validate() const {
+  if (vehicle_type < 1 || vehicle_type > 3) {
+    return Status::Error("vehicle type must be 1, 2 or 3, got " + std::to_string(vehicle_type));
+  }
+  return Status::Ok();
+}
+
+StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig c, const VehicleParams& vp,
+                                               PredictionMode prediction) {
+  c.PinDeadlines();
+  const std::pair<const char*, double> values[] = {
+      {"check.ego_length", vp.length},
+      {"check.ego_width", vp.width},
+      {"vehicle.wheelbase", vp.Wheelbase()},
+      {"vehicle.max_steer", kLimitMargin * vp.steering_max},
+      {"vehicle.max_steer_rate", kLimitMargin * vp.steering_rate_max},
+      {"vehicle.max_accel", kLimitMargin * vp.a_max},
+      {"vehicle.switch_speed", vp.v_switch},
+      {"prediction.manoeuvres", prediction == PredictionMode::kRecorded ? 1.0 : 0.0},
+  };
+  for (const auto& [key, value] : values) {
+    if (Status st = c.Set(key, value); !st.ok()) return st;
+  }
+  return c;
+}
+
+ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
+                        const RunOptions& options) {
+  ScenarioRun out;
+  out.source = sc.source;
+  out.benchmark_id = sc.benchmark_id;
+  const VehicleParams vp = VehicleParamsForType(options.vehicle_type).ok()
+                               ? *VehicleParamsForType(options.vehicle_type)
+                               : VehicleParams();
+  const VerdictChecker checker(sc, vp);
+  const double dt = sc.dt;
+  for (const PlanningProblem& problem : sc.problems) {
+    ProblemRun run;
+    run.problem_id = problem.id;
+    auto built = BuildRoad(sc, problem);
+    if (!built.ok()) {
+      run.road = built.status();
+      run.verdict = checker.Check(problem, run.trajectory);
+      out.problems.push_back(std::move(run));
+      continue;
+    }
+    const map::Road& road = *built->road;
+    const map::ReferenceLine& line = road.line();
+    run.lanes = road.num_lanes();
+    run.road_length = line.length();
+    run.route = built->route;
+    // The ego's cruise speed: the configured one, but never below its initial speed (the
+    // planner's speed limit is hard) nor above the vehicle's.
+    plan::PlannerConfig problem_config = config;
+    {
+      const double v0 = problem.initial.velocity.value_or(0.0);
+      const double mph = std::min(std::max(config.value("limits.max_speed_mph"),
+                                           (v0 + kStartSpeedRoom) / kMphToMps),
+                                  kLimitMargin * vp.v_max / kMphToMps);
+      (void)problem_config.Set("limits.max_speed_mph", mph);
+    }
+    auto planner = plan::MakePlanner("search", problem_config, built->road);
+    if (!planner.ok()) {
+      run.road = planner.status();
+      out.problems.push_back(std::move(run));
+      continue;
+    }
+    const std::vector<FrenetGoal> goals = FrenetGoals(sc, problem, line);
+    for (const FrenetGoal& g : goals) {
+      const cost::GoalRegion& r = g.region;
+      spdlog::debug("{} #{}: goal s [{:.2f}, {:.2f}] d [{:.2f}, {:.2f}] steps [{}, {}] v [{}, {}] h [{}, {}]",
+                    sc.benchmark_id, problem.id, r.s_lo, r.s_hi, r.d_lo, r.d_hi, r.t_lo, r.t_hi,
+                    r.v_lo, r.v_hi, r.h_lo, r.h_hi);
+    }
+    for (int l = 0; l < road.num_lanes(); ++l) {
+      const map::Road::Span a = road.LaneAt(l, line.ToFrenet(problem.initial.position.x,
+                                                             problem.initial.position.y).s);
+      spdlog::debug("{} #{}: lane {} [{:.2f}, {:.2f}] at the start, s [{:.1f}, {:.1f}]",
+                    sc.benchmark_id, problem.id, l, a.left, a.right, road.LaneBegin(l),
+                    road.LaneEnd(l));
+    }
+    const int start = problem.initial.time_step, end = EndStep(sc, problem);
+    KsState ego;
+    ego.time_step = start;
+    ego.x = problem.initial.position.x;
+    ego.y = problem.initial.position.y;
+    ego.velocity = problem.initial.velocity.value_or(0.0);
+    if (problem.initial.orientation) {
+      ego.orientation = *problem.initial.orientation;
+    } else {
+      ego.orientation = line.At(line.ToFrenet(ego.x, ego.y).s).heading;
+    }
+    ego.steering_angle = problem.initial.steering_angle.value_or(0.0);
+    run.trajectory.push_back(ego);
+    plan::Telemetry t;
+    std::vector<double> path_x, path_y;
+    run.stop_reason = "time";
+    for (int k = start; k < end; ++k) {
+      bool met = false;
+      for (const GoalState& g : problem.goals) met = met || MeetsGoal(sc, g, ego);
+      if (met) {
+        run.stop_reason = "goal";
+        break;
+      }
+      // The telemetry of step k.
+      t.x = ego.x;
+      t.y = ego.y;
+      t.yaw = ego.orientation;
+      t.speed = ego.velocity;
+      const map::FrenetPoint fe = line.ToFrenet(ego.x, ego.y);
+      t.s = fe.s;
+      t.d = fe.d;
+      t.previous_path_x = path_x;
+      t.previous_path_y = path_y;
+      t.sensor_fusion.clear();
+      t.futures.clear();
+      for (const Obstacle& o : sc.obstacles) {
+        const std::optional<State> st = o.StateAt(k);
+        if (!st) continue;
+        const Footprint fp = FootprintOf(o, *st);
+        const double v = SpeedAt(o, k, dt);
+        plan::SensorCar row;
+        row.id = o.id;
+        row.x = fp.centre.x;
+        row.y = fp.centre.y;
+        row.vx = v * std::cos(fp.heading);
+        row.vy = v * std::sin(fp.heading);
+        const map::FrenetPoint fo = line.ToFrenet(row.x, row.y, fe.s);
+        row.s = fo.s;
+        row.d = fo.d;
+        row.length = fp.length;
+        row.width = fp.width;
+        t.sensor_fusion.push_back(row);
+        if (options.prediction != PredictionMode::kRecorded) continue;
+        plan::CarFuture fut;
+        fut.id = o.id;
+        fut.dt = dt;
+        for (int q = k; q <= std::min(k + kFutureSteps, o.LastStep()); ++q) {
+          const std::optional<State> sq = o.StateAt(q);
+          if (!sq) break;
+          const Footprint fq = FootprintOf(o, *sq);
+          fut.x.push_back(fq.centre.x);
+          fut.y.push_back(fq.centre.y);
+          fut.v.push_back(SpeedAt(o, q, dt));
+          fut.heading.push_back(fq.heading);
+        }
+        t.futures.push_back(std::move(fut));
+      }
+      t.goals.clear();
+      for (const FrenetGoal& g : goals) {
+        cost::GoalRegion r = g.region;
+        if (g.timed_lo) r.t_lo = (r.t_lo - k) * dt;
+        if (g.timed_hi) r.t_hi = (r.t_hi - k) * dt;
+        t.goals.push_back(r);
+      }
+      const bool tracing = spdlog::should_log(spdlog::level::trace);
+      plan::CycleTrace trace;
+      if (tracing) (*planner)->set_trace(&trace, 200);
+      const auto t0 = std::chrono::steady_clock::now();
+      const plan::PlanResult& res = (*planner)->Plan(t);
+      if (tracing) {
+        // The best candidate of each lane: its cost by term and what became of it.
+        std::vector<bool> seen(16, false);
+        for (const plan::CandidateTrace& c : trace.candidates) {
+          if (c.lane < 0 || c.lane >= 16 || (seen[c.lane] && !c.checked)) continue;
+          seen[c.lane] = true;
+          std::string terms;
+          for (const plan::CostTermValue& v : c.costs) {
+            if (v.weight * v.value > 0.01) terms += fmt::format(" {} {:.2f}", v.name, v.weight * v.value);
+          }
+          spdlog::trace("  lane {} v_end {:.1f} T {:.1f} cost {:.2f} reject {} car {} at {:.1f} s:{}",
+                        c.lane, c.end_speed, c.duration, c.total_cost,
+                        c.reject >= 0 ? plan::ToString(static_cast<plan::Reject>(c.reject)) : "-",
+                        c.reject_car, c.reject_time, terms);
+        }
+        (*planner)->set_trace(nullptr, 0);
+      }
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      RunCycle cyc;
+      cyc.step = k;
+      cyc.plan_ms = options.timing ? ms : 0.0;
+      cyc.candidates = res.summary.candidates_generated;
+      cyc.checked = res.summary.candidates_checked;
+      cyc.status = res.status;
+      // The ego drives dt along the plan.
+      const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
+      ego = Follow(ego, res.x, res.y, dt, vp);
+      ego.time_step = k + 1;
+      const size_t j = std::min<size_t>(ticks - 1, res.x.empty() ? 0 : res.x.size() - 1);
+      if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);
+      path_x.assign(res.x.begin() + std::min<size_t>(ticks, res.x.size()), res.x.end());
+      path_y.assign(res.y.begin() + std::min<size_t>(ticks, res.y.size()), res.y.end());
+      run.trajectory.push_back(ego);
+      std::string why;
+      for (int q = 0; q < static_cast<int>(plan::Reject::kCount); ++q) {
+        if (res.summary.rejections[q] > 0) {
+          why += std::string(" ") + plan::ToString(static_cast<plan::Reject>(q)) + " " +
+                 std::to_string(res.summary.rejections[q]);
+        }
+      }
+      spdlog::debug("{} #{} step {}: {} cands {} checked {} ({}) lane {} v_end {:.2f} | ego s {:.2f} d {:.2f} v {:.2f} delta {:.3f} track {:.3f}",
+                    sc.benchmark_id, problem.id, k, plan::ToString(res.status),
+                    res.summary.candidates_generated, res.summary.candidates_checked, why,
+                    res.summary.winner_lane, res.summary.winner_end_speed, fe.s, fe.d,
+                    ego.velocity, ego.steering_angle, cyc.tracking_error);
+      run.cycles.push_back(cyc);
+      run.computation_s += cyc.plan_ms / 1000.0;
+    }
+    if (run.stop_reason == "time") {
+      bool met = false;
+      for (const GoalState& g : problem.goals) met = met || MeetsGoal(sc, g, ego);
+      if (met) run.stop_reason = "goal";
+    }
+    run.verdict = checker.Check(problem, run.trajectory);
+    out.problems.push_back(std::move(run));
+  }
+  return out;
+}
+
+}  // namespace frenetic::commonroad
