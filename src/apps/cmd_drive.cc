@@ -35,6 +35,8 @@ struct DriveArgs {
   int episodes = 1;
   int jobs = 0;
   bool progress = false;
+  bool no_judge = false;
+  int judge_budget = sim::JudgeOptions().budget_blocks;
   bool no_timing = false;
   bool real_time_deadlines = false;
   std::string connect;
@@ -66,12 +68,15 @@ int Drive(const DriveArgs& a) {
   auto world = sim::LoadWorld(map_path);
   if (!world.ok()) return Fail(world.message());
 
+  sim::JudgeOptions judge;
+  judge.budget_blocks = a.judge_budget;
   if (!a.connect.empty()) {
     if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
     ConnectOptions connect;
     connect.url = a.connect;
     connect.realtime = a.realtime;
     connect.timing = !a.no_timing;
+    if (!a.no_judge) connect.judge = judge;
     std::unique_ptr<sim::RecordWriter> record;
     if (!a.record_path.empty()) {
       auto writer = sim::RecordWriter::Open(a.record_path);
@@ -104,8 +109,11 @@ int Drive(const DriveArgs& a) {
   const bool tty = isatty(fileno(stderr)) != 0;
   if (a.episodes > 1) {
     if (!a.record_path.empty()) return Fail("--record needs a single episode (--episodes 1)");
-    auto agg = sim::RunEpisodes(*world, *scenario, seed, a.episodes, a.jobs, limits, factory,
-                                !a.no_timing);
+    sim::EpisodesOptions options;
+    options.timing = !a.no_timing;
+    if (!a.no_judge) options.judge = judge;
+    auto agg =
+        sim::RunEpisodes(*world, *scenario, seed, a.episodes, a.jobs, limits, factory, options);
     if (!agg.ok()) return Fail(agg.message());
     if (a.json) {
       std::printf("%s\n", agg->ToJson().dump().c_str());
@@ -118,6 +126,7 @@ int Drive(const DriveArgs& a) {
   std::unique_ptr<sim::RecordWriter> record;
   sim::RunOptions options;
   options.timing = !a.no_timing;
+  if (!a.no_judge) options.judge = judge;
   if (!a.record_path.empty()) {
     auto writer = sim::RecordWriter::Open(a.record_path);
     if (!writer.ok()) return Fail(writer.message());
@@ -194,6 +203,16 @@ void RegisterDrive(CLI::App& app) {
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,
                 "Show the live progress line on stderr even when it is not a terminal");
+  sub->add_flag("--no-judge", args->no_judge,
+                "Do not judge the incidents. Default: every incident is judged: a search from the "
+                "ego's state at every 0.2 s of the 3 s before it, over trajectories within the "
+                "simulator's limits against the traffic as it moved, reports \"avoidable from "
+                "t = ...\" or \"unavoidable\" (the traffic's) in the report and the JSON");
+  sub->add_option("--judge-budget", args->judge_budget,
+                  "Judging: 0.2 s blocks simulated per start before a search gives up (the start "
+                  "is then undecided, never unavoidable). Default: " +
+                      std::to_string(sim::JudgeOptions().budget_blocks))
+      ->check(CLI::Range(1, 100000000));
   sub->add_flag("--real-time-deadlines", args->real_time_deadlines,
                 "Apply the planner's wall-clock deadlines (budget_ms, refine.budget_ms) as "
                 "configured. Default: off - the headless simulator counts latency in ticks, so "

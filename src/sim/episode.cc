@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "frenetic/net/protocol.h"
+#include "frenetic/sim/incident_recorder.h"
 #include "frenetic/sim/record.h"
 #include "frenetic/wire_precision.h"
 
@@ -60,6 +61,10 @@ DriveReport MakeReport(const Episode& ep, std::string_view planner,
   r.incident_log = m.log();
   r.laps = sim.breakdown().laps();
   r.breakdown = sim.breakdown().Total();
+  if (const auto* judged = ep.judgements(); judged != nullptr) {
+    r.judged = true;
+    r.judgements = *judged;
+  }
   return r;
 }
 
@@ -87,6 +92,27 @@ Episode::Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits)
   sim_->GetTelemetry(&telemetry_);
 }
 
+Episode::~Episode() = default;
+
+void Episode::EnableJudging(const JudgeOptions& options, bool timing) {
+  recorder_ = std::make_unique<IncidentRecorder>(*sim_, options, timing);
+}
+
+const std::vector<IncidentJudgement>* Episode::judgements() const {
+  return recorder_ ? &recorder_->judgements() : nullptr;
+}
+
+void Episode::Advance(int ticks) {
+  if (!recorder_) {
+    sim_->Advance(ticks);
+    return;
+  }
+  for (int i = 0; i < ticks; ++i) {
+    sim_->Advance(1);
+    recorder_->AfterTick();
+  }
+}
+
 Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
   const TimingOptions& t = sim_->scenario().timing;
   int l_old = 0, l_new = 1;
@@ -106,11 +132,12 @@ Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
   }
   last_l_old_ = l_old;
   last_l_new_ = l_new;
-  sim_->Advance(l_old);
+  Advance(l_old);
   Status status = sim_->ApplyPath(x, y);
-  sim_->Advance(l_new);
+  Advance(l_new);
   ++exchanges_;
   CheckDone();
+  if (done() && recorder_) recorder_->Finish();
   sim_->GetTelemetry(&telemetry_);
   return status;
 }
@@ -134,9 +161,13 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
                                  std::uint64_t seed, const EpisodeLimits& limits,
                                  plan::Planner& planner, const RunOptions& options) {
   if (Status s = limits.Validate(); !s.ok()) return s;
+  if (options.judge) {
+    if (Status s = options.judge->Validate(); !s.ok()) return s;
+  }
   auto sim = Simulator::Create(std::move(world), scenario, seed);
   if (!sim.ok()) return sim.status();
   Episode ep(std::move(*sim), limits);
+  if (options.judge) ep.EnableJudging(*options.judge, options.timing);
   planner.Reset();
   plan::CycleTrace trace;
   RecordWriter* record = options.record;
@@ -198,12 +229,15 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   return report;
 }
 
-StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
-                                      const Scenario& scenario, std::uint64_t first_seed,
-                                      int episodes, int jobs, const EpisodeLimits& limits,
-                                      const PlannerFactory& factory, bool timing) {
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const Scenario& scenario,
+                                      std::uint64_t first_seed, int episodes, int jobs,
+                                      const EpisodeLimits& limits, const PlannerFactory& factory,
+                                      const EpisodesOptions& options) {
   if (episodes < 1) return Status::Error("episodes must be >= 1");
   if (Status s = limits.Validate(); !s.ok()) return s;
+  if (options.judge) {
+    if (Status s = options.judge->Validate(); !s.ok()) return s;
+  }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   jobs = std::min(jobs, episodes);
   std::vector<std::optional<StatusOr<DriveReport>>> results(episodes);
@@ -215,9 +249,10 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
         results[i] = planner.status();
         continue;
       }
-      RunOptions options;
-      options.timing = timing;
-      results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, options);
+      RunOptions run;
+      run.timing = options.timing;
+      run.judge = options.judge;
+      results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, run);
     }
   };
   std::vector<std::thread> pool;
@@ -231,6 +266,16 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
     reports.push_back(std::move(r->value()));
   }
   return AggregateReport::From(std::move(reports));
+}
+
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const Scenario& scenario,
+                                      std::uint64_t first_seed, int episodes, int jobs,
+                                      const EpisodeLimits& limits, const PlannerFactory& factory,
+                                      bool timing) {
+  EpisodesOptions options;
+  options.timing = timing;
+  return RunEpisodes(std::move(world), scenario, first_seed, episodes, jobs, limits, factory,
+                     options);
 }
 
 }  // namespace frenetic::sim

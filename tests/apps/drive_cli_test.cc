@@ -37,11 +37,35 @@ TEST(DriveCli, BadInputGivesOneLineAndExitOne) {
   }
 }
 
+// Incidents are judged unless --no-judge: the JSON gains fields only.
+TEST(DriveCli, IncidentsAreJudgedUnlessSwitchedOff) {
+  const std::string args =
+      "drive --seconds 95 --seed 1 --latency random --planner baseline --scenario cut-in --json "
+      "--no-timing";
+  CommandResult judged = RunFrenetic(args + " 2>/dev/null");
+  CommandResult plain = RunFrenetic(args + " --no-judge 2>/dev/null");
+  ASSERT_EQ(judged.exit_code, 0);
+  ASSERT_EQ(plain.exit_code, 0);
+  auto j = nlohmann::json::parse(judged.out);
+  const auto p = nlohmann::json::parse(plain.out);
+  ASSERT_GT(j["incidents"].get<int>(), 0) << "the baseline crashes at 89.5 s";
+  ASSERT_TRUE(j.contains("judged"));
+  EXPECT_FALSE(p.contains("judged"));
+  for (const auto& i : j["incident_log"]) {
+    ASSERT_TRUE(i.contains("judgement"));
+    EXPECT_TRUE(i["judgement"]["summary"].is_string());
+  }
+  j.erase("judged");
+  for (auto& i : j["incident_log"]) i.erase("judgement");
+  EXPECT_EQ(j.dump(), p.dump());
+}
+
 TEST(DriveCli, HelpExplainsOptionsWithDefaults) {
   CommandResult r = RunFrenetic("drive --help");
   ASSERT_EQ(r.exit_code, 0);
-  for (const char* option : {"--map", "--scenario", "--seed", "--laps", "--planner", "--record",
-                             "--json", "--episodes", "--connect"}) {
+  for (const char* option :
+       {"--map", "--scenario", "--seed", "--laps", "--planner", "--record", "--json", "--episodes",
+        "--connect", "--progress", "--no-judge", "--judge-budget"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }
   EXPECT_NE(r.out.find("Default"), std::string::npos);
