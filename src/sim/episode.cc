@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -242,7 +243,25 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
   jobs = std::min(jobs, episodes);
   std::vector<std::optional<StatusOr<DriveReport>>> results(episodes);
   std::atomic<int> next{0};
-  auto worker = [&] {
+  // Progress: the finished episodes' totals and each worker's running distance, under a lock.
+  std::mutex progress_mutex;
+  EpisodesProgress progress;
+  progress.total = episodes;
+  std::vector<double> running(jobs, 0.0);
+  auto report_progress = [&](int worker, double worker_miles, const DriveReport* finished) {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    running[worker] = worker_miles;
+    progress.episode_finished = finished != nullptr;
+    if (finished != nullptr) {
+      ++progress.done;
+      progress.miles += finished->miles();
+      progress.incidents += finished->incidents;
+    }
+    progress.running_miles = 0;
+    for (double m : running) progress.running_miles += m;
+    options.progress(progress);
+  };
+  auto worker = [&](int w) {
     for (int i = next++; i < episodes; i = next++) {
       auto planner = factory();
       if (!planner.ok()) {
@@ -252,12 +271,19 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
       RunOptions run;
       run.timing = options.timing;
       run.judge = options.judge;
+      if (options.progress) {
+        run.progress = [&, w, exchanges = 0](const Episode& ep) mutable {
+          if (++exchanges % 256 != 0) return;
+          report_progress(w, ep.sim().monitor().distance() / kMetersPerMile, nullptr);
+        };
+      }
       results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, run);
+      if (options.progress && results[i]->ok()) report_progress(w, 0.0, &results[i]->value());
     }
   };
   std::vector<std::thread> pool;
-  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
-  worker();
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker, j);
+  worker(0);
   for (auto& t : pool) t.join();
   std::vector<DriveReport> reports;
   reports.reserve(episodes);

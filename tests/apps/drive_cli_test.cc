@@ -1,7 +1,10 @@
 // `frenetic drive` as a user runs it: report fields, JSON, exit codes and one-line errors.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <regex>
 #include <string>
+#include <vector>
 
 #include "apps_test_util.h"
 
@@ -35,6 +38,44 @@ TEST(DriveCli, BadInputGivesOneLineAndExitOne) {
     EXPECT_NE(r.out.find(c.needle), std::string::npos) << c.args << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << c.args << ": " << r.out;
   }
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// `--episodes N --progress` off a terminal: lines "episodes k/N  elapsed ...  ETA ...  x mi
+// n incidents" on stderr, the last one for N/N; stdout is the same JSON as without it.
+TEST(DriveCli, ProgressOfManyEpisodesGoesToStderr) {
+  const std::string err = ::testing::TempDir() + "/progress_err.txt";
+  const std::string common =
+      "drive --seconds 10 --planner baseline --episodes 3 --jobs 2 --json --no-timing";
+  CommandResult quiet = RunFrenetic(common + " 2>/dev/null");
+  CommandResult shown = RunFrenetic(common + " --progress 2>" + err);
+  ASSERT_EQ(quiet.exit_code, 0);
+  ASSERT_EQ(shown.exit_code, 0);
+  EXPECT_EQ(shown.out, quiet.out);
+  const std::vector<std::string> lines = Lines(err);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_LE(lines.size(), 3u);  // one per episode at most, not a flood
+  const std::regex format(
+      R"(episodes ([0-3])/3  elapsed \d+:\d\d:\d\d  ETA (\d+:\d\d:\d\d|-:--:--)  \d+\.\d mi  \d+ incidents?)");
+  int done = 0;
+  for (const std::string& line : lines) {
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(line, m, format)) << line;
+    EXPECT_GE(std::stoi(m[1]), done) << line;
+    done = std::stoi(m[1]);
+  }
+  EXPECT_EQ(lines.back().rfind("episodes 3/3  ", 0), 0u) << lines.back();
+  const auto j = nlohmann::json::parse(shown.out);
+  const int incidents = j["incidents"].get<int>();
+  std::string needle = "mi  ";
+  needle += std::to_string(incidents);
+  EXPECT_NE(lines.back().find(needle), std::string::npos) << lines.back();
 }
 
 // Incidents are judged unless --no-judge: the JSON gains fields only.

@@ -211,6 +211,36 @@ TEST(RunEpisode, JudgingReportsEveryIncidentAndNeverChangesTheDrive) {
   }
 }
 
+TEST(RunEpisodes, ProgressIsReportedAndChangesNothing) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  auto factory = [&]() -> StatusOr<std::unique_ptr<plan::Planner>> {
+    return std::unique_ptr<plan::Planner>(new KeepLanePlanner(world->line, 21));
+  };
+  const EpisodeLimits limits{0, 0, 40, 60};
+  auto quiet = RunEpisodes(world, Scenario(), 5, 3, 2, limits, factory, false);
+  EpisodesOptions options;
+  options.timing = false;
+  std::vector<EpisodesProgress> seen;
+  options.progress = [&seen](const EpisodesProgress& p) { seen.push_back(p); };
+  auto shown = RunEpisodes(world, Scenario(), 5, 3, 2, limits, factory, options);
+  ASSERT_TRUE(quiet.ok() && shown.ok());
+  EXPECT_EQ(quiet->ToJson().dump(), shown->ToJson().dump());
+  int finished = 0, done = 0;
+  for (const EpisodesProgress& p : seen) {
+    EXPECT_EQ(p.total, 3);
+    EXPECT_GE(p.done, done);
+    done = p.done;
+    finished += p.episode_finished;
+  }
+  EXPECT_EQ(finished, 3);
+  EXPECT_GT(seen.size(), 3u);  // calls while the episodes run as well
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back().done, 3);
+  EXPECT_NEAR(seen.back().miles, shown->total_miles, 1e-9);
+  EXPECT_EQ(seen.back().incidents, shown->incidents);
+  EXPECT_EQ(seen.back().running_miles, 0);
+}
+
 TEST(RunEpisodes, JudgedVerdictsAddUp) {
   FRENETIC_REQUIRE_UDACITY(world);
   auto factory = [&]() -> StatusOr<std::unique_ptr<plan::Planner>> {

@@ -110,9 +110,21 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
 
 using PlannerFactory = std::function<StatusOr<std::unique_ptr<plan::Planner>>()>;
 
+// How far RunEpisodes has got.
+struct EpisodesProgress {
+  int done = 0, total = 0;        // episodes finished, episodes asked for
+  double miles = 0;               // driven by the finished episodes
+  int incidents = 0;              // of the finished episodes
+  double running_miles = 0;       // driven so far by the episodes still running
+  bool episode_finished = false;  // this call follows the end of an episode
+};
+
 struct EpisodesOptions {
   bool timing = true;                 // RunOptions::timing
   std::optional<JudgeOptions> judge;  // RunOptions::judge
+  // Called after every finished episode and every 256 exchanges of a running one, one call at a
+  // time (from the worker threads, under a lock); may be empty. It cannot change the results.
+  std::function<void(const EpisodesProgress&)> progress;
 };
 
 // Runs `episodes` episodes with seeds first_seed, first_seed + 1, ... on `jobs` threads (0 =
