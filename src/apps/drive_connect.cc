@@ -105,6 +105,7 @@ StatusOr<sim::DriveReport> DriveOverNetwork(std::shared_ptr<const sim::World> wo
   auto simulator = sim::Simulator::Create(std::move(world), scenario, seed);
   if (!simulator.ok()) return simulator.status();
   sim::Episode episode(std::move(simulator).value(), limits);
+  if (options.judge) episode.EnableJudging(*options.judge, options.timing);
   EpisodeEndpoint endpoint(&episode, options.record, options.timing);
   if (options.record != nullptr) {
     options.record->set_timing(options.timing);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "frenetic/sim/drive_report.h"
@@ -23,6 +24,8 @@ struct ConnectOptions {
   // When set, the drive is recorded as an in-process one is (sim/record.h), with the planner's
   // internals absent: header, one line per exchange, footer.
   sim::RecordWriter* record = nullptr;
+  // Judge every incident (sim::Episode::EnableJudging); unset: off.
+  std::optional<sim::JudgeOptions> judge;
 };
 
 // Drives one episode over the network. The report's planning times are round-trip times per

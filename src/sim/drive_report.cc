@@ -43,6 +43,53 @@ nlohmann::json BreakdownJson(const LapBreakdown& total, const std::vector<LapBre
   return j;
 }
 
+nlohmann::json JudgementJson(const IncidentJudgement& j) {
+  nlohmann::json starts = nlohmann::json::array();
+  for (const StartJudgement& s : j.starts) {
+    nlohmann::json o = {{"t", s.t}, {"result", ToString(s.result)}, {"blocks", s.blocks}};
+    if (s.as_driven_first) o["as_driven_first"] = true;
+    starts.push_back(std::move(o));
+  }
+  nlohmann::json o = {{"verdict", ToString(j.verdict)},
+                      {"summary", Describe(j)},
+                      {"until", j.until},
+                      {"blocks", j.blocks},
+                      {"ms", j.ms},
+                      {"starts", std::move(starts)}};
+  if (j.verdict == Verdict::kAvoidable) {
+    o["avoidable_from"] = j.avoidable_from;
+    o["last_chance"] = j.last_chance;
+    o["escape"] = j.escape;
+  }
+  return o;
+}
+
+constexpr std::array<Verdict, 4> kVerdicts = {Verdict::kAvoidable, Verdict::kUnavoidable,
+                                              Verdict::kUndecided, Verdict::kNotJudged};
+
+// Incidents per verdict; an incident without a judgement (a drive cut short) is not judged.
+std::array<int, 4> CountVerdicts(const DriveReport& r) {
+  std::array<int, 4> n{};
+  for (const IncidentJudgement& j : r.judgements) ++n[static_cast<int>(j.verdict)];
+  if (r.incident_log.size() > r.judgements.size()) {
+    n[static_cast<int>(Verdict::kNotJudged)] +=
+        static_cast<int>(r.incident_log.size() - r.judgements.size());
+  }
+  return n;
+}
+
+nlohmann::json VerdictsJson(const std::array<int, 4>& n) {
+  nlohmann::json o = nlohmann::json::object();
+  for (Verdict v : kVerdicts) o[ToString(v)] = n[static_cast<int>(v)];
+  return o;
+}
+
+std::string VerdictsText(const std::array<int, 4>& n) {
+  return fmt::format(
+      "judged          {} avoidable, {} unavoidable (the traffic's), {} undecided, {} not judged\n",
+      n[0], n[1], n[2], n[3]);
+}
+
 }  // namespace
 
 double DriveReport::per_mile(IncidentKind kind) const {
@@ -58,36 +105,44 @@ nlohmann::json DriveReport::ToJson() const {
     per_mile_j[ToString(kind)] = per_mile(kind);
   }
   nlohmann::json log = nlohmann::json::array();
-  for (const Incident& i : incident_log) {
+  for (std::size_t n = 0; n < incident_log.size(); ++n) {
+    const Incident& i = incident_log[n];
     log.push_back({{"t", i.t}, {"s", i.s}, {"d", i.d}, {"lane", i.lane},
                    {"kind", ToString(i.kind)}, {"value", i.value}});
+    if (judged) {
+      log.back()["judgement"] =
+          JudgementJson(n < judgements.size() ? judgements[n] : IncidentJudgement());
+    }
   }
-  return {{"scenario", scenario},
-          {"planner", planner},
-          {"map", map},
-          {"seed", seed},
-          {"stop_reason", stop_reason},
-          {"distance_m", distance_m},
-          {"miles", miles()},
-          {"sim_seconds", sim_seconds},
-          {"exchanges", exchanges},
-          {"avg_speed_mph", avg_speed_mph},
-          {"miles_to_first_incident", miles_to_first_incident},
-          {"best_miles_without_incident", best_miles_without_incident},
-          {"incidents", incidents},
-          {"incidents_by_kind", by_kind},
-          {"incidents_per_mile", per_mile_j},
-          {"max_speed_mph", max_speed_mph},
-          {"max_acc", max_acc},
-          {"max_jerk", max_jerk},
-          {"mean_squared_jerk", mean_squared_jerk},
-          {"lane_changes", lane_changes},
-          {"min_gap_m", Finite(min_gap_m)},
-          {"min_headway_s", Finite(min_headway_s)},
-          {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
-          {"plan_fallbacks", plan_fallbacks},
-          {"breakdown", BreakdownJson(breakdown, &laps)},
-          {"incident_log", log}};
+  nlohmann::json out = {
+      {"scenario", scenario},
+      {"planner", planner},
+      {"map", map},
+      {"seed", seed},
+      {"stop_reason", stop_reason},
+      {"distance_m", distance_m},
+      {"miles", miles()},
+      {"sim_seconds", sim_seconds},
+      {"exchanges", exchanges},
+      {"avg_speed_mph", avg_speed_mph},
+      {"miles_to_first_incident", miles_to_first_incident},
+      {"best_miles_without_incident", best_miles_without_incident},
+      {"incidents", incidents},
+      {"incidents_by_kind", by_kind},
+      {"incidents_per_mile", per_mile_j},
+      {"max_speed_mph", max_speed_mph},
+      {"max_acc", max_acc},
+      {"max_jerk", max_jerk},
+      {"mean_squared_jerk", mean_squared_jerk},
+      {"lane_changes", lane_changes},
+      {"min_gap_m", Finite(min_gap_m)},
+      {"min_headway_s", Finite(min_headway_s)},
+      {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
+      {"plan_fallbacks", plan_fallbacks},
+      {"breakdown", BreakdownJson(breakdown, &laps)},
+      {"incident_log", log}};
+  if (judged) out["judged"] = VerdictsJson(CountVerdicts(*this));
+  return out;
 }
 
 std::string DriveReport::ToText() const {
@@ -122,9 +177,17 @@ std::string DriveReport::ToText() const {
     << Maybe(min_headway_s, "{:.2f} s") << "\n";
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max, plan_fallbacks);
-  for (const Incident& i : incident_log) {
+  if (judged) o << VerdictsText(CountVerdicts(*this));
+  for (std::size_t n = 0; n < incident_log.size(); ++n) {
+    const Incident& i = incident_log[n];
     o << fmt::format("  t {:8.2f} s  s {:8.1f}  d {:6.2f}  lane {:2d}  {:<12} {:.2f}\n", i.t, i.s,
                      i.d, i.lane, ToString(i.kind), i.value);
+    if (judged) {
+      const IncidentJudgement j = n < judgements.size() ? judgements[n] : IncidentJudgement();
+      o << "      " << Describe(j);
+      if (j.verdict == Verdict::kAvoidable) o << "; escape: " << j.escape;
+      o << "\n";
+    }
   }
   return o.str();
 }
@@ -143,6 +206,11 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
     a.plan_ms_p99 = std::max(a.plan_ms_p99, r.plan_ms_p99);
     a.plan_ms_max = std::max(a.plan_ms_max, r.plan_ms_max);
     a.breakdown.Add(r.breakdown);
+    if (r.judged) {
+      a.judged = true;
+      const std::array<int, 4> n = CountVerdicts(r);
+      for (std::size_t v = 0; v < n.size(); ++v) a.verdicts[v] += n[v];
+    }
   }
   for (int k = 0; k < kIncidentKinds; ++k) {
     a.per_100_miles[k] = a.total_miles > 0 ? 100.0 * counts[k] / a.total_miles : 0;
@@ -178,16 +246,19 @@ nlohmann::json AggregateReport::ToJson() const {
   }
   nlohmann::json eps = nlohmann::json::array();
   for (const DriveReport& r : episodes) eps.push_back(r.ToJson());
-  return {{"episodes", static_cast<int>(episodes.size())},
-          {"total_miles", total_miles},
-          {"incidents", incidents},
-          {"incidents_per_100_miles", per100},
-          {"avg_speed_mph", avg_speed_mph},
-          {"avg_speed_stddev_mph", avg_speed_stddev},
-          {"worst_episode", worst >= 0 ? nlohmann::json(episodes[worst].seed) : nlohmann::json()},
-          {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
-          {"breakdown", BreakdownJson(breakdown, nullptr)},
-          {"per_episode", eps}};
+  nlohmann::json out = {
+      {"episodes", static_cast<int>(episodes.size())},
+      {"total_miles", total_miles},
+      {"incidents", incidents},
+      {"incidents_per_100_miles", per100},
+      {"avg_speed_mph", avg_speed_mph},
+      {"avg_speed_stddev_mph", avg_speed_stddev},
+      {"worst_episode", worst >= 0 ? nlohmann::json(episodes[worst].seed) : nlohmann::json()},
+      {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
+      {"breakdown", BreakdownJson(breakdown, nullptr)},
+      {"per_episode", eps}};
+  if (judged) out["judged"] = VerdictsJson(verdicts);
+  return out;
 }
 
 std::string AggregateReport::ToText() const {
@@ -211,6 +282,16 @@ std::string AggregateReport::ToText() const {
   if (worst >= 0) {
     o << fmt::format("worst episode   seed {} ({} incidents in {:.3f} mi)\n", episodes[worst].seed,
                      episodes[worst].incidents, episodes[worst].miles());
+  }
+  if (judged) {
+    o << VerdictsText(verdicts);
+    for (const DriveReport& r : episodes) {
+      for (std::size_t n = 0; n < r.incident_log.size() && r.judged; ++n) {
+        const IncidentJudgement j = n < r.judgements.size() ? r.judgements[n] : IncidentJudgement();
+        o << fmt::format("  seed {:<6} t {:7.2f} s  {:<12} {}\n", r.seed, r.incident_log[n].t,
+                         ToString(r.incident_log[n].kind), Describe(j));
+      }
+    }
   }
   return o.str();
 }

@@ -7,10 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <thread>
 
 #include "frenetic/net/protocol.h"
+#include "frenetic/sim/incident_recorder.h"
 #include "frenetic/sim/record.h"
 #include "frenetic/wire_precision.h"
 
@@ -60,6 +62,10 @@ DriveReport MakeReport(const Episode& ep, std::string_view planner,
   r.incident_log = m.log();
   r.laps = sim.breakdown().laps();
   r.breakdown = sim.breakdown().Total();
+  if (const auto* judged = ep.judgements(); judged != nullptr) {
+    r.judged = true;
+    r.judgements = *judged;
+  }
   return r;
 }
 
@@ -87,6 +93,27 @@ Episode::Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits)
   sim_->GetTelemetry(&telemetry_);
 }
 
+Episode::~Episode() = default;
+
+void Episode::EnableJudging(const JudgeOptions& options, bool timing) {
+  recorder_ = std::make_unique<IncidentRecorder>(*sim_, options, timing);
+}
+
+const std::vector<IncidentJudgement>* Episode::judgements() const {
+  return recorder_ ? &recorder_->judgements() : nullptr;
+}
+
+void Episode::Advance(int ticks) {
+  if (!recorder_) {
+    sim_->Advance(ticks);
+    return;
+  }
+  for (int i = 0; i < ticks; ++i) {
+    sim_->Advance(1);
+    recorder_->AfterTick();
+  }
+}
+
 Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
   const TimingOptions& t = sim_->scenario().timing;
   int l_old = 0, l_new = 1;
@@ -106,11 +133,12 @@ Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
   }
   last_l_old_ = l_old;
   last_l_new_ = l_new;
-  sim_->Advance(l_old);
+  Advance(l_old);
   Status status = sim_->ApplyPath(x, y);
-  sim_->Advance(l_new);
+  Advance(l_new);
   ++exchanges_;
   CheckDone();
+  if (done() && recorder_) recorder_->Finish();
   sim_->GetTelemetry(&telemetry_);
   return status;
 }
@@ -134,9 +162,13 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
                                  std::uint64_t seed, const EpisodeLimits& limits,
                                  plan::Planner& planner, const RunOptions& options) {
   if (Status s = limits.Validate(); !s.ok()) return s;
+  if (options.judge) {
+    if (Status s = options.judge->Validate(); !s.ok()) return s;
+  }
   auto sim = Simulator::Create(std::move(world), scenario, seed);
   if (!sim.ok()) return sim.status();
   Episode ep(std::move(*sim), limits);
+  if (options.judge) ep.EnableJudging(*options.judge, options.timing);
   planner.Reset();
   plan::CycleTrace trace;
   RecordWriter* record = options.record;
@@ -198,31 +230,60 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   return report;
 }
 
-StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
-                                      const Scenario& scenario, std::uint64_t first_seed,
-                                      int episodes, int jobs, const EpisodeLimits& limits,
-                                      const PlannerFactory& factory, bool timing) {
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const Scenario& scenario,
+                                      std::uint64_t first_seed, int episodes, int jobs,
+                                      const EpisodeLimits& limits, const PlannerFactory& factory,
+                                      const EpisodesOptions& options) {
   if (episodes < 1) return Status::Error("episodes must be >= 1");
   if (Status s = limits.Validate(); !s.ok()) return s;
+  if (options.judge) {
+    if (Status s = options.judge->Validate(); !s.ok()) return s;
+  }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   jobs = std::min(jobs, episodes);
   std::vector<std::optional<StatusOr<DriveReport>>> results(episodes);
   std::atomic<int> next{0};
-  auto worker = [&] {
+  // Progress: the finished episodes' totals and each worker's running distance, under a lock.
+  std::mutex progress_mutex;
+  EpisodesProgress progress;
+  progress.total = episodes;
+  std::vector<double> running(jobs, 0.0);
+  auto report_progress = [&](int worker, double worker_miles, const DriveReport* finished) {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    running[worker] = worker_miles;
+    progress.episode_finished = finished != nullptr;
+    if (finished != nullptr) {
+      ++progress.done;
+      progress.miles += finished->miles();
+      progress.incidents += finished->incidents;
+    }
+    progress.running_miles = 0;
+    for (double m : running) progress.running_miles += m;
+    options.progress(progress);
+  };
+  auto worker = [&](int w) {
     for (int i = next++; i < episodes; i = next++) {
       auto planner = factory();
       if (!planner.ok()) {
         results[i] = planner.status();
         continue;
       }
-      RunOptions options;
-      options.timing = timing;
-      results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, options);
+      RunOptions run;
+      run.timing = options.timing;
+      run.judge = options.judge;
+      if (options.progress) {
+        run.progress = [&, w, exchanges = 0](const Episode& ep) mutable {
+          if (++exchanges % 256 != 0) return;
+          report_progress(w, ep.sim().monitor().distance() / kMetersPerMile, nullptr);
+        };
+      }
+      results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, run);
+      if (options.progress && results[i]->ok()) report_progress(w, 0.0, &results[i]->value());
     }
   };
   std::vector<std::thread> pool;
-  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker);
-  worker();
+  for (int j = 1; j < jobs; ++j) pool.emplace_back(worker, j);
+  worker(0);
   for (auto& t : pool) t.join();
   std::vector<DriveReport> reports;
   reports.reserve(episodes);
@@ -231,6 +292,16 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
     reports.push_back(std::move(r->value()));
   }
   return AggregateReport::From(std::move(reports));
+}
+
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const Scenario& scenario,
+                                      std::uint64_t first_seed, int episodes, int jobs,
+                                      const EpisodeLimits& limits, const PlannerFactory& factory,
+                                      bool timing) {
+  EpisodesOptions options;
+  options.timing = timing;
+  return RunEpisodes(std::move(world), scenario, first_seed, episodes, jobs, limits, factory,
+                     options);
 }
 
 }  // namespace frenetic::sim

@@ -1,7 +1,10 @@
 // `frenetic drive` as a user runs it: report fields, JSON, exit codes and one-line errors.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <regex>
 #include <string>
+#include <vector>
 
 #include "apps_test_util.h"
 
@@ -37,11 +40,73 @@ TEST(DriveCli, BadInputGivesOneLineAndExitOne) {
   }
 }
 
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// `--episodes N --progress` off a terminal: lines "episodes k/N  elapsed ...  ETA ...  x mi
+// n incidents" on stderr, the last one for N/N; stdout is the same JSON as without it.
+TEST(DriveCli, ProgressOfManyEpisodesGoesToStderr) {
+  const std::string err = ::testing::TempDir() + "/progress_err.txt";
+  const std::string common =
+      "drive --seconds 10 --planner baseline --episodes 3 --jobs 2 --json --no-timing";
+  CommandResult quiet = RunFrenetic(common + " 2>/dev/null");
+  CommandResult shown = RunFrenetic(common + " --progress 2>" + err);
+  ASSERT_EQ(quiet.exit_code, 0);
+  ASSERT_EQ(shown.exit_code, 0);
+  EXPECT_EQ(shown.out, quiet.out);
+  const std::vector<std::string> lines = Lines(err);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_LE(lines.size(), 3u);  // one per episode at most, not a flood
+  const std::regex format(
+      R"(episodes ([0-3])/3  elapsed \d+:\d\d:\d\d  ETA (\d+:\d\d:\d\d|-:--:--)  \d+\.\d mi  \d+ incidents?)");
+  int done = 0;
+  for (const std::string& line : lines) {
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(line, m, format)) << line;
+    EXPECT_GE(std::stoi(m[1]), done) << line;
+    done = std::stoi(m[1]);
+  }
+  EXPECT_EQ(lines.back().rfind("episodes 3/3  ", 0), 0u) << lines.back();
+  const auto j = nlohmann::json::parse(shown.out);
+  const int incidents = j["incidents"].get<int>();
+  std::string needle = "mi  ";
+  needle += std::to_string(incidents);
+  EXPECT_NE(lines.back().find(needle), std::string::npos) << lines.back();
+}
+
+// Incidents are judged unless --no-judge: the JSON gains fields only.
+TEST(DriveCli, IncidentsAreJudgedUnlessSwitchedOff) {
+  const std::string args =
+      "drive --seconds 95 --seed 1 --latency random --planner baseline --scenario cut-in --json "
+      "--no-timing";
+  CommandResult judged = RunFrenetic(args + " 2>/dev/null");
+  CommandResult plain = RunFrenetic(args + " --no-judge 2>/dev/null");
+  ASSERT_EQ(judged.exit_code, 0);
+  ASSERT_EQ(plain.exit_code, 0);
+  auto j = nlohmann::json::parse(judged.out);
+  const auto p = nlohmann::json::parse(plain.out);
+  ASSERT_GT(j["incidents"].get<int>(), 0) << "the baseline crashes at 89.5 s";
+  ASSERT_TRUE(j.contains("judged"));
+  EXPECT_FALSE(p.contains("judged"));
+  for (const auto& i : j["incident_log"]) {
+    ASSERT_TRUE(i.contains("judgement"));
+    EXPECT_TRUE(i["judgement"]["summary"].is_string());
+  }
+  j.erase("judged");
+  for (auto& i : j["incident_log"]) i.erase("judgement");
+  EXPECT_EQ(j.dump(), p.dump());
+}
+
 TEST(DriveCli, HelpExplainsOptionsWithDefaults) {
   CommandResult r = RunFrenetic("drive --help");
   ASSERT_EQ(r.exit_code, 0);
-  for (const char* option : {"--map", "--scenario", "--seed", "--laps", "--planner", "--record",
-                             "--json", "--episodes", "--connect"}) {
+  for (const char* option :
+       {"--map", "--scenario", "--seed", "--laps", "--planner", "--record", "--json", "--episodes",
+        "--connect", "--progress", "--no-judge", "--judge-budget"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }
   EXPECT_NE(r.out.find("Default"), std::string::npos);

@@ -170,5 +170,100 @@ TEST(RunEpisodes, ResultsDoNotDependOnTheNumberOfThreads) {
   EXPECT_GE(one->worst, 0);
 }
 
+// The report without the judging's fields.
+nlohmann::json Unjudged(nlohmann::json j) {
+  j.erase("judged");
+  for (auto& i : j["incident_log"]) i.erase("judgement");
+  return j;
+}
+
+TEST(RunEpisode, JudgingReportsEveryIncidentAndNeverChangesTheDrive) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  KeepLanePlanner planner(world->line, 22);  // keeps its lane into the traffic
+  const EpisodeLimits limits{0, 0, 90, 60};
+  RunOptions off;
+  off.timing = false;
+  RunOptions on = off;
+  on.judge = JudgeOptions();
+  auto plain = RunEpisode(world, Scenario(), 3, limits, planner, off);
+  auto judged = RunEpisode(world, Scenario(), 3, limits, planner, on);
+  ASSERT_TRUE(plain.ok() && judged.ok());
+  ASSERT_GT(judged->incidents, 0);
+  EXPECT_FALSE(plain->judged);
+  EXPECT_FALSE(plain->ToJson().contains("judged"));
+  ASSERT_TRUE(judged->judged);
+  ASSERT_EQ(judged->judgements.size(), judged->incident_log.size());
+  EXPECT_EQ(Unjudged(judged->ToJson()).dump(), plain->ToJson().dump());
+  const nlohmann::json j = judged->ToJson();
+  int counted = 0;
+  for (const char* verdict : {"avoidable", "unavoidable", "undecided", "not_judged"}) {
+    counted += j["judged"][verdict].get<int>();
+  }
+  EXPECT_EQ(counted, judged->incidents);
+  const std::string text = judged->ToText();
+  EXPECT_NE(text.find("judged          "), std::string::npos) << text;
+  for (std::size_t i = 0; i < judged->judgements.size(); ++i) {
+    const IncidentJudgement& v = judged->judgements[i];
+    EXPECT_EQ(j["incident_log"][i]["judgement"]["verdict"], ToString(v.verdict));
+    EXPECT_EQ(j["incident_log"][i]["judgement"]["ms"], 0);  // timing off
+    EXPECT_NE(text.find(Describe(v)), std::string::npos) << Describe(v);
+    EXPECT_LE(v.until, judged->incident_log[i].t + 2.0 + 1e-9);
+  }
+}
+
+TEST(RunEpisodes, ProgressIsReportedAndChangesNothing) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  auto factory = [&]() -> StatusOr<std::unique_ptr<plan::Planner>> {
+    return std::unique_ptr<plan::Planner>(new KeepLanePlanner(world->line, 21));
+  };
+  const EpisodeLimits limits{0, 0, 40, 60};
+  auto quiet = RunEpisodes(world, Scenario(), 5, 3, 2, limits, factory, false);
+  EpisodesOptions options;
+  options.timing = false;
+  std::vector<EpisodesProgress> seen;
+  options.progress = [&seen](const EpisodesProgress& p) { seen.push_back(p); };
+  auto shown = RunEpisodes(world, Scenario(), 5, 3, 2, limits, factory, options);
+  ASSERT_TRUE(quiet.ok() && shown.ok());
+  EXPECT_EQ(quiet->ToJson().dump(), shown->ToJson().dump());
+  int finished = 0, done = 0;
+  for (const EpisodesProgress& p : seen) {
+    EXPECT_EQ(p.total, 3);
+    EXPECT_GE(p.done, done);
+    done = p.done;
+    finished += p.episode_finished;
+  }
+  EXPECT_EQ(finished, 3);
+  EXPECT_GT(seen.size(), 3u);  // calls while the episodes run as well
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back().done, 3);
+  EXPECT_NEAR(seen.back().miles, shown->total_miles, 1e-9);
+  EXPECT_EQ(seen.back().incidents, shown->incidents);
+  EXPECT_EQ(seen.back().running_miles, 0);
+}
+
+TEST(RunEpisodes, JudgedVerdictsAddUp) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  auto factory = [&]() -> StatusOr<std::unique_ptr<plan::Planner>> {
+    return std::unique_ptr<plan::Planner>(new KeepLanePlanner(world->line, 22));
+  };
+  EpisodesOptions options;
+  options.timing = false;
+  options.judge = JudgeOptions();
+  auto agg = RunEpisodes(world, Scenario(), 3, 2, 2, EpisodeLimits{0, 0, 60, 60}, factory, options);
+  ASSERT_TRUE(agg.ok()) << agg.message();
+  ASSERT_GT(agg->incidents, 0);
+  ASSERT_TRUE(agg->judged);
+  int sum = 0;
+  for (int n : agg->verdicts) sum += n;
+  EXPECT_EQ(sum, agg->incidents);
+  const nlohmann::json j = agg->ToJson();
+  EXPECT_EQ(j["judged"]["avoidable"], agg->verdicts[0]);
+  EXPECT_NE(agg->ToText().find("judged          "), std::string::npos);
+  options.judge = JudgeOptions();
+  options.judge->budget_blocks = 0;
+  EXPECT_FALSE(
+      RunEpisodes(world, Scenario(), 3, 2, 2, EpisodeLimits{0, 0, 60, 60}, factory, options).ok());
+}
+
 }  // namespace
 }  // namespace frenetic::sim

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "frenetic/sim/drive_breakdown.h"
+#include "frenetic/sim/incident_judge.h"
 #include "frenetic/sim/incident_monitor.h"
 
 namespace frenetic::sim {
@@ -35,6 +36,10 @@ struct DriveReport {
   double plan_ms_p50 = 0, plan_ms_p99 = 0, plan_ms_max = 0;  // wall time per Plan() call
   int plan_fallbacks = 0;     // cycles whose status was not ok
   std::vector<Incident> incident_log;
+  // Judging on: one judgement per incident_log entry (could a trajectory within the simulator's
+  // limits have avoided it?), in JSON under each entry's "judgement" and counted in "judged".
+  bool judged = false;
+  std::vector<IncidentJudgement> judgements;
   // Where the time went: the whole drive and each lap (following, at the limit, passes).
   LapBreakdown breakdown;
   std::vector<LapBreakdown> laps;
@@ -55,6 +60,8 @@ struct AggregateReport {
   int worst = -1;  // index of the worst episode: most incidents per mile, then slowest
   double plan_ms_p50 = 0, plan_ms_p99 = 0, plan_ms_max = 0;  // over episodes (max of each)
   LapBreakdown breakdown;  // summed over episodes
+  bool judged = false;     // the episodes' incidents were judged
+  std::array<int, 4> verdicts{};  // incidents per Verdict, summed over episodes
   static AggregateReport From(std::vector<DriveReport> episodes);
   nlohmann::json ToJson() const;
   std::string ToText() const;

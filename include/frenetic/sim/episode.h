@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 
 #include "frenetic/plan/planner.h"
 #include "frenetic/sim/drive_report.h"
+#include "frenetic/sim/incident_judge.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 
@@ -32,11 +34,21 @@ struct EpisodeLimits {
   Status Validate() const;
 };
 
-class RecordWriter;  // sim/record.h
+class RecordWriter;      // sim/record.h
+class IncidentRecorder;  // sim/incident_recorder.h
 
 class Episode {
  public:
   Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits);
+  ~Episode();
+
+  // From now on keeps the traffic's history and judges every incident (incident_judge.h) once
+  // its margin is driven, or when the drive ends. It never changes the drive. timing false:
+  // judging times are reported as 0.
+  void EnableJudging(const JudgeOptions& options, bool timing);
+  // One per incident judged so far (all of them once done()), in the log's order; nullptr when
+  // judging is off.
+  const std::vector<IncidentJudgement>* judgements() const;
 
   // The telemetry to send now (valid until Submit).
   const plan::Telemetry& telemetry() const { return telemetry_; }
@@ -56,6 +68,7 @@ class Episode {
 
  private:
   void CheckDone();
+  void Advance(int ticks);
 
   std::unique_ptr<Simulator> sim_;
   EpisodeLimits limits_;
@@ -65,10 +78,12 @@ class Episode {
   std::string stop_reason_;
   int exchanges_ = 0, last_l_old_ = 0, last_l_new_ = 0;
   double stall_ref_distance_ = 0, stall_ref_time_ = 0;
+  std::unique_ptr<IncidentRecorder> recorder_;
 };
 
 // The report of an episode driven so far; `plan_ms` are the per-exchange planning (or round-trip)
-// times and `fallbacks` the exchanges whose plan status was not ok.
+// times and `fallbacks` the exchanges whose plan status was not ok. With judging on, the
+// incidents' judgements so far.
 DriveReport MakeReport(const Episode& episode, std::string_view planner,
                        const std::vector<double>& plan_ms, int fallbacks);
 
@@ -79,6 +94,8 @@ struct RunOptions {
   nlohmann::json planner_config;  // written into the record's header (object or text)
   // Called after every exchange (e.g. a progress line); may be empty.
   std::function<void(const Episode&)> progress;
+  // Judge every incident (Episode::EnableJudging); unset: off.
+  std::optional<JudgeOptions> judge;
 };
 
 // Drives `planner` (Reset first) through one episode. The planner sees every telemetry number
@@ -93,9 +110,30 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
 
 using PlannerFactory = std::function<StatusOr<std::unique_ptr<plan::Planner>>()>;
 
+// How far RunEpisodes has got.
+struct EpisodesProgress {
+  int done = 0, total = 0;        // episodes finished, episodes asked for
+  double miles = 0;               // driven by the finished episodes
+  int incidents = 0;              // of the finished episodes
+  double running_miles = 0;       // driven so far by the episodes still running
+  bool episode_finished = false;  // this call follows the end of an episode
+};
+
+struct EpisodesOptions {
+  bool timing = true;                 // RunOptions::timing
+  std::optional<JudgeOptions> judge;  // RunOptions::judge
+  // Called after every finished episode and every 256 exchanges of a running one, one call at a
+  // time (from the worker threads, under a lock); may be empty. It cannot change the results.
+  std::function<void(const EpisodesProgress&)> progress;
+};
+
 // Runs `episodes` episodes with seeds first_seed, first_seed + 1, ... on `jobs` threads (0 =
 // hardware concurrency), each with its own simulator and planner. Results are in seed order and
 // do not depend on `jobs`. Fails with the first failing episode's message.
+StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const Scenario& scenario,
+                                      std::uint64_t first_seed, int episodes, int jobs,
+                                      const EpisodeLimits& limits, const PlannerFactory& factory,
+                                      const EpisodesOptions& options);
 StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world,
                                       const Scenario& scenario, std::uint64_t first_seed,
                                       int episodes, int jobs, const EpisodeLimits& limits,

@@ -49,6 +49,9 @@ class IncidentMonitor {
   // Flags as the simulator has them after the last tick.
   bool active(IncidentKind kind) const { return active_[static_cast<int>(kind)]; }
   const std::vector<Incident>& log() const { return log_; }
+  // Drops the log (flags, meters and counters stay): a copy that only judges what comes next
+  // (the incident judge's search) then copies no history.
+  void ClearLog() { log_.clear(); }
   const std::array<int, kIncidentKinds>& counts() const { return counts_; }
   int total() const { return static_cast<int>(log_.size()); }
 

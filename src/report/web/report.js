@@ -58,6 +58,14 @@
   const state = { k: 0, playing: false, zoom: 3.0, rate: 4, detail: -1, showCandidates: true,
                   simTime: T.length ? T[0] : 0, lastFrame: 0 };
 
+  // The judgement of an incident (drive's judging, sim/incident_judge.h): the footer's
+  // incident_log is in the same order as the exchanges' incidents. Null when not judged.
+  function judgementOf(incident) {
+    const log = D.footer && Array.isArray(D.footer.incident_log) ? D.footer.incident_log : [];
+    const entry = log[D.incidents.indexOf(incident)];
+    return entry && typeof entry.judgement === "object" && entry.judgement ? entry.judgement : null;
+  }
+
   // ---------- summary header ----------
   function buildSummary() {
     const root = $("summary");
@@ -123,10 +131,13 @@
     } else {
       inc.append(el("span", {}, `${D.incidents.length} incident(s): `));
       for (const i of D.incidents.slice(0, 200)) {
+        const j = judgementOf(i);
         inc.append(el("button", { type: "button", class: "incident",
-                                  title: `s ${fmt(i.s, 1)} m, d ${fmt(i.d, 2)} m, value ${fmt(i.value)}`,
+                                  title: `s ${fmt(i.s, 1)} m, d ${fmt(i.d, 2)} m, value ${fmt(i.value)}` +
+                                         (j ? `\n${j.summary}` : ""),
                                   onclick: () => { setCycle(i.e); showDetails(i.e); } },
-                      `${i.kind} at ${fmt(i.t, 1)} s (lane ${i.lane})`));
+                      `${i.kind} at ${fmt(i.t, 1)} s (lane ${i.lane})` +
+                      (j ? ` \u00b7 ${j.verdict.replace("_", " ")}` : "")));
       }
       if (D.incidents.length > 200) inc.append(` \u2026 and ${D.incidents.length - 200} more`);
     }
@@ -582,6 +593,11 @@
     const incs = D.incidents.filter((i) => i.e === k);
     for (const i of incs) {
       root.append(el("div", { class: "warn" }, `incident: ${i.kind} (value ${fmt(i.value)}) at s ${fmt(i.s, 1)} m, lane ${i.lane}`));
+      const j = judgementOf(i);
+      if (j) {
+        root.append(el("div", { class: "warn" },
+                       `judged: ${j.summary}` + (j.escape ? `; escape: ${j.escape}` : "")));
+      }
     }
     // Rejections by reason.
     root.append(el("h3", {}, "Rejections by reason"));
