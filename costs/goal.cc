@@ -1,7 +1,7 @@
 // goal: how far the candidate misses the nearest goal region (CostContext::goals, a CommonRoad
 // planning problem's goal states) within its time window: over the window, the least of
-//   out(s, [s_lo, s_hi]) / s_scale + out(d, [d_lo, d_hi]) / d_scale + out(v, [v_lo, v_hi]) / v_scale
-//   + out(h, [h_lo, h_hi]) / h_scale
+//   out(s, [s_lo, s_hi]) / s_scale + out(d - d_slope (s - s_ref), [d_lo, d_hi]) / d_scale
+//   + out(v, [v_lo, v_hi]) / v_scale + out(h, [h_lo, h_hi]) / h_scale
 // with out(x, [lo, hi]) the distance of x outside the interval and h = atan2(d', s') the heading
 // against the line's, the candidate continued past its samples at its last speed along its last
 // d. 0 when it passes through a region in its window (and with no goal: the Udacity track), else
@@ -61,6 +61,8 @@ class GoalCost : public CostTerm {
   struct At {
     double s, d, v, h;
   };
+  // d against the region's slanted sides.
+  static double Across(const GoalRegion& g, const At& a) { return a.d - g.d_slope * (a.s - g.s_ref); }
   static double Heading(double s_d, double d_d) { return std::atan2(d_d, std::max(s_d, 0.1)); }
   At State(const CostContext& ctx, const CostInput& in, double t) const {
     const int n = ctx.num_samples;
@@ -76,7 +78,7 @@ class GoalCost : public CostTerm {
             in.s_d[k] + f * (in.s_d[k + 1] - in.s_d[k]), h0 + f * (h1 - h0)};
   }
   double MissAt(const GoalRegion& g, const At& a) const {
-    return Out(a.s, g.s_lo, g.s_hi) / s_scale_ + Out(a.d, g.d_lo, g.d_hi) / d_scale_ +
+    return Out(a.s, g.s_lo, g.s_hi) / s_scale_ + Out(Across(g, a), g.d_lo, g.d_hi) / d_scale_ +
            Out(a.v, g.v_lo, g.v_hi) / v_scale_ + Out(a.h, g.h_lo, g.h_hi) / h_scale_;
   }
   // The least miss over the window, at its ends, the samples inside it and the crossings.
@@ -97,7 +99,7 @@ class GoalCost : public CostTerm {
     auto piece = [&](double ta, double tb) {
       const At a = State(ctx, in, ta), b = State(ctx, in, tb);
       for (const double level : {g.s_lo, g.s_hi}) cross(ta, tb, a.s, b.s, level);
-      for (const double level : {g.d_lo, g.d_hi}) cross(ta, tb, a.d, b.d, level);
+      for (const double level : {g.d_lo, g.d_hi}) cross(ta, tb, Across(g, a), Across(g, b), level);
       for (const double level : {g.v_lo, g.v_hi}) cross(ta, tb, a.v, b.v, level);
       for (const double level : {g.h_lo, g.h_hi}) cross(ta, tb, a.h, b.h, level);
     };

@@ -25,7 +25,8 @@ constexpr double kLimitMargin = 0.85;
 constexpr int kFutureSteps = 80;
 constexpr double kMphToMps = 0.44704;
 // m/s: the ego's speed limit is at least this much above its initial speed (the planner's
-// speed limit is hard).
+// speed limit is hard), and at least kGoalSpeedFactor times the mean speed a timed goal needs.
+constexpr double kGoalSpeedFactor = 1.8;
 constexpr double kStartSpeedRoom = 2.0;
 
 // An obstacle's footprint at a step: centre, heading, length and width (its shape's bounding
@@ -96,6 +97,33 @@ void AddBox(const map::ReferenceLine& line, const std::vector<Vec2>& pts, cost::
   }
 }
 
+// A goal rectangle: its long axis in the Frenet frame (the centre's s and d, the slope of d
+// along s), the s range of its ends and the d half-width across it, the corners' s range for a
+// wide one. Exact for a rectangle on a straight stretch of the line.
+void AddRectangle(const map::ReferenceLine& line, const Shape& sh, cost::GoalRegion* r) {
+  const bool long_axis = sh.length >= sh.width;
+  const double along = long_axis ? sh.orientation : sh.orientation + 0.5 * 3.141592653589793;
+  const double half_len = 0.5 * std::max(sh.length, sh.width), half_wid = 0.5 * std::min(sh.length, sh.width);
+  const Vec2 u{std::cos(along), std::sin(along)};
+  const map::FrenetPoint a = line.ToFrenet(sh.center.x - half_len * u.x, sh.center.y - half_len * u.y);
+  const map::FrenetPoint b = line.ToFrenet(sh.center.x + half_len * u.x, sh.center.y + half_len * u.y);
+  const map::FrenetPoint c = line.ToFrenet(sh.center.x, sh.center.y);
+  const double ds = b.s - a.s;
+  const double slope = std::abs(ds) > 1e-6 ? (b.d - a.d) / ds : 0.0;
+  if (std::abs(slope) > 1.0) {  // turned across the road: its bounding box will do
+    AddBox(line, sh.Vertices(), r);
+    return;
+  }
+  r->s_ref = c.s;
+  r->d_slope = slope;
+  const double half_d = half_wid * std::sqrt(1 + slope * slope);  // across, measured along d
+  r->d_lo = c.d - half_d;
+  r->d_hi = c.d + half_d;
+  const double spread = half_wid * std::abs(slope) / std::sqrt(1 + slope * slope);
+  r->s_lo = std::min(a.s, b.s) - spread;
+  r->s_hi = std::max(a.s, b.s) + spread;
+}
+
 // The goal's orientation interval as a heading against the road's in the region (its s mid):
 // a vehicle turned left of the road moves toward smaller d, so h = road - orientation.
 void AddHeading(const map::ReferenceLine& line, const GoalState& g, cost::GoalRegion* r) {
@@ -129,6 +157,12 @@ std::vector<FrenetGoal> FrenetGoals(const Scenario& sc, const PlanningProblem& p
     }
     for (const Shape& sh : g.shapes) {
       FrenetGoal fg = base;
+      if (sh.kind == Shape::Kind::kRectangle) {
+        AddRectangle(line, sh, &fg.region);
+        AddHeading(line, g, &fg.region);
+        out.push_back(fg);
+        continue;
+      }
       std::vector<Vec2> pts = sh.Vertices();
       if (sh.kind == Shape::Kind::kCircle) {
         for (int i = 0; i < 8; ++i) {
@@ -182,37 +216,32 @@ double Curvature(double x1, double y1, double x2, double y2, double x3, double y
 }
 
 // The ego after one step toward the planned path (x, y: 0.02 s points from the step's start,
-// the first one 0.02 s in): the constant KS input whose step lands closest to the planned
-// state there (position, orientation, steering angle, speed, weighted), found by Gauss-Newton
-// from the feed-forward input.
+// the first one 0.02 s in): a constant KS input for the step. Feed-forward from the path at the
+// step's end (the steering angle of its curvature, the rear axle's speed, the slip angle between
+// the centre's path and the axis), corrected as a Stanley controller does (Hoffmann et al.,
+// "Autonomous Automobile Trajectory Tracking for Off-Road Driving", ACC 2007): the heading error
+// and atan(k e / v) of the cross-track error e, both of the state the feed-forward input would
+// reach; the speed corrected by the along-track error. A one-step fit of the position instead
+// steers back and forth at speed (the position answers the steering rate only within the step).
 KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
                double dt, const VehicleParams& vp) {
+  constexpr double kHeadingGain = 0.5;  // of the heading error
+  constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
+  constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
   const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
   const int j = ticks - 1;  // the point dt in
-  const double tx = x[j], ty = y[j];
   const int a = std::max(0, j - 1), b = j + 1;
   const double theta = std::atan2(y[b] - y[a], x[b] - x[a]);
   const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * kTick);
   const double kappa = Curvature(x[a], y[a], x[j], y[j], x[b], y[b]);
   const double l_wb = vp.Wheelbase();
-  const double delta = std::atan(l_wb * kappa);
+  const double delta_ff = std::atan(l_wb * kappa);
   // The centre moves at the slip angle beta off the vehicle's axis.
-  const double beta = std::atan(vp.b * std::tan(delta) / l_wb);
-  const double psi = theta - beta;
-  const double v = speed * std::cos(beta);
-  // Residuals, scaled by what counts as 1: 1 cm, 5 mrad of orientation, 10 mrad of steering,
-  // 0.1 m/s.
-  auto residual = [&](const KsInput& u, double r[5]) {
-    const KsState s = SimulateKs(ego, u, dt, vp);
-    r[0] = (s.x - tx) / 0.01;
-    r[1] = (s.y - ty) / 0.01;
-    r[2] = WrapAngle(s.orientation - psi) / 0.005;
-    r[3] = (s.steering_angle - delta) / 0.01;
-    r[4] = (s.velocity - v) / 0.1;
-  };
-  KsInput u{(delta - ego.steering_angle) / dt, (v - ego.velocity) / dt};
+  const double beta = std::atan(vp.b * std::tan(delta_ff) / l_wb);
+  const double psi_ff = theta - beta;
+  const double v_ff = speed * std::cos(beta);
   // Within the steering rate and acceleration limits, and the friction circle a^2 + (v psi')^2
   // <= a_max^2 at the step's start (with kLimitMargin to spare).
   const double yaw_acc = ego.velocity * ego.velocity / l_wb * std::tan(ego.steering_angle);
@@ -223,29 +252,18 @@ KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vect
                                 std::min(a_room, kLimitMargin * vp.MaxAcceleration(ego.velocity)));
     return w;
   };
-  u = clip(u);
-  for (int it = 0; it < 4; ++it) {
-    double r[5], r1[5], r2[5];
-    residual(u, r);
-    const double h1 = 1e-4, h2 = 1e-3;
-    residual({u.steering_rate + h1, u.acceleration}, r1);
-    residual({u.steering_rate, u.acceleration + h2}, r2);
-    double jtj[3] = {0, 0, 0}, jtr[2] = {0, 0};  // [a b; b c]
-    for (int k = 0; k < 5; ++k) {
-      const double j1 = (r1[k] - r[k]) / h1, j2 = (r2[k] - r[k]) / h2;
-      jtj[0] += j1 * j1;
-      jtj[1] += j1 * j2;
-      jtj[2] += j2 * j2;
-      jtr[0] += j1 * r[k];
-      jtr[1] += j2 * r[k];
-    }
-    const double det = jtj[0] * jtj[2] - jtj[1] * jtj[1];
-    if (!(std::abs(det) > 1e-12)) break;
-    const double d1 = (jtj[2] * jtr[0] - jtj[1] * jtr[1]) / det;
-    const double d2 = (jtj[0] * jtr[1] - jtj[1] * jtr[0]) / det;
-    u = clip({u.steering_rate - d1, u.acceleration - d2});
-    if (std::abs(d1) < 1e-7 && std::abs(d2) < 1e-6) break;
-  }
+  const KsInput ff = clip({(delta_ff - ego.steering_angle) / dt, (v_ff - ego.velocity) / dt});
+  const KsState pred = SimulateKs(ego, ff, dt, vp);
+  // Errors of the predicted state against the path's point: cross-track (left positive) and
+  // along-track (ahead positive) in the path's direction, and the heading's.
+  const double ex = x[j] - pred.x, ey = y[j] - pred.y;
+  const double c = std::cos(theta), sn = std::sin(theta);
+  const double along = ex * c + ey * sn, cross = -(-ex * sn + ey * c);
+  const double heading_err = WrapAngle(psi_ff - pred.orientation);
+  const double delta_cmd = delta_ff + kHeadingGain * heading_err -
+                           std::atan(kCrossGain * cross / std::max(ego.velocity, 1.0));
+  const double v_cmd = v_ff + kAlongGain * along;
+  const KsInput u = clip({(delta_cmd - ego.steering_angle) / dt, (v_cmd - ego.velocity) / dt});
   return SimulateKs(ego, u, dt, vp);
 }
 
@@ -313,15 +331,25 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     run.lanes = road.num_lanes();
     run.road_length = line.length();
     run.route = built->route;
+    const std::vector<FrenetGoal> goals = FrenetGoals(sc, problem, line);
     // The ego's cruise speed: the configured one, but never below its initial speed (the
-    // planner's speed limit is hard) nor above the vehicle's.
+    // planner's speed limit is hard), nor below kGoalSpeedFactor times the mean speed that
+    // reaches a goal in time (corners and traffic take their share), nor above the vehicle's.
     plan::PlannerConfig problem_config = config;
     {
       const double v0 = problem.initial.velocity.value_or(0.0);
-      const double mph = std::min(std::max(config.value("limits.max_speed_mph"),
-                                           (v0 + kStartSpeedRoom) / kMphToMps),
-                                  kLimitMargin * vp.v_max / kMphToMps);
-      (void)problem_config.Set("limits.max_speed_mph", mph);
+      const double s0 = line.ToFrenet(problem.initial.position.x, problem.initial.position.y).s;
+      double needed = 0;
+      for (const FrenetGoal& g : goals) {
+        const double t = (g.region.t_hi - problem.initial.time_step) * sc.dt;
+        if (g.timed_hi && t > 0 && std::isfinite(g.region.s_lo)) {
+          needed = std::max(needed, (g.region.s_lo - s0) / t);
+        }
+      }
+      const double mps = std::min(std::max({config.value("limits.max_speed_mph") * kMphToMps,
+                                            v0 + kStartSpeedRoom, kGoalSpeedFactor * needed}),
+                                  kLimitMargin * vp.v_max);
+      (void)problem_config.Set("limits.max_speed_mph", mps / kMphToMps);
     }
     auto planner = plan::MakePlanner("search", problem_config, built->road);
     if (!planner.ok()) {
@@ -329,11 +357,10 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       out.problems.push_back(std::move(run));
       continue;
     }
-    const std::vector<FrenetGoal> goals = FrenetGoals(sc, problem, line);
     for (const FrenetGoal& g : goals) {
       const cost::GoalRegion& r = g.region;
-      spdlog::debug("{} #{}: goal s [{:.2f}, {:.2f}] d [{:.2f}, {:.2f}] steps [{}, {}] v [{}, {}] h [{}, {}]",
-                    sc.benchmark_id, problem.id, r.s_lo, r.s_hi, r.d_lo, r.d_hi, r.t_lo, r.t_hi,
+      spdlog::debug("{} #{}: goal s [{:.2f}, {:.2f}] d [{:.2f}, {:.2f}] slope {:.4f} steps [{}, {}] v [{}, {}] h [{}, {}]",
+                    sc.benchmark_id, problem.id, r.s_lo, r.s_hi, r.d_lo, r.d_hi, r.d_slope, r.t_lo, r.t_hi,
                     r.v_lo, r.v_hi, r.h_lo, r.h_hi);
     }
     for (int l = 0; l < road.num_lanes(); ++l) {

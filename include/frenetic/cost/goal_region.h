@@ -11,7 +11,10 @@ namespace frenetic::cost {
 struct GoalRegion {
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   double s_lo = -kInf, s_hi = kInf;  // m along the line (unwrapped)
-  double d_lo = -kInf, d_hi = kInf;  // m, right positive
+  // m, right positive: at s the region spans d in [d_lo, d_hi] + d_slope (s - s_ref) (a box
+  // turned a little against the road: a goal rectangle along a lane that bends off the line).
+  double d_lo = -kInf, d_hi = kInf;
+  double s_ref = 0, d_slope = 0;
   double t_lo = -kInf, t_hi = kInf;  // s from the instant it is given for
   double v_lo = -kInf, v_hi = kInf;  // m/s
   // The heading relative to the line's (atan2(d', s'), rad, right positive as d): a goal
