@@ -2,13 +2,14 @@
 // planning problem's goal states) within its time window: over the window, the least of
 //   out(s, [s_lo, s_hi]) / s_scale + out(d - d_slope (s - s_ref), [d_lo, d_hi]) / d_scale
 //   + out(v, [v_lo, v_hi]) / v_scale + out(h, [h_lo, h_hi]) / h_scale
-// with out(x, [lo, hi]) the distance of x outside the interval and h = atan2(d', s') the heading
-// against the line's, the candidate continued past its samples at its last speed along its last
+// with out(x, [lo, hi]) the distance of x outside the interval and h = d' / s' the tangent of
+// the heading against the line's (the bounds' tangents likewise), the candidate continued past its samples at its last speed along its last
 // d. 0 when it passes through a region in its window (and with no goal: the Udacity track), else
 // `miss` plus that least sum (a goal is reached or not: missing it by a little is still missing
 // it), at most `cap`. Between samples each quantity is taken linear in time, so each term is convex and
 // piecewise linear and their sum is least at a window end, a sample or where a term crosses an
 // interval's end: the minimum over those is exact (for h, of its linear interpolation).
+// About 25 samples and a few crossings per candidate and goal: cheap enough for every candidate.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -57,13 +58,19 @@ class GoalCost : public CostTerm {
   }
 
  private:
-  // The candidate at time t (s after the start): sampled, then straight on.
+  // The candidate at time t (s after the start): sampled, then straight on. h is its heading's
+  // tangent against the line's, d' / s' (s' floored at 0.1 m/s): monotone in the heading, and
+  // the heading itself for small angles, without an atan2 per sample.
   struct At {
     double s, d, v, h;
   };
   // d against the region's slanted sides.
   static double Across(const GoalRegion& g, const At& a) { return a.d - g.d_slope * (a.s - g.s_ref); }
-  static double Heading(double s_d, double d_d) { return std::atan2(d_d, std::max(s_d, 0.1)); }
+  static double Slope(double s_d, double d_d) { return d_d / std::max(s_d, 0.1); }
+  static double Tan(double h) { return std::tan(std::clamp(h, -1.5, 1.5)); }
+  At Sample(const CostInput& in, int k) const {
+    return {in.s[k], in.d[k], in.s_d[k], Slope(in.s_d[k], in.d_d[k])};
+  }
   At State(const CostContext& ctx, const CostInput& in, double t) const {
     const int n = ctx.num_samples;
     const double x = t / ctx.dt;
@@ -73,13 +80,19 @@ class GoalCost : public CostTerm {
     }
     const int k = std::max(0, static_cast<int>(x));
     const double f = x - k;
-    const double h0 = Heading(in.s_d[k], in.d_d[k]), h1 = Heading(in.s_d[k + 1], in.d_d[k + 1]);
-    return {in.s[k] + f * (in.s[k + 1] - in.s[k]), in.d[k] + f * (in.d[k + 1] - in.d[k]),
-            in.s_d[k] + f * (in.s_d[k + 1] - in.s_d[k]), h0 + f * (h1 - h0)};
+    const At a = Sample(in, k), b = Sample(in, k + 1);
+    return {a.s + f * (b.s - a.s), a.d + f * (b.d - a.d), a.v + f * (b.v - a.v),
+            a.h + f * (b.h - a.h)};
   }
-  double MissAt(const GoalRegion& g, const At& a) const {
-    return Out(a.s, g.s_lo, g.s_hi) / s_scale_ + Out(Across(g, a), g.d_lo, g.d_hi) / d_scale_ +
-           Out(a.v, g.v_lo, g.v_hi) / v_scale_ + Out(a.h, g.h_lo, g.h_hi) / h_scale_;
+  // The region's heading bounds as tangents (+-inf when absent).
+  struct Bounds {
+    double h_lo, h_hi;
+  };
+  double MissAt(const GoalRegion& g, const Bounds& hb, const At& a) const {
+    double m = Out(a.s, g.s_lo, g.s_hi) / s_scale_ + Out(Across(g, a), g.d_lo, g.d_hi) / d_scale_ +
+               Out(a.v, g.v_lo, g.v_hi) / v_scale_;
+    if (std::isfinite(hb.h_lo) || std::isfinite(hb.h_hi)) m += Out(a.h, hb.h_lo, hb.h_hi) / h_scale_;
+    return m;
   }
   // The least miss over the window, at its ends, the samples inside it and the crossings.
   double Miss(const CostContext& ctx, const CostInput& in, const GoalRegion& g) const {
@@ -89,27 +102,34 @@ class GoalCost : public CostTerm {
     // An endless window is judged up to a minute past the samples.
     const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
     if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();
-    double best = std::min(MissAt(g, State(ctx, in, t0)), MissAt(g, State(ctx, in, t1)));
+    const Bounds hb{std::isfinite(g.h_lo) ? Tan(g.h_lo) : g.h_lo,
+                    std::isfinite(g.h_hi) ? Tan(g.h_hi) : g.h_hi};
+    double best = std::min(MissAt(g, hb, State(ctx, in, t0)), MissAt(g, hb, State(ctx, in, t1)));
     // Where a linear piece from time ta (values a) to tb (b) crosses x = level.
     auto cross = [&](double ta, double tb, double a, double b, double level) {
       if (!std::isfinite(level) || (a - level) * (b - level) > 0 || a == b) return;
       const double t = ta + (level - a) / (b - a) * (tb - ta);
-      if (t >= t0 && t <= t1) best = std::min(best, MissAt(g, State(ctx, in, t)));
+      if (t >= t0 && t <= t1) best = std::min(best, MissAt(g, hb, State(ctx, in, t)));
     };
-    auto piece = [&](double ta, double tb) {
-      const At a = State(ctx, in, ta), b = State(ctx, in, tb);
+    auto piece = [&](double ta, double tb, const At& a, const At& b) {
       for (const double level : {g.s_lo, g.s_hi}) cross(ta, tb, a.s, b.s, level);
       for (const double level : {g.d_lo, g.d_hi}) cross(ta, tb, Across(g, a), Across(g, b), level);
       for (const double level : {g.v_lo, g.v_hi}) cross(ta, tb, a.v, b.v, level);
-      for (const double level : {g.h_lo, g.h_hi}) cross(ta, tb, a.h, b.h, level);
+      for (const double level : {hb.h_lo, hb.h_hi}) cross(ta, tb, a.h, b.h, level);
     };
-    for (int k = 0; k + 1 < n; ++k) {
-      const double ta = k * dt, tb = (k + 1) * dt;
-      if (tb < t0 || ta > t1) continue;
-      if (ta >= t0) best = std::min(best, MissAt(g, State(ctx, in, ta)));
-      piece(ta, tb);
+    const int k0 = std::max(0, static_cast<int>(std::floor(t0 / dt)));
+    const int k1 = std::min(n - 1, static_cast<int>(std::ceil(t1 / dt)));
+    At a = k0 < n ? Sample(in, k0) : At{};
+    for (int k = k0; k < k1; ++k) {
+      const At b = Sample(in, k + 1);
+      if (k * dt >= t0) best = std::min(best, MissAt(g, hb, a));
+      piece(k * dt, (k + 1) * dt, a, b);
+      a = b;
     }
-    if (t1 > t_end) piece(std::max(t_end, t0), t1);  // the straight continuation
+    if (t1 > t_end) {  // the straight continuation
+      const double ta = std::max(t_end, t0);
+      piece(ta, t1, State(ctx, in, ta), State(ctx, in, t1));
+    }
     return best;
   }
 

@@ -55,6 +55,7 @@ constexpr Default kDefaults[] = {
     {"grid.lat_max_duration", 4.0, 1, 8, false},
     {"grid.lat_offsets", 1, 1, 7, false},
     {"grid.lat_offset_step", 0.3, 0.05, 1, false},
+    {"grid.lane_reach", 2.5, 1, 4, false},
     {"grid.lat_delays", 2, 0, 4, false},
     {"grid.lat_delay_step", 1.5, 0.5, 3, false},
     {"score.dt", 0.25, 0.1, 0.5, false},

@@ -200,10 +200,11 @@ void Lattice::Generate() {
   ws_.lat.clear();
   ws_.cand_lon.clear();
   ws_.cand_lat.clear();
-  // Lanes within reach: the current one and its neighbours.
+  // Lanes within reach (grid.lane_reach lane widths): the current one and its neighbours.
   bool reachable[cost::kMaxLanes] = {};
   for (int l = 0; l < cfg_.num_lanes; ++l) {
-    reachable[l] = ws_.lane_exists[l] && std::abs(ws_.lane_center[l] - start.d) <= 2.5 * cfg_.lane_width;
+    reachable[l] = ws_.lane_exists[l] &&
+                   std::abs(ws_.lane_center[l] - start.d) <= cfg_.lane_reach * cfg_.lane_width;
   }
   double vmax = 0;
   for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);

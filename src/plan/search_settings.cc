@@ -56,6 +56,7 @@ Settings::Settings(const PlannerConfig& c) {
   lat_max_duration = c.value("grid.lat_max_duration");
   lat_offsets = c.int_value("grid.lat_offsets");
   lat_offset_step = c.value("grid.lat_offset_step");
+  lane_reach = c.value("grid.lane_reach");
   lat_delays = c.int_value("grid.lat_delays");
   lat_delay_step = c.value("grid.lat_delay_step");
   score_dt = c.value("score.dt");

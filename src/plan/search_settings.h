@@ -57,6 +57,7 @@ struct Settings {
   double lat_min_duration, lat_max_duration;
   int lat_offsets;
   double lat_offset_step;
+  double lane_reach;          // lane widths: lanes whose centre is this near are targets
   int lat_delays;
   double lat_delay_step;
   double score_dt, score_horizon;

@@ -110,7 +110,8 @@ TEST_F(GoalCostTest, ThePassedWindowAndTheNearestGoalCount) {
 }
 
 TEST_F(GoalCostTest, HeadingOutsideItsIntervalCounts) {
-  // The candidate moves across at 1 m/s at 20 m/s: heading atan(1 / 20) = 0.04996 rad.
+  // The candidate moves across at 1 m/s at 20 m/s: a heading whose tangent is 0.05 (measured as
+  // tangents: 0.04996 rad).
   Case c(20, {});
   for (double& dd : c.d_d) dd = 1.0;
   GoalRegion g = Box(95, 105, 4, 6);
@@ -120,9 +121,24 @@ TEST_F(GoalCostTest, HeadingOutsideItsIntervalCounts) {
   c.goals = {g};
   c.ctx.num_goals = 1;
   c.ctx.goals = c.goals.data();
-  EXPECT_NEAR(Eval(c), 1 + (std::atan(1.0 / 20) - 0.01) / 0.05, 1e-6);
+  EXPECT_NEAR(Eval(c), 1 + (1.0 / 20 - std::tan(0.01)) / 0.05, 1e-9);
   c.goals[0].h_hi = 0.06;
   EXPECT_EQ(Eval(c), 0.0);
+}
+
+TEST_F(GoalCostTest, ASlantedRegionFollowsItsSlope) {
+  // A strip 1 m wide whose middle climbs from d = 2 at s = 100 by 0.1 m per m. In the window
+  // [5.4, 6] s the candidate (d = 2, 20 m/s) is at s = 108 first, where the strip spans
+  // [2.3, 3.3]: 0.3 m off, and more later. In [4.9, 5.1] it crosses s = 100, inside the strip.
+  GoalRegion g = Box(95, 115, 5.4, 6);
+  g.d_lo = 1.5;
+  g.d_hi = 2.5;
+  g.s_ref = 100;
+  g.d_slope = 0.1;
+  EXPECT_NEAR(Eval(Case(20, {g})), 1 + 0.3 / 1.75, 1e-9);
+  g.t_lo = 4.9;
+  g.t_hi = 5.1;
+  EXPECT_EQ(Eval(Case(20, {g})), 0.0);
 }
 
 TEST_F(GoalCostTest, NoPositionMeansTimeAndSpeedOnly) {
