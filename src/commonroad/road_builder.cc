@@ -1,6 +1,7 @@
 #include "frenetic/commonroad/road_builder.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -27,6 +28,10 @@ constexpr double kLaneGap = 1.0;
 constexpr double kMinWidth = 0.05;
 // m: how far a lane goes on past an open end of the lanelet network (RoadArea's margin).
 constexpr double kOpenEnd = RoadArea::kDefaultOpenEndMargin;
+// m: lanes ending within kMapEndSlack of the map's last (or first) metre are the map's end and
+// run on kMapRunOn m straight for the planner.
+constexpr double kMapEndSlack = 10.0;
+constexpr double kMapRunOn = 300.0;
 
 // The lanelet network by index, with what the search needs of each lanelet.
 class Network {
@@ -306,41 +311,82 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   } else {
     route = {start};
   }
-  // 3. The skeleton: successor to successor, over the route's cross-sections. offset[k]: the
-  // lateral position of skeleton lanelet k in the road's lanes (its neighbours' are relative).
-  std::vector<int> skeleton = {route.front()};
-  std::vector<int> offset = {0};
-  std::vector<bool> jump_before = {false};
-  int lateral = 0;  // the route's lanelet's position relative to the skeleton's, this section
-  for (size_t r = 1; r < route.size(); ++r) {
-    const int prev = route[r - 1], cur = route[r];
-    const int side = net.Beside(prev, -1) == cur ? -1 : net.Beside(prev, 1) == cur ? 1 : 0;
-    if (side != 0) {  // a lane change within the section
-      lateral += side;
-      continue;
-    }
-    // `cur` follows `prev` (at `lateral` from the skeleton): the next cross-section.
-    std::set<int> section;
-    for (const auto& [j, pos] : net.CrossSection(cur)) section.insert(j);
-    int next = -1;
-    for (int j : net.Successors(skeleton.back())) {
-      if (section.count(j)) next = j;
-    }
-    if (next >= 0) {
-      skeleton.push_back(next);
-      offset.push_back(offset.back());
-      jump_before.push_back(false);
-      // The route's lanelet relative to the new skeleton lanelet.
-      lateral = 0;
-      for (const auto& [j, pos] : net.CrossSection(next)) {
-        if (j == cur) lateral = pos;
+  // 3. The route's cross-sections, each with the road's lateral position of its lanelets: a
+  // section's positions are relative to its entry lanelet (where the route comes in), the next
+  // section's entry continues the exit's lane.
+  struct Section {
+    std::vector<std::pair<int, int>> lanelets;  // lanelet, the road's lateral position
+  };
+  std::vector<Section> sections;
+  {
+    int base = 0, entry = route.front();
+    std::vector<std::pair<int, int>> cs = net.CrossSection(entry);
+    for (size_t r = 1; r <= route.size(); ++r) {
+      const bool ends = r == route.size();
+      const int prev = route[r - 1], cur = ends ? -1 : route[r];
+      if (!ends && (net.Beside(prev, -1) == cur || net.Beside(prev, 1) == cur)) continue;
+      // The section ends at `prev` (its exit).
+      Section sec;
+      int exit_pos = 0;
+      for (const auto& [j, pos] : cs) {
+        sec.lanelets.push_back({j, base + pos});
+        if (j == prev) exit_pos = pos;
       }
-    } else {  // the skeleton's lane ends here: it moves to the route's lane
-      skeleton.push_back(cur);
-      offset.push_back(offset.back() + lateral);
-      jump_before.push_back(true);
-      lateral = 0;
+      sections.push_back(std::move(sec));
+      if (ends) break;
+      base += exit_pos;
+      entry = cur;
+      cs = net.CrossSection(entry);
     }
+  }
+  auto position_in = [&](int section, int lanelet) {
+    for (const auto& [j, pos] : sections[section].lanelets) {
+      if (j == lanelet) return pos;
+    }
+    return INT_MIN;
+  };
+  // chain[i][j]: how many sections on lanelet j of section i continues by successors.
+  std::vector<std::map<int, int>> chain(sections.size());
+  for (int i = static_cast<int>(sections.size()) - 1; i >= 0; --i) {
+    for (const auto& [j, pos] : sections[i].lanelets) {
+      int best = 0;
+      if (i + 1 < static_cast<int>(sections.size())) {
+        for (int k : net.Successors(j)) {
+          if (chain[i + 1].count(k)) best = std::max(best, chain[i + 1][k]);
+        }
+      }
+      chain[i][j] = 1 + best;
+    }
+  }
+  // The skeleton: the longest chain from the first section (of equals, the one nearest the
+  // start's lane), on along it; where it ends before the last section, over to the next
+  // section's longest chain nearest its lane. offset[k]: skeleton lanelet k's lateral position.
+  std::vector<int> skeleton, offset;
+  std::vector<bool> jump_before;
+  auto pick = [&](int i, int near_pos, const std::vector<int>& among) {
+    int best = -1, best_len = -1, best_off = INT_MAX;
+    for (int j : among) {
+      const auto it = chain[i].find(j);
+      if (it == chain[i].end()) continue;
+      const int off = std::abs(position_in(i, j) - near_pos);
+      if (it->second > best_len || (it->second == best_len && off < best_off)) {
+        best = j;
+        best_len = it->second;
+        best_off = off;
+      }
+    }
+    return best;
+  };
+  for (int i = 0; i < static_cast<int>(sections.size()); ++i) {
+    std::vector<int> all;
+    for (const auto& [j, pos] : sections[i].lanelets) all.push_back(j);
+    int next = -1;
+    if (!skeleton.empty()) next = pick(i, offset.back(), net.Successors(skeleton.back()));
+    const bool jump = next < 0;
+    if (jump) next = pick(i, skeleton.empty() ? position_in(0, start) : offset.back(), all);
+    skeleton.push_back(next);
+    offset.push_back(position_in(i, next));
+    jump_before.push_back(jump && i > 0);
   }
   // Road ahead of the goal and behind the start, for the horizon and the cars behind.
   std::set<int> used(skeleton.begin(), skeleton.end());
@@ -379,20 +425,24 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   auto line = map::ReferenceLine::FitOpen(poly, map::ReferenceLine::Options(),
                                           where + "reference line");
   if (!line.ok()) return line.status();
-  // 4. Lanes: each skeleton lanelet's cross-section, at the road's lateral positions.
+  // 4. Lanes: every lanelet of the route's sections and of the extensions' cross-sections, at
+  // its lateral position.
   struct Piece {
     int lanelet;
     Stations st;
   };
   std::map<int, std::vector<Piece>> by_position;
   std::set<int> placed;
+  auto place = [&](int j, int pos) {
+    if (!placed.insert(j).second) return;
+    Stations st = Project(net.at(j), **line);
+    if (st.s.size() >= 2) by_position[pos].push_back({j, std::move(st)});
+  };
+  for (const Section& sec : sections) {
+    for (const auto& [j, pos] : sec.lanelets) place(j, pos);
+  }
   for (size_t k = 0; k < skeleton.size(); ++k) {
-    for (const auto& [j, pos] : net.CrossSection(skeleton[k])) {
-      if (!placed.insert(j).second) continue;
-      Stations st = Project(net.at(j), **line);
-      if (st.s.size() < 2) continue;
-      by_position[offset[k] + pos].push_back({j, std::move(st)});
-    }
+    for (const auto& [j, pos] : net.CrossSection(skeleton[k])) place(j, offset[k] + pos);
   }
   BuiltRoad out;
   std::vector<map::LaneProfile> lanes;
@@ -437,6 +487,27 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
       }
     }
     flush();
+  }
+  // Where the map itself ends (every lane that reaches the road's last metres), the lanes run on
+  // straight for the planner's horizons: the map's end is not a wall it must stop at, and a run
+  // ends at the goal (the verdict still holds the ego to the lanelets up to there). Likewise
+  // before the map's start.
+  double first = std::numeric_limits<double>::infinity(), last = -first;
+  for (const map::LaneProfile& l : lanes) {
+    first = std::min(first, l.s.front());
+    last = std::max(last, l.s.back());
+  }
+  for (map::LaneProfile& l : lanes) {
+    if (l.s.back() > last - kMapEndSlack) {
+      l.s.push_back(l.s.back() + kMapRunOn);
+      l.left.push_back(l.left.back());
+      l.right.push_back(l.right.back());
+    }
+    if (l.s.front() < first + kMapEndSlack) {
+      l.s.insert(l.s.begin(), l.s.front() - kMapRunOn);
+      l.left.insert(l.left.begin(), l.left.front());
+      l.right.insert(l.right.begin(), l.right.front());
+    }
   }
   auto road = map::Road::Make(*line, std::move(lanes), where + "road");
   if (!road.ok()) return road.status();

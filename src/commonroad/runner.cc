@@ -21,6 +21,9 @@ constexpr double kTick = plan::kTickSeconds;
 // The planner's limits sit this far inside the verdict's: it measures them on its own path,
 // which the KS ego follows to within centimetres, not exactly.
 constexpr double kLimitMargin = 0.85;
+// Insets of the goal regions the planner aims at (Inset): m along, m across, m/s, rad, and
+// steps of the time window.
+constexpr double kInsetS = 1.0, kInsetD = 0.2, kInsetV = 0.5, kInsetH = 0.02, kTimeInset = 0.5;
 // Recorded futures the planner is given: enough samples for its horizons (6 s and a little).
 constexpr int kFutureSteps = 80;
 constexpr double kMphToMps = 0.44704;
@@ -122,6 +125,26 @@ void AddRectangle(const map::ReferenceLine& line, const Shape& sh, cost::GoalReg
   const double spread = half_wid * std::abs(slope) / std::sqrt(1 + slope * slope);
   r->s_lo = std::min(a.s, b.s) - spread;
   r->s_hi = std::max(a.s, b.s) + spread;
+}
+
+// The region the planner aims at: a little inside the goal's intervals (a quarter of each, at
+// most the margin), so that the ego's state at a whole step lies inside, not on the edge the
+// plan touched between two steps.
+double InsetBy(double lo, double hi, double margin) {
+  return std::isfinite(lo) && std::isfinite(hi) ? std::min(margin, 0.25 * (hi - lo)) : 0.0;
+}
+cost::GoalRegion Inset(cost::GoalRegion r) {
+  const double s = InsetBy(r.s_lo, r.s_hi, kInsetS), d = InsetBy(r.d_lo, r.d_hi, kInsetD);
+  const double v = InsetBy(r.v_lo, r.v_hi, kInsetV), h = InsetBy(r.h_lo, r.h_hi, kInsetH);
+  r.s_lo += s;
+  r.s_hi -= s;
+  r.d_lo += d;
+  r.d_hi -= d;
+  r.v_lo += v;
+  r.v_hi -= v;
+  r.h_lo += h;
+  r.h_hi -= h;
+  return r;
 }
 
 // The goal's orientation interval as a heading against the road's in the region (its s mid):
@@ -228,11 +251,18 @@ KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vect
   constexpr double kHeadingGain = 0.5;  // of the heading error
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
   constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
+  constexpr double kMinSpan = 0.5;      // m: the shortest chord the path's direction is taken on
   const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
   const int j = ticks - 1;  // the point dt in
-  const int a = std::max(0, j - 1), b = j + 1;
+  // The neighbours the heading and curvature are measured over: the next points, or farther
+  // ones at a crawl (points millimetres apart give no direction).
+  int a = std::max(0, j - 1), b = j + 1;
+  while (std::hypot(x[b] - x[a], y[b] - y[a]) < kMinSpan && (a > 0 || b + 1 < n)) {
+    if (a > 0) --a;
+    if (b + 1 < n) ++b;
+  }
   const double theta = std::atan2(y[b] - y[a], x[b] - x[a]);
   const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * kTick);
   const double kappa = Curvature(x[a], y[a], x[j], y[j], x[b], y[b]);
@@ -260,8 +290,15 @@ KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vect
   const double c = std::cos(theta), sn = std::sin(theta);
   const double along = ex * c + ey * sn, cross = -(-ex * sn + ey * c);
   const double heading_err = WrapAngle(psi_ff - pred.orientation);
-  const double delta_cmd = delta_ff + kHeadingGain * heading_err -
-                           std::atan(kCrossGain * cross / std::max(ego.velocity, 1.0));
+  // Within the steering limits, and the friction circle's lateral part: v^2 tan(delta) / l_wb
+  // <= a_max at the step's end speed.
+  const double v_end = std::max(ego.velocity, v_ff);
+  const double max_steer =
+      std::min(kLimitMargin * std::min(vp.steering_max, -vp.steering_min),
+               std::atan(kLimitMargin * vp.a_max * l_wb / std::max(v_end * v_end, 1e-6)));
+  const double delta_cmd = std::clamp(delta_ff + kHeadingGain * heading_err -
+                                          std::atan(kCrossGain * cross / std::max(ego.velocity, 1.0)),
+                                      -max_steer, max_steer);
   const double v_cmd = v_ff + kAlongGain * along;
   const KsInput u = clip({(delta_cmd - ego.steering_angle) / dt, (v_cmd - ego.velocity) / dt});
   return SimulateKs(ego, u, dt, vp);
@@ -288,7 +325,7 @@ Status RunOptions::Validate() const {
 }
 
 StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig c, const VehicleParams& vp,
-                                               PredictionMode prediction) {
+                                               PredictionMode /*prediction*/) {
   c.PinDeadlines();
   const std::pair<const char*, double> values[] = {
       {"check.ego_length", vp.length},
@@ -298,7 +335,6 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig c, const Vehi
       {"vehicle.max_steer_rate", kLimitMargin * vp.steering_rate_max},
       {"vehicle.max_accel", kLimitMargin * vp.a_max},
       {"vehicle.switch_speed", vp.v_switch},
-      {"prediction.manoeuvres", prediction == PredictionMode::kRecorded ? 1.0 : 0.0},
   };
   for (const auto& [key, value] : values) {
     if (Status st = c.Set(key, value); !st.ok()) return st;
@@ -439,9 +475,11 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       }
       t.goals.clear();
       for (const FrenetGoal& g : goals) {
-        cost::GoalRegion r = g.region;
-        if (g.timed_lo) r.t_lo = (r.t_lo - k) * dt;
-        if (g.timed_hi) r.t_hi = (r.t_hi - k) * dt;
+        cost::GoalRegion r = Inset(g.region);
+        // Time steps to seconds from now, half a step inside the window (the verdict looks at
+        // whole steps).
+        if (g.timed_lo) r.t_lo = (r.t_lo - k) * dt + kTimeInset * dt;
+        if (g.timed_hi) r.t_hi = (r.t_hi - k) * dt - kTimeInset * dt;
         t.goals.push_back(r);
       }
       const bool tracing = spdlog::should_log(spdlog::level::trace);

@@ -13,6 +13,7 @@ constexpr double kDt = 0.02;
 constexpr int kBlock = 10;  // ticks per acceleration sample (0.2 s)
 constexpr int kJerkBlocks = 5;  // acceleration samples per jerk sample (1 s)
 constexpr int kVehicleBlock = 5;  // ticks per VehicleLimits sample (0.1 s, CommonRoad's step)
+constexpr double kSteerSpeed = 2.0;  // m/s: VehicleLimits' steering is measured from this speed on
 
 double Norm(double x, double y) { return std::sqrt(x * x + y * y); }
 
@@ -90,11 +91,15 @@ void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
   auto steer = [&](int j) { return std::atan(lim.wheelbase * kmean(j)); };
   // The last point's curvature is not known (0): blocks end at n - 2.
   for (int j = std::max(b, first); j <= n - 2; ++j) {
-    if (lim.max_steer > 0) {
+    // At a crawl a path's curvature says nothing about the steering (a car turns its wheels at
+    // a standstill, and points millimetres apart bend any way): steering is measured from
+    // kSteerSpeed on.
+    const bool steering = vmean(j) >= kSteerSpeed && (j < 2 * b || vmean(j - b) >= kSteerSpeed);
+    if (lim.max_steer > 0 && steering) {
       m->steer_ratio = std::max(m->steer_ratio, std::abs(steer(j)) / lim.max_steer);
     }
     if (j < 2 * b) continue;  // the rates need the block before (from tick 1 on)
-    if (lim.max_steer_rate > 0) {
+    if (lim.max_steer_rate > 0 && steering) {
       const double rate = std::abs(steer(j) - steer(j - b)) / bt;
       m->steer_rate_ratio = std::max(m->steer_rate_ratio, rate / lim.max_steer_rate);
     }

@@ -57,7 +57,7 @@ TEST(RoadBuilderTest, TwoLanesOfAStraightRoad) {
   EXPECT_NEAR(b.road->lane_width(), 3.5, 0.01);
 }
 
-TEST(RoadBuilderTest, ALaneDropMovesTheSkeletonOver) {
+TEST(RoadBuilderTest, ALaneDropKeepsTheReferenceOnTheLaneThatGoesOn) {
   // Right lane 1 (0-150 m) ends; the left lane is 2 (0-150) then 3 (150-300). The ego starts in
   // lane 1; the goal is lanelet 3.
   ScenarioXml xml;
@@ -74,14 +74,17 @@ TEST(RoadBuilderTest, ALaneDropMovesTheSkeletonOver) {
   const BuiltRoad b = Build(sc);
   ASSERT_NE(b.road, nullptr);
   EXPECT_EQ(b.route, (std::vector<int>{1, 2, 3}));
-  EXPECT_EQ(b.skeleton, (std::vector<int>{1, 3}));
+  // The reference follows the lane that reaches the goal's section, not the start's.
+  EXPECT_EQ(b.skeleton, (std::vector<int>{2, 3}));
   ASSERT_EQ(b.road->num_lanes(), 2);
   EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1}}));
-  // The right lane ends where lanelet 1 does, plus the open end's 5 m.
+  // The right lane ends where lanelet 1 does, plus the open end's 5 m: a lane drop. Both lanes
+  // run on 300 m before the map's start, the left one 300 m past the map's end.
   EXPECT_NEAR(b.road->LaneEnd(1), 155, 1.0);
-  EXPECT_NEAR(b.road->LaneBegin(1), -5, 1.0);
+  EXPECT_NEAR(b.road->LaneBegin(1), -305, 1.0);
+  EXPECT_NEAR(b.road->LaneEnd(0), 605, 1.0);
   EXPECT_GT(b.road->LaneEnd(0), 290);
-  // The left lane's centre is y = 1.75 in XY everywhere, wherever the line crosses over.
+  // The left lane's centre is y = 1.75 in XY everywhere (the line itself).
   for (double s : {20.0, 120.0, 160.0, 250.0}) {
     const map::Road::Span a = b.road->LaneAt(0, s);
     ASSERT_TRUE(a.exists) << s;

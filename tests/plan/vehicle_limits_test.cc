@@ -89,6 +89,16 @@ TEST(VehicleLimitsTest, SteeringAngleOfATightCircle) {
   }
 }
 
+TEST(VehicleLimitsTest, NoSteeringAtACrawl) {
+  // Sideways by 5 cm while creeping at 0.3 m/s: a curvature no steering gives, but a car at a
+  // crawl turns its wheels as it likes; at 3 m/s the same path's steering is measured.
+  const XyMeasure crawl = Measure(Drive(0.3, 0, 150, 0.05, 0.2, 2), Bmw());
+  EXPECT_EQ(crawl.steer_ratio, 0.0);
+  EXPECT_EQ(crawl.steer_rate_ratio, 0.0);
+  const XyMeasure moving = Measure(Drive(3, 0, 150, 0.05, 0.2, 2), Bmw());
+  EXPECT_GT(moving.steer_ratio, 0.0);
+}
+
 TEST(VehicleLimitsTest, NaNPathIsAViolation) {
   Path p = Drive(20, 0, 100);
   p.y[99] = NAN;

@@ -15,8 +15,11 @@
 //     lanes over) at its lateral position; a lane is the lanelets at one lateral position, their
 //     borders projected onto the reference line; a lane goes on RoadArea::kDefaultOpenEndMargin
 //     (5 m) past an open end of the network (a lanelet without predecessor or successor), as the
-//     verdict's road area does. Lanelets of the opposite direction are not part of the road (the
-//     verdict still counts them as road surface).
+//     verdict's road area does; at the map's own ends (where every lane ends) the lanes run on
+//     straight for 300 m, so that the planner does not stop at the edge of the map (a run ends
+//     at its goal; the verdict holds the ego to the lanelets up to there). Lanelets of the
+//     opposite direction are not part of the road (the verdict still counts them as road
+//     surface).
 #pragma once
 
 #include <memory>

@@ -8,7 +8,9 @@
 // orientation and speed; the rest of its last path (its 0.02 s points after the dt driven); the
 // obstacles there at that step as sensor rows (centre, velocity, footprint); with
 // --prediction recorded, each dynamic obstacle's recorded future (the benchmark's convention for
-// "T" scenarios), else nothing beyond the present (the planner's constant-velocity predictor); and
+// "T" scenarios), else nothing beyond the present: the planner's own predictor then carries each
+// car on at its velocity (along its lane, and across it to the next lane's centre), a car
+// braking hard since the last step braking on for up to 2 s; and
 // the goal states as regions of its road's Frenet frame. The ego then moves dt with the constant
 // KS input (steering rate, acceleration) that best lands it on the planned state dt ahead
 // (position, orientation, steering angle, speed: a few Gauss-Newton steps on SimulateKs, the
@@ -73,8 +75,8 @@ struct ScenarioRun {
 
 // The planner configuration for CommonRoad: `base` (config/planner.yaml with
 // config/commonroad.yaml on top, as the command loads it) with the ego's footprint and the
-// vehicle's kinematic limits (vehicle.*, 15% inside the verdict's), the wall-clock deadlines
-// pinned, and the constant-velocity predictor for PredictionMode::kConstantVelocity. Each problem
+// vehicle's kinematic limits (vehicle.*, 15% inside the verdict's) and the wall-clock deadlines
+// pinned (the prediction mode changes what the runner tells the planner, not its config). Each problem
 // raises limits.max_speed_mph to 2 m/s above its initial speed when that is faster (the planner's
 // speed limit is hard); the lanes' signs limit it further.
 inline constexpr const char* kCommonRoadConfig = "config/commonroad.yaml";  // in the source tree

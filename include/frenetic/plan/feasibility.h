@@ -19,8 +19,9 @@ struct XyLimits {
 // A real vehicle's kinematic limits, those of CommonRoad's single-track models (the Udacity
 // simulator has none): the steering angle delta = atan(wheelbase kappa) and its rate, and the
 // forward acceleration, a_max up to switch_speed and a_max switch_speed / v above it. Measured
-// on 0.1 s block means (speed, signed curvature) of the path, every alignment. A limit of 0 is
-// not measured.
+// on 0.1 s block means (speed, signed curvature) of the path, every alignment; the steering only
+// where the blocks' speeds are 2 m/s or more (at a crawl the path's curvature is no steering
+// angle). A limit of 0 is not measured.
 struct VehicleLimits {
   double wheelbase = 0;       // m
   double max_steer = 0;       // rad
