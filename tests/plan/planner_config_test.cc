@@ -133,3 +133,55 @@ TEST(PlannerConfigTest, ParamsCoverWeightsAndHaveSaneRanges) {
 
 }  // namespace
 }  // namespace frenetic::plan
+
+namespace frenetic::plan {
+namespace {
+
+TEST(PlannerConfigOverlayTest, SetsTheKeysItNamesAndOnlyThose) {
+  auto c = PlannerConfig::LoadDefault();
+  ASSERT_TRUE(c.ok()) << c.message();
+  const double jerk = c->value("weights.jerk");
+  ASSERT_TRUE(c->Overlay("limits:\n  max_speed_mph: 70\ncosts:\n  goal:\n    weight: 12\n"
+                         "    s_scale: 4\ngrid:\n  gap_targets: 2\n",
+                         "overlay.yaml")
+                  .ok());
+  EXPECT_EQ(c->value("limits.max_speed_mph"), 70);
+  EXPECT_EQ(c->value("weights.goal"), 12);
+  EXPECT_EQ(c->value("costs.goal.s_scale"), 4);
+  EXPECT_EQ(c->int_value("grid.gap_targets"), 2);
+  EXPECT_EQ(c->value("weights.jerk"), jerk);
+  EXPECT_TRUE(c->Overlay("", "empty.yaml").ok());
+  // The shipped CommonRoad overlay applies.
+  EXPECT_TRUE(c->OverlayFile(FRENETIC_SOURCE_DIR "/config/commonroad.yaml").ok());
+}
+
+TEST(PlannerConfigOverlayTest, AnErrorNamesFileAndKeyAndChangesNothing) {
+  auto c = PlannerConfig::LoadDefault();
+  ASSERT_TRUE(c.ok()) << c.message();
+  const std::string before = c->ToYaml();
+  struct Case {
+    const char* yaml;
+    const char* needle;
+  };
+  const Case cases[] = {
+      {"limits:\n  max_speed_mph: 60\n  max_sped: 3\n", "over.yaml: unknown key 'limits.max_sped'"},
+      {"limits:\n  max_speed_mph: 60\ngrid:\n  speeds: 1000\n", "'grid.speeds' = 1000 outside"},
+      {"costs:\n  goal:\n    wieght: 3\n", "unknown key 'costs.goal.wieght'"},
+      {"check:\n  margin_s: fast\n", "'check.margin_s' must be a number"},
+      {"[1, 2]", "expected a mapping"},
+      {"limits: {max_speed_mph: 60", "YAML error"},
+  };
+  for (const Case& k : cases) {
+    const Status st = c->Overlay(k.yaml, "over.yaml");
+    ASSERT_FALSE(st.ok()) << k.yaml;
+    EXPECT_NE(st.message().find(k.needle), std::string::npos) << st.message();
+    EXPECT_EQ(st.message().find('\n'), std::string::npos) << st.message();
+    EXPECT_EQ(c->ToYaml(), before) << "changed by " << k.yaml;
+  }
+  const Status missing = c->OverlayFile("/nonexistent/over.yaml");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("/nonexistent/over.yaml"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace frenetic::plan

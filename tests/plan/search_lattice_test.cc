@@ -152,6 +152,39 @@ TEST(SearchLatticeTest, YieldsToACarAlongsideInTheNeighbourLane) {
   EXPECT_EQ(yield, st.cfg.durations * st.cfg.follow_gaps);
 }
 
+TEST(SearchLatticeTest, GapTargetsEndBetweenTwoCarsOfTheNeighbourLane) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig c = GridOnly();
+  ASSERT_TRUE(c.Set("grid.gap_targets", 2).ok());
+  Stages st(c);
+  // The left lane: cars 30 m apart at 18 m/s around the ego, and one far ahead.
+  const std::vector<SceneCar> cars = {{kS - 15, 2.0, 18}, {kS + 15, 2.0, 18}, {kS + 120, 2.0, 18}};
+  PrepareCentred(st, 20, 0, cars);
+  st.lattice.Generate();
+  const Workspace& ws = st.ws;
+  const double margin = st.config.value("check.margin_s");
+  int in_gaps = 0;
+  for (const LonTraj& l : ws.lon) {
+    if (l.kind != cost::LonKind::kFollowing || l.lane != 0) continue;
+    const double T = l.traj.duration, s = l.traj.At(T).p;
+    // Gap targets end in the middle of a gap, clear of both cars' bumpers and margins: the
+    // nearer gap (between the first two cars) and the next one.
+    const double behind = kS - 15 + 18 * T, ahead = kS + 15 + 18 * T, far = kS + 120 + 18 * T;
+    const double sep = ws.car_sep_s[0] + margin;
+    if (std::abs(s - 0.5 * (behind + ahead)) < 0.05 && s > behind + sep && s < ahead - sep) ++in_gaps;
+    if (std::abs(s - 0.5 * (ahead + far)) < 0.05) ++in_gaps;
+    EXPECT_NEAR(l.traj.At(T).v, 18, 1e-3);
+  }
+  EXPECT_EQ(in_gaps, 2 * st.cfg.durations);
+  // None without the setting.
+  Stages off(GridOnly());
+  PrepareCentred(off, 20, 0, cars);
+  off.lattice.Generate();
+  int following = 0;
+  for (const LonTraj& l : off.ws.lon) following += l.kind == cost::LonKind::kFollowing;
+  EXPECT_LT(following, Count(ws, cost::LonKind::kFollowing));
+}
+
 TEST(SearchLatticeTest, MakeLonHitsEachFamilysEndCondition) {
   REQUIRE_UDACITY_MAP();
   Stages st;
