@@ -3,7 +3,7 @@
 //   out(s, [s_lo, s_hi]) / s_scale + out(d - d_slope (s - s_ref), [d_lo, d_hi]) / d_scale
 //   + out(v, [v_lo, v_hi]) / v_scale + out(h, [h_lo, h_hi]) / h_scale
 // with out(x, [lo, hi]) the distance of x outside the interval and h = d' / s' the tangent of
-// the heading against the line's (the bounds' tangents likewise), the candidate continued past its samples at its last speed along its last
+// the heading against the line's (GoalRegion's bounds are tangents too), the candidate continued past its samples at its last speed along its last
 // d. 0 when it passes through a region in its window (and with no goal: the Udacity track), else
 // `miss` plus that least sum (a goal is reached or not: missing it by a little is still missing
 // it), at most `cap`. Between samples each quantity is taken linear in time, so each term is convex and
@@ -41,6 +41,10 @@ class GoalCost : public CostTerm {
     h_scale_ = v[3];
     miss_ = v[4];
     cap_ = v[5];
+    inv_s_ = 1 / s_scale_;
+    inv_d_ = 1 / d_scale_;
+    inv_v_ = 1 / v_scale_;
+    inv_h_ = 1 / h_scale_;
   }
   double Evaluate(const CostContext& ctx, const CostInput& in) const override {
     const int n = ctx.num_samples;
@@ -67,7 +71,6 @@ class GoalCost : public CostTerm {
   // d against the region's slanted sides.
   static double Across(const GoalRegion& g, const At& a) { return a.d - g.d_slope * (a.s - g.s_ref); }
   static double Slope(double s_d, double d_d) { return d_d / std::max(s_d, 0.1); }
-  static double Tan(double h) { return std::tan(std::clamp(h, -1.5, 1.5)); }
   At Sample(const CostInput& in, int k) const {
     return {in.s[k], in.d[k], in.s_d[k], Slope(in.s_d[k], in.d_d[k])};
   }
@@ -84,15 +87,10 @@ class GoalCost : public CostTerm {
     return {a.s + f * (b.s - a.s), a.d + f * (b.d - a.d), a.v + f * (b.v - a.v),
             a.h + f * (b.h - a.h)};
   }
-  // The region's heading bounds as tangents (+-inf when absent).
-  struct Bounds {
-    double h_lo, h_hi;
-  };
-  double MissAt(const GoalRegion& g, const Bounds& hb, const At& a) const {
-    double m = Out(a.s, g.s_lo, g.s_hi) / s_scale_ + Out(Across(g, a), g.d_lo, g.d_hi) / d_scale_ +
-               Out(a.v, g.v_lo, g.v_hi) / v_scale_;
-    if (std::isfinite(hb.h_lo) || std::isfinite(hb.h_hi)) m += Out(a.h, hb.h_lo, hb.h_hi) / h_scale_;
-    return m;
+  double MissAt(const GoalRegion& g, const At& a) const {
+    // Out() of an absent part (infinite bounds) is 0.
+    return Out(a.s, g.s_lo, g.s_hi) * inv_s_ + Out(Across(g, a), g.d_lo, g.d_hi) * inv_d_ +
+           Out(a.v, g.v_lo, g.v_hi) * inv_v_ + Out(a.h, g.h_lo, g.h_hi) * inv_h_;
   }
   // The least miss over the window, at its ends, the samples inside it and the crossings.
   double Miss(const CostContext& ctx, const CostInput& in, const GoalRegion& g) const {
@@ -102,31 +100,29 @@ class GoalCost : public CostTerm {
     // An endless window is judged up to a minute past the samples.
     const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
     if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();
-    const Bounds hb{std::isfinite(g.h_lo) ? Tan(g.h_lo) : g.h_lo,
-                    std::isfinite(g.h_hi) ? Tan(g.h_hi) : g.h_hi};
-    double best = std::min(MissAt(g, hb, State(ctx, in, t0)), MissAt(g, hb, State(ctx, in, t1)));
+    double best = std::min(MissAt(g, State(ctx, in, t0)), MissAt(g, State(ctx, in, t1)));
     // Where a linear piece from time ta (values a) to tb (b) crosses x = level.
     auto cross = [&](double ta, double tb, double a, double b, double level) {
       if (!std::isfinite(level) || (a - level) * (b - level) > 0 || a == b) return;
       const double t = ta + (level - a) / (b - a) * (tb - ta);
-      if (t >= t0 && t <= t1) best = std::min(best, MissAt(g, hb, State(ctx, in, t)));
+      if (t >= t0 && t <= t1) best = std::min(best, MissAt(g, State(ctx, in, t)));
     };
     auto piece = [&](double ta, double tb, const At& a, const At& b) {
       for (const double level : {g.s_lo, g.s_hi}) cross(ta, tb, a.s, b.s, level);
       for (const double level : {g.d_lo, g.d_hi}) cross(ta, tb, Across(g, a), Across(g, b), level);
       for (const double level : {g.v_lo, g.v_hi}) cross(ta, tb, a.v, b.v, level);
-      for (const double level : {hb.h_lo, hb.h_hi}) cross(ta, tb, a.h, b.h, level);
+      for (const double level : {g.h_lo, g.h_hi}) cross(ta, tb, a.h, b.h, level);
     };
     const int k0 = std::max(0, static_cast<int>(std::floor(t0 / dt)));
     const int k1 = std::min(n - 1, static_cast<int>(std::ceil(t1 / dt)));
     At a = k0 < n ? Sample(in, k0) : At{};
-    for (int k = k0; k < k1; ++k) {
+    for (int k = k0; k < k1 && best > 0; ++k) {  // nothing is below 0: done
       const At b = Sample(in, k + 1);
-      if (k * dt >= t0) best = std::min(best, MissAt(g, hb, a));
+      if (k * dt >= t0) best = std::min(best, MissAt(g, a));
       piece(k * dt, (k + 1) * dt, a, b);
       a = b;
     }
-    if (t1 > t_end) {  // the straight continuation
+    if (t1 > t_end && best > 0) {  // the straight continuation
       const double ta = std::max(t_end, t0);
       piece(ta, t1, State(ctx, in, ta), State(ctx, in, t1));
     }
@@ -135,6 +131,7 @@ class GoalCost : public CostTerm {
 
   double s_scale_ = 10.0, d_scale_ = 1.75, v_scale_ = 5.0, h_scale_ = 0.05, miss_ = 1.0,
          cap_ = 10.0;
+  double inv_s_ = 0.1, inv_d_ = 1 / 1.75, inv_v_ = 0.2, inv_h_ = 20;
 };
 
 }  // namespace

@@ -32,6 +32,8 @@ constexpr double kOpenEnd = RoadArea::kDefaultOpenEndMargin;
 // run on kMapRunOn m straight for the planner.
 constexpr double kMapEndSlack = 10.0;
 constexpr double kMapRunOn = 300.0;
+// m: a lane farther than this from the lane on its left is apart from it there.
+constexpr double kDetached = 0.5;
 
 // The lanelet network by index, with what the search needs of each lanelet.
 class Network {
@@ -91,41 +93,43 @@ class Network {
   }
 
   // Some files leave out adjacency between lanelets that share a bound (DEU_Muc-2: two lanes
-  // side by side, neither naming the other). A lanelet without a neighbour on its left gets the
-  // one whose right bound runs along its left bound (every sample of it that lies within the
-  // other's length closer than kSharedBound, at least kSharedSamples of them, same direction)
-  // and that has no neighbour on its right.
+  // side by side, neither naming the other; US-101: an on-ramp along the right lane). A lanelet
+  // without a neighbour on its left gets the one whose right bound runs along its left bound
+  // (within kSharedBound of it for kSharedLength m or more, sampled every kSampleSpacing m: the
+  // last stretch of a converging ramp will do; the same direction there) and that has no
+  // neighbour on its right.
   void InferNeighbours() {
-    constexpr double kSharedBound = 0.5;  // m
-    constexpr int kSamples = 9, kSharedSamples = 3;
+    constexpr double kSharedBound = 0.5;    // m
+    constexpr double kSampleSpacing = 2.0;  // m
+    constexpr double kSharedLength = 10.0;  // m of the bounds within kSharedBound of each other
     constexpr double kSameDirection = 0.35;  // rad
     const int n = size();
     inferred_left_.assign(n, -1);
     inferred_right_.assign(n, -1);
     for (int i = 0; i < n; ++i) {
       if (at(i).adjacent_left.has_value()) continue;
-      const std::vector<Vec2> left = ResamplePolyline(at(i).CleanLeft(), kSamples);
+      const std::vector<Vec2> clean = at(i).CleanLeft();
+      const double left_len = PolylineLength(clean);
+      const int samples = std::max(2, static_cast<int>(std::ceil(left_len / kSampleSpacing)) + 1);
+      const std::vector<Vec2> left = ResamplePolyline(clean, samples);
+      const double spacing = left_len / (samples - 1);
       for (int j = 0; j < n && inferred_left_[i] < 0; ++j) {
         if (j == i || at(j).adjacent_right.has_value() || inferred_right_[j] >= 0) continue;
         const std::vector<Vec2> right = at(j).CleanRight();
         const double len = PolylineLength(right);
         int shared = 0;
-        bool apart = false;
+        bool opposite = false;
         for (const Vec2& p : left) {
           const PolylineProjection pr = ProjectOntoPolyline(right, p);
-          if (pr.s < 0 || pr.s > len) continue;
-          if (std::abs(pr.d) > kSharedBound) {
-            apart = true;
-            break;
-          }
+          if (pr.s < 0 || pr.s > len || std::abs(pr.d) > kSharedBound) continue;
           const double di = ProjectOntoPolyline(centre_[i], p).heading;
           if (std::abs(WrapAngle(di - pr.heading)) > kSameDirection) {
-            apart = true;
+            opposite = true;
             break;
           }
           ++shared;
         }
-        if (!apart && shared >= kSharedSamples) {
+        if (!opposite && shared * spacing >= kSharedLength) {
           inferred_left_[i] = j;
           inferred_right_[j] = i;
         }
@@ -278,6 +282,17 @@ Stations Project(const Lanelet& l, const map::ReferenceLine& line) {
     out.right.push_back(fr.d);
   }
   return out;
+}
+
+// A lane profile's left (right: right) border at s, false outside its stations.
+bool BorderAt(const map::LaneProfile& l, double s, bool right, double* out) {
+  if (l.s.size() < 2 || !(s >= l.s.front() && s <= l.s.back())) return false;
+  const size_t i = std::clamp<size_t>(std::upper_bound(l.s.begin(), l.s.end(), s) - l.s.begin(),
+                                      1, l.s.size() - 1);
+  const std::vector<double>& b = right ? l.right : l.left;
+  const double f = (s - l.s[i - 1]) / (l.s[i] - l.s[i - 1]);
+  *out = b[i - 1] + f * (b[i] - b[i - 1]);
+  return true;
 }
 
 std::string Where(const Scenario& sc, const PlanningProblem& p) {
@@ -446,6 +461,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   }
   BuiltRoad out;
   std::vector<map::LaneProfile> lanes;
+  std::vector<int> lane_pos;  // each lane's lateral position
   for (auto& [pos, pieces] : by_position) {
     std::sort(pieces.begin(), pieces.end(),
               [](const Piece& a, const Piece& b) { return a.st.s.front() < b.st.s.front(); });
@@ -468,6 +484,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
           lane.right.push_back(lane.right.back());
         }
         lanes.push_back(std::move(lane));
+        lane_pos.push_back(pos);
         out.lane_lanelets.push_back(ids);
       }
       lane = map::LaneProfile();
@@ -487,6 +504,53 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
       }
     }
     flush();
+  }
+  // A lane lying apart from the lanes on its left (a gap wider than kDetached between them: an
+  // on-ramp before it converges) is a lane only where it touches them: its longest stretch of
+  // stations that do. Between the two, the road has no surface.
+  for (size_t i = 0; i < lanes.size(); ++i) {
+    map::LaneProfile& l = lanes[i];
+    std::vector<char> touching(l.s.size(), 1);
+    bool apart = false;
+    for (size_t k = 0; k < l.s.size(); ++k) {
+      double gap = kInf;
+      bool beside = false;
+      for (size_t j = 0; j < lanes.size(); ++j) {
+        double right = 0;
+        if (lane_pos[j] != lane_pos[i] - 1 || !BorderAt(lanes[j], l.s[k], true, &right)) continue;
+        beside = true;
+        gap = std::min(gap, std::abs(l.left[k] - right));
+      }
+      if (beside && gap > kDetached) {
+        touching[k] = 0;
+        apart = true;
+      }
+    }
+    if (!apart) continue;
+    size_t best_from = 0, best_len = 0;
+    for (size_t k = 0; k < l.s.size();) {
+      size_t e = k;
+      while (e < l.s.size() && touching[e]) ++e;
+      if (e - k > best_len) {
+        best_from = k;
+        best_len = e - k;
+      }
+      k = e + 1;
+    }
+    map::LaneProfile kept;
+    kept.speed_limit = l.speed_limit;
+    for (size_t k = best_from; k < best_from + best_len; ++k) {
+      kept.s.push_back(l.s[k]);
+      kept.left.push_back(l.left[k]);
+      kept.right.push_back(l.right[k]);
+    }
+    l = std::move(kept);
+  }
+  for (size_t i = lanes.size(); i-- > 0;) {
+    if (lanes[i].s.size() >= 2) continue;
+    lanes.erase(lanes.begin() + i);
+    lane_pos.erase(lane_pos.begin() + i);
+    out.lane_lanelets.erase(out.lane_lanelets.begin() + i);
   }
   // Where the map itself ends (every lane that reaches the road's last metres), the lanes run on
   // straight for the planner's horizons: the map's end is not a wall it must stop at, and a run

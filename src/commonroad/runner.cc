@@ -156,8 +156,9 @@ void AddHeading(const map::ReferenceLine& line, const GoalState& g, cost::GoalRe
   const double road = line.At(0.5 * (r->s_lo + r->s_hi)).heading;
   const double half = 0.5 * (g.orientation->end - g.orientation->start);
   const double mid = WrapAngle(road - g.orientation->Mid());
-  r->h_lo = mid - half;
-  r->h_hi = mid + half;
+  constexpr double kQuarter = 1.5;  // rad: headings beyond stay at its tangent
+  r->h_lo = std::tan(std::clamp(mid - half, -kQuarter, kQuarter));
+  r->h_hi = std::tan(std::clamp(mid + half, -kQuarter, kQuarter));
 }
 
 std::vector<FrenetGoal> FrenetGoals(const Scenario& sc, const PlanningProblem& p,

@@ -88,20 +88,25 @@ void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
   // Block means over ticks j-4..j: speed, and the signed curvature of the triples centred there.
   auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - b]) / b; };
   auto kmean = [&](int j) { return (ksigned_sum_[j + 1] - ksigned_sum_[j + 1 - b]) / b; };
-  auto steer = [&](int j) { return std::atan(lim.wheelbase * kmean(j)); };
+  // The steering angle is atan(wheelbase kappa): its worst size and change are taken on
+  // tangents (atan is monotone; atan x - atan y = atan((x - y) / (1 + x y)) for x y > -1), and
+  // one atan each at the end.
+  double max_tan = 0, max_change = 0;
   // The last point's curvature is not known (0): blocks end at n - 2.
   for (int j = std::max(b, first); j <= n - 2; ++j) {
     // At a crawl a path's curvature says nothing about the steering (a car turns its wheels at
     // a standstill, and points millimetres apart bend any way): steering is measured from
     // kSteerSpeed on.
     const bool steering = vmean(j) >= kSteerSpeed && (j < 2 * b || vmean(j - b) >= kSteerSpeed);
-    if (lim.max_steer > 0 && steering) {
-      m->steer_ratio = std::max(m->steer_ratio, std::abs(steer(j)) / lim.max_steer);
-    }
+    const double x = lim.wheelbase * kmean(j);
+    if (steering) max_tan = std::max(max_tan, std::abs(x));
     if (j < 2 * b) continue;  // the rates need the block before (from tick 1 on)
     if (lim.max_steer_rate > 0 && steering) {
-      const double rate = std::abs(steer(j) - steer(j - b)) / bt;
-      m->steer_rate_ratio = std::max(m->steer_rate_ratio, rate / lim.max_steer_rate);
+      const double y = lim.wheelbase * kmean(j - b);
+      const double den = 1 + x * y;
+      const double change =
+          den > 0 ? std::abs(x - y) / den : std::tan(std::abs(std::atan(x) - std::atan(y)));
+      max_change = std::max(max_change, change);
     }
     if (lim.max_accel > 0) {
       const double v0 = vmean(j - b), a = (vmean(j) - v0) / bt;
@@ -111,6 +116,8 @@ void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
       m->forward_accel_ratio = std::max(m->forward_accel_ratio, a / limit);
     }
   }
+  if (lim.max_steer > 0) m->steer_ratio = std::atan(max_tan) / lim.max_steer;
+  if (lim.max_steer_rate > 0) m->steer_rate_ratio = std::atan(max_change) / bt / lim.max_steer_rate;
   if (std::isnan(v_[n - 1])) m->steer_ratio = m->steer_rate_ratio = m->forward_accel_ratio = NAN;
 }
 

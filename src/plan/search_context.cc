@@ -134,7 +134,8 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   }
   // Traffic: relevant cars only. A car right behind the ego in its lane is its follower's
   // problem (the simulator's traffic brakes for the car ahead) — but only once the ego is
-  // squarely in front of it: mid lane change the car may not have seen the ego yet.
+  // squarely in front of it: mid lane change the car may not have seen the ego yet. Traffic
+  // that does not react (prediction.followers_react 0: recorded traffic) counts behind too.
   // Predictions are sampled once here: at the scoring samples and at the collision-check
   // steps, t_keep after the observation.
   // The predictor's ghosts (they follow every real car) go last, for the hard checks only.
@@ -144,7 +145,9 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     const TrackedCar& car = cars[i];
     const double hl = 0.5 * car.length, hw = 0.5 * car.width;
     const double sep_s = 0.5 * cfg.ego_length + hl;
-    if (car.s < -sep_s && std::abs(car.d - start.d) < kFollowerLateral) continue;
+    if (cfg.followers_react && car.s < -sep_s && std::abs(car.d - start.d) < kFollowerLateral) {
+      continue;
+    }
     if (!car.ghost) real = nc + 1;
     ws.car_index[nc] = i;
     ws.car_hl[nc] = hl;

@@ -67,6 +67,8 @@ std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
   po.num_lanes = cfg.num_lanes;
   po.car_length = cfg.car_length;
   po.car_width = cfg.car_width;
+  // The horizons the context samples predictions over, from the kept points' end.
+  po.future_horizon = std::max(cfg.score_horizon, cfg.check_horizon) + 1.0;
   return config.int_value("prediction.manoeuvres") != 0
              ? MakeManoeuvrePredictor(std::move(road), po)
              : MakeConstantVelocityPredictor(std::move(road), po);

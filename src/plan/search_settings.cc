@@ -70,6 +70,7 @@ Settings::Settings(const PlannerConfig& c) {
   margin_behind = c.value("check.margin_behind");
   headway_min = c.value("check.headway_min");
   behind_time = c.value("check.behind_time");
+  followers_react = c.int_value("prediction.followers_react") != 0;
   refine = c.int_value("refine.enabled") != 0;
   refine_iterations = c.int_value("refine.max_iterations");
   // A pinned deadline never fires (PlannerConfig::PinDeadlines).

@@ -116,13 +116,13 @@ TEST_F(GoalCostTest, HeadingOutsideItsIntervalCounts) {
   for (double& dd : c.d_d) dd = 1.0;
   GoalRegion g = Box(95, 105, 4, 6);
   g.d_hi = 1e9;
-  g.h_lo = -0.01;
-  g.h_hi = 0.01;
+  g.h_lo = -std::tan(0.01);
+  g.h_hi = std::tan(0.01);
   c.goals = {g};
   c.ctx.num_goals = 1;
   c.ctx.goals = c.goals.data();
   EXPECT_NEAR(Eval(c), 1 + (1.0 / 20 - std::tan(0.01)) / 0.05, 1e-9);
-  c.goals[0].h_hi = 0.06;
+  c.goals[0].h_hi = std::tan(0.06);
   EXPECT_EQ(Eval(c), 0.0);
 }
 

@@ -17,8 +17,9 @@ struct GoalRegion {
   double s_ref = 0, d_slope = 0;
   double t_lo = -kInf, t_hi = kInf;  // s from the instant it is given for
   double v_lo = -kInf, v_hi = kInf;  // m/s
-  // The heading relative to the line's (atan2(d', s'), rad, right positive as d): a goal
-  // orientation interval less the road's heading there.
+  // The heading relative to the line's, as its tangent d' / s' (right positive as d): the
+  // tangents of a goal orientation interval less the road's heading there (headings within a
+  // quarter turn of the road's).
   double h_lo = -kInf, h_hi = kInf;
 };
 

@@ -50,6 +50,7 @@ struct PredictorOptions {
   // edges at their s are dropped (on a uniform road d_min and d_max above rule).
   double edge_slack = 1.0;  // m
   double car_length = 4.8, car_width = 2.4;  // m: a row's footprint when it gives none
+  double future_horizon = 8.0;  // s of a recorded future kept (past it: straight on)
   // The simulator's traffic changes lane only while braking behind a leader (udacity-sim.md
   // §8.5): left from the middle lane, to the middle from the outer ones, when no car (nor the
   // ego) within 20 m of it in s is in that lane. With this on, every such car faster than
