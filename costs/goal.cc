@@ -99,7 +99,7 @@ class GoalCost : public CostTerm {
     const double t0 = std::max(g.t_lo, 0.0);
     // An endless window is judged up to a minute past the samples.
     const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
-    if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();
+    if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();  // no window left
     double best = std::min(MissAt(g, State(ctx, in, t0)), MissAt(g, State(ctx, in, t1)));
     // Where a linear piece from time ta (values a) to tb (b) crosses x = level.
     auto cross = [&](double ta, double tb, double a, double b, double level) {

@@ -477,10 +477,12 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       t.goals.clear();
       for (const FrenetGoal& g : goals) {
         cost::GoalRegion r = Inset(g.region);
-        // Time steps to seconds from now, half a step inside the window (the verdict looks at
-        // whole steps).
-        if (g.timed_lo) r.t_lo = (r.t_lo - k) * dt + kTimeInset * dt;
-        if (g.timed_hi) r.t_hi = (r.t_hi - k) * dt - kTimeInset * dt;
+        // Time steps to seconds from now, a little inside the window (the verdict looks at
+        // whole steps; a window of one step stays one instant).
+        const double in = g.timed_lo && g.timed_hi
+                              ? InsetBy(r.t_lo * dt, r.t_hi * dt, kTimeInset * dt) : 0.0;
+        if (g.timed_lo) r.t_lo = (r.t_lo - k) * dt + in;
+        if (g.timed_hi) r.t_hi = (r.t_hi - k) * dt - in;
         t.goals.push_back(r);
       }
       const bool tracing = spdlog::should_log(spdlog::level::trace);

@@ -11,6 +11,9 @@ namespace {
 
 // m along s: a car in another lane this close is alongside (a lane change must yield to it).
 constexpr double kAlongside = 20.0;
+// m/s and m: a goal whose speeds reach this low may be stood in; and a stop target this near
+// or nearer is no target.
+constexpr double kStandingGoal = 0.5;
 // m/s: a lane whose limit is within this of the fastest lane's shares the grid's top end speed.
 constexpr double kLaneLimitStep = 0.05;
 
@@ -223,6 +226,17 @@ void Lattice::Generate() {
     }
     if (cfg_.stop) {
       AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start.s_d * T, T));
+    }
+    // A goal region one may stand in (its speeds reach down to rest): stopping in its middle,
+    // to wait there for its time window (a goal in a queue).
+    for (int g = 0; g < ws_.num_goals; ++g) {
+      const cost::GoalRegion& r = ws_.goals[g];
+      const double mid = 0.5 * (r.s_lo + r.s_hi) - start.s;
+      if (!(r.v_lo <= kStandingGoal) || !std::isfinite(mid) || !(mid > kStandingGoal) ||
+          !(mid < start.s_d * T + kStandingGoal)) {
+        continue;
+      }
+      AddLon(MakeLon(cost::LonKind::kStopping, -1, mid, T));
     }
     if (di == 0) AddBraking();
     for (int l = 0; l < cfg_.num_lanes; ++l) {
