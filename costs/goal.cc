@@ -101,17 +101,40 @@ class GoalCost : public CostTerm {
     const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
     if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();  // no window left
     double best = std::min(MissAt(g, State(ctx, in, t0)), MissAt(g, State(ctx, in, t1)));
-    // Where a linear piece from time ta (values a) to tb (b) crosses x = level.
-    auto cross = [&](double ta, double tb, double a, double b, double level) {
-      if (!std::isfinite(level) || (a - level) * (b - level) > 0 || a == b) return;
-      const double t = ta + (level - a) / (b - a) * (tb - ta);
-      if (t >= t0 && t <= t1) best = std::min(best, MissAt(g, State(ctx, in, t)));
+    // The levels that bound something (an absent part's are infinite), and where a linear
+    // piece from time ta (state a) to tb (b) crosses them: the state there, interpolated.
+    const bool has_s = std::isfinite(g.s_lo) || std::isfinite(g.s_hi);
+    const bool has_d = std::isfinite(g.d_lo) || std::isfinite(g.d_hi);
+    const bool has_v = std::isfinite(g.v_lo) || std::isfinite(g.v_hi);
+    const bool has_h = std::isfinite(g.h_lo) || std::isfinite(g.h_hi);
+    auto cross = [&](double ta, double tb, const At& a, const At& b, double qa, double qb,
+                     double level) {
+      if (!((qa - level) * (qb - level) <= 0) || qa == qb) return;  // no crossing (or NaN)
+      const double f = (level - qa) / (qb - qa);
+      const double t = ta + f * (tb - ta);
+      if (!(t >= t0 && t <= t1)) return;
+      const At m{a.s + f * (b.s - a.s), a.d + f * (b.d - a.d), a.v + f * (b.v - a.v),
+                 a.h + f * (b.h - a.h)};
+      best = std::min(best, MissAt(g, m));
     };
     auto piece = [&](double ta, double tb, const At& a, const At& b) {
-      for (const double level : {g.s_lo, g.s_hi}) cross(ta, tb, a.s, b.s, level);
-      for (const double level : {g.d_lo, g.d_hi}) cross(ta, tb, Across(g, a), Across(g, b), level);
-      for (const double level : {g.v_lo, g.v_hi}) cross(ta, tb, a.v, b.v, level);
-      for (const double level : {g.h_lo, g.h_hi}) cross(ta, tb, a.h, b.h, level);
+      if (has_s) {
+        cross(ta, tb, a, b, a.s, b.s, g.s_lo);
+        cross(ta, tb, a, b, a.s, b.s, g.s_hi);
+      }
+      if (has_d) {
+        const double da = Across(g, a), db = Across(g, b);
+        cross(ta, tb, a, b, da, db, g.d_lo);
+        cross(ta, tb, a, b, da, db, g.d_hi);
+      }
+      if (has_v) {
+        cross(ta, tb, a, b, a.v, b.v, g.v_lo);
+        cross(ta, tb, a, b, a.v, b.v, g.v_hi);
+      }
+      if (has_h) {
+        cross(ta, tb, a, b, a.h, b.h, g.h_lo);
+        cross(ta, tb, a, b, a.h, b.h, g.h_hi);
+      }
     };
     const int k0 = std::max(0, static_cast<int>(std::floor(t0 / dt)));
     const int k1 = std::min(n - 1, static_cast<int>(std::ceil(t1 / dt)));

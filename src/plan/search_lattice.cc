@@ -32,7 +32,7 @@ void Lattice::AddLon(const LonTraj& l) {
   const double dt = cfg_.score_dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
                 &ws_.lon_sdd[i * n]);
-  NearLon(ws_, ws_.lon_s.data() + i * n, ws_.lon_near.data() + 2 * i * n);
+  ws_.lon_near_have[i] = 0;  // its masks: when first needed (Scorer::InputFor)
 }
 
 void Lattice::AddLat(const LatTraj& l) {

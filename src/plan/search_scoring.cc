@@ -27,7 +27,18 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   cheap_.assign(cap * costs_.size(), 0.0);
 }
 
-cost::CostInput Scorer::InputFor(int i, int j) const {
+cost::CostInput Scorer::InputFor(int i, int j) {
+  if (!ws_.lon_near_have[i]) {
+    NearLon(ws_, ws_.lon_s.data() + i * ws_.n_samples, ws_.lon_near.data() + 2 * i * ws_.n_samples);
+    ws_.lon_near_have[i] = 1;
+  }
+  cost::CostInput in = BoundInputFor(i, j);
+  SetNear(ws_, in, ws_.lat_near.data() + 2 * j * ws_.n_samples,
+          ws_.lon_near.data() + 2 * i * ws_.n_samples);
+  return in;
+}
+
+cost::CostInput Scorer::BoundInputFor(int i, int j) const {
   cost::CostInput in;
   const int oi = i * ws_.n_samples, oj = j * ws_.n_samples;
   in.s = ws_.lon_s.data() + oi;
@@ -44,7 +55,6 @@ cost::CostInput Scorer::InputFor(int i, int j) const {
   in.end_d = ws_.lat_d[oj + ws_.n_samples - 1];
   in.target_lane = ws_.lat[j].lane;
   in.kind = ws_.lon[i].kind;
-  SetNear(ws_, in, ws_.lat_near.data() + 2 * oj, ws_.lon_near.data() + 2 * oi);
   return in;
 }
 
@@ -71,7 +81,7 @@ bool Scorer::Score() {
     }
     // Resolve() makes the cost 1e300 when it is not finite: never below this bound.
     const double b =
-        costs_.LowerBound(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+        costs_.LowerBound(ws_.ctx, BoundInputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
                           &cheap_[static_cast<std::size_t>(c) * costs_.size()], &lane_memo_);
     bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
     ws_.order[c] = c;

@@ -66,7 +66,10 @@ class Scorer {
   double Bound(int c) const { return bound_[c]; }
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
-  cost::CostInput InputFor(int i, int j) const;
+  cost::CostInput InputFor(int i, int j);
+  // The same without the broad-phase masks (null): for the cheap terms of the lower bound,
+  // which read none.
+  cost::CostInput BoundInputFor(int i, int j) const;
   // Samples `tr` on the scoring grid into this scorer's own buffers and points a cost input at
   // them; lbase and dbase give the family and target lane. Valid until the next call.
   cost::CostInput SampleForCost(const traj::FrenetTrajectory& tr, const LonTraj& lbase,

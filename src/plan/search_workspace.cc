@@ -53,6 +53,7 @@ Workspace::Workspace(const Settings& cfg) {
     v->assign(kMaxCars * (n_steps + 1), 0.0);
   lat_near.assign(2 * max_lat * n_samples, 0);
   lon_near.assign(2 * max_lon * n_samples, 0);
+  lon_near_have.assign(max_lon, 0);
   prev_s.assign(n_samples, 0.0);
   prev_d.assign(n_samples, 0.0);
   for (auto* v : {&tk_s, &tk_sd, &tk_sdd, &tk_d, &tk_dd, &tk_ddd}) v->assign(n_ticks + 1, 0.0);

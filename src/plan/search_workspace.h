@@ -105,6 +105,9 @@ struct Workspace {
   std::vector<LatTraj> lat;
   std::vector<double> lon_s, lon_sd, lon_sdd, lat_d, lat_dd, lat_ddd;
   std::vector<std::uint64_t> lat_near, lon_near;
+  // Whether lon bundle i's masks are filled: the scorer fills them when a candidate of the
+  // bundle is first costed in full (most bundles' candidates never are).
+  std::vector<char> lon_near_have;
   std::vector<int> cand_lon, cand_lat;
 
   // Scores (Scorer): the weighted cost per candidate and the candidates by rank; order[0,

@@ -115,6 +115,9 @@ TEST(SearchScoringTest, BroadPhaseMasksMarkTheCarsWithinEachReach) {
   const int n = ws.n_samples;
   ASSERT_EQ(ws.ctx.num_cars, 4);
   for (int i = 0; i < static_cast<int>(ws.lon.size()); i += 7) {
+    // A lon bundle's masks are filled when a candidate of it is first costed in full.
+    st.scorer.InputFor(i, 0);
+    ASSERT_TRUE(ws.lon_near_have[i]);
     const double* s = ws.lon_s.data() + i * n;
     const std::uint64_t* near = ws.lon_near.data() + 2 * i * n;
     for (int k = 0; k < n; ++k) {
@@ -136,7 +139,10 @@ TEST(SearchScoringTest, BroadPhaseMasksMarkTheCarsWithinEachReach) {
       }
     }
   }
-  // The cost input of a pair points at its bundles' masks.
+  // The cost input of a pair points at its bundles' masks; the lower bound's at none.
+  const cost::CostInput bound = st.scorer.BoundInputFor(3, 2);
+  EXPECT_EQ(bound.near_lon[0], nullptr);
+  EXPECT_EQ(bound.near_lat[0], nullptr);
   const cost::CostInput in = st.scorer.InputFor(3, 2);
   EXPECT_EQ(in.near_lon[0], ws.lon_near.data() + 2 * 3 * n);
   EXPECT_EQ(in.near_lon[1], ws.lon_near.data() + 2 * 3 * n + n);
