@@ -531,8 +531,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                  std::to_string(res.summary.rejections[q]);
         }
       }
-      spdlog::debug("{} #{} step {}: {} cands {} checked {} ({}) lane {} v_end {:.2f} | ego s {:.2f} d {:.2f} v {:.2f} delta {:.3f} track {:.3f}",
-                    sc.benchmark_id, problem.id, k, plan::ToString(res.status),
+      spdlog::debug("{} #{} step {}: {} {:.3f} ms cands {} checked {} ({}) lane {} v_end {:.2f} | ego s {:.2f} d {:.2f} v {:.2f} delta {:.3f} track {:.3f}",
+                    sc.benchmark_id, problem.id, k, plan::ToString(res.status), ms,
                     res.summary.candidates_generated, res.summary.candidates_checked, why,
                     res.summary.winner_lane, res.summary.winner_end_speed, fe.s, fe.d,
                     ego.velocity, ego.steering_angle, cyc.tracking_error);

@@ -11,14 +11,14 @@
 namespace frenetic::plan::search {
 namespace {
 
-// m[j] for j in [1, n]: bit c set unless |cars[c * w + j] - x[j]| > reach[j] (NaN passes), for
-// cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2 registers until
+// m[j] for j in [1, n]: bit c set unless |cars[c * w + j] - x[j]| - extra[c] > reach[j] (NaN
+// passes), for cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2 registers until
 // every car is in; the rest car by car over the last steps. The scoring's
 // cost::FillNearMasks is built the same way but is not this test: a reach per step here
 // (FirstCollision's, from the step's speed), and a car at a NaN distance is kept (HitsAt then
 // decides), where a broad-phase mask leaves it out.
 void ReachMasks(const double* x, const double* reach, const double* cars, int w, int n,
-                int num_cars, std::uint64_t* m) {
+                int num_cars, const double* extra, std::uint64_t* m) {
   int j = 1;
 #if defined(__SSE2__)
   const __m128d sign = _mm_set1_pd(-0.0);
@@ -29,8 +29,9 @@ void ReachMasks(const double* x, const double* reach, const double* cars, int w,
     for (int car = 0; car < num_cars; ++car) {
       const __m128i bit = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << car));
       const double* row = cars + static_cast<std::ptrdiff_t>(car) * w + j;
-      const __m128d da = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row), xa));
-      const __m128d db = _mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row + 2), xb));
+      const __m128d ex = _mm_set1_pd(extra[car]);
+      const __m128d da = _mm_sub_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row), xa)), ex);
+      const __m128d db = _mm_sub_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(row + 2), xb)), ex);
       // !(|d| > reach): the same test, lane by lane (NaN passes).
       a = _mm_or_si128(a, _mm_and_si128(_mm_castpd_si128(_mm_cmpngt_pd(da, ra)), bit));
       b = _mm_or_si128(b, _mm_and_si128(_mm_castpd_si128(_mm_cmpngt_pd(db, rb)), bit));
@@ -44,7 +45,7 @@ void ReachMasks(const double* x, const double* reach, const double* cars, int w,
   for (int car = 0; car < num_cars; ++car) {
     const double* row = cars + static_cast<std::ptrdiff_t>(car) * w;
     const std::uint64_t bit = std::uint64_t{1} << car;
-    for (j = j0; j <= n; ++j) m[j] |= std::abs(row[j] - x[j]) > reach[j] ? 0 : bit;
+    for (j = j0; j <= n; ++j) m[j] |= std::abs(row[j] - x[j]) - extra[car] > reach[j] ? 0 : bit;
   }
 }
 
@@ -125,14 +126,14 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
       reach_[j] = ReachS(lon_sd_[i * w + j], margin_scale, behind_scale);
     }
     ReachMasks(&lon_s_[i * w], reach_.data(), ws_.step_s.data(), w, ws_.n_steps, num_cars,
-               &lon_near_[i * w]);
+               ws_.car_reach_s.data(), &lon_near_[i * w]);
     lk = {ws_.traffic_stamp, margin_scale, behind_scale};
   }
   const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
   if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
     if (lat_reach_[1] != ws_.reach_d) std::fill(lat_reach_.begin(), lat_reach_.end(), ws_.reach_d);
     ReachMasks(&lat_d_[k * w], lat_reach_.data(), ws_.step_d.data(), w, ws_.n_steps, num_cars,
-               &lat_near_[k * w]);
+               ws_.car_reach_d.data(), &lat_near_[k * w]);
     lat_near_stamp_[k] = ws_.traffic_stamp;
   }
   return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,

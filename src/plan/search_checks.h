@@ -300,7 +300,10 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
   const traj::OrientedBox& ego = e.box;
   const int at = c * (ws_.n_steps + 1) + j;
   const double cs = ws_.step_s[at], cd = ws_.step_d[at];
-  if (std::abs(cd - ego.cy) > ws_.reach_d || std::abs(cs - ego.cx) > e.reach_s) return false;
+  if (std::abs(cd - ego.cy) > ws_.reach_d + ws_.car_reach_d[c] ||
+      std::abs(cs - ego.cx) > e.reach_s + ws_.car_reach_s[c]) {
+    return false;
+  }
   // A car behind in another lane than the start's is one the ego would cut in front of:
   // the simulator's traffic brakes hard when its gap falls below 10-20 m, so entering
   // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
@@ -319,7 +322,8 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
       cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d)
       : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                           : margin_scale * cfg_.margin_s;
-  if (std::abs(cs - ego.cx) > ws_.reach_s_base + margin || std::abs(cd - ego.cy) > ws_.reach_d) {
+  if (std::abs(cs - ego.cx) > ws_.reach_s_base + ws_.car_reach_s[c] + margin ||
+      std::abs(cd - ego.cy) > ws_.reach_d + ws_.car_reach_d[c]) {
     return false;
   }
   const double cu = ws_.step_dir_s[at], cw = ws_.step_dir_d[at];  // the car's unit heading

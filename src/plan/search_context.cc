@@ -182,13 +182,20 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   c.num_cars = real;
   ws.num_check_cars = nc;
   // FirstCollision's broad reaches: the Udacity footprints' 8 and 5 m, scaled up with the
-  // half diagonals of the ego and the largest car when they are larger.
-  double car_diag = 0;
-  for (int i = 0; i < nc; ++i) car_diag = std::max(car_diag, std::hypot(ws.car_hl[i], ws.car_hw[i]));
-  const double diag = std::hypot(0.5 * cfg.ego_length, 0.5 * cfg.ego_width) + car_diag;
-  const double scale = std::max(1.0, diag / (2 * kUdacityHalfDiagonal));
-  ws.reach_s_base = kReachS * scale;
-  ws.reach_d = kReachD * scale;
+  // half diagonals of the ego and of each car when they are larger: a base for a car of the
+  // Udacity footprint, and per car what its own size adds (a truck's reach is not every car's).
+  const double ego_diag = std::hypot(0.5 * cfg.ego_length, 0.5 * cfg.ego_width);
+  auto scale = [&](double car_diag) {
+    return std::max(1.0, (ego_diag + car_diag) / (2 * kUdacityHalfDiagonal));
+  };
+  const double base = scale(kUdacityHalfDiagonal);
+  ws.reach_s_base = kReachS * base;
+  ws.reach_d = kReachD * base;
+  for (int i = 0; i < nc; ++i) {
+    const double own = scale(std::hypot(ws.car_hl[i], ws.car_hw[i]));
+    ws.car_reach_s[i] = own > base ? kReachS * own - ws.reach_s_base : 0.0;
+    ws.car_reach_d[i] = own > base ? kReachD * own - ws.reach_d : 0.0;
+  }
   // Bounds the collision check's margins (Checker::FirstCollision).
   ++ws.traffic_stamp;
   ws.step_v_max = 0;

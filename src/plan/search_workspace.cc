@@ -39,7 +39,9 @@ Workspace::Workspace(const Settings& cfg) {
   order.reserve(max_lon * max_lat);
   for (auto* v : {&car_s, &car_d, &car_v}) v->assign(kMaxCars * n_samples, 0.0);
   car_index.assign(kMaxCars, 0);
-  for (auto* v : {&car_hl, &car_hw, &car_sep_s, &car_sep_d}) v->assign(kMaxCars, 0.0);
+  for (auto* v : {&car_hl, &car_hw, &car_sep_s, &car_sep_d, &car_reach_s, &car_reach_d}) {
+    v->assign(kMaxCars, 0.0);
+  }
   const int edge_bins =
       static_cast<int>(std::ceil((cfg.max_speed * std::max(cfg.check_horizon, cfg.score_horizon) +
                                   kEdgeBehind + kEdgeAhead) / kEdgeBin)) + 2;

@@ -91,8 +91,10 @@ struct Workspace {
   // separation of two aligned boxes' centres at contact: 0.5 ego_length + car_hl...).
   std::vector<double> car_hl, car_hw, car_sep_s, car_sep_d;
   // FirstCollision's broad reach along s (before margins) and across (m): 8 and 5 for the
-  // Udacity footprints, more with longer cars.
+  // Udacity footprints, more with a larger ego; per car, the more its own size adds (0 for a
+  // car no larger than the Udacity footprint).
   double reach_s_base = 8, reach_d = 5;
+  std::vector<double> car_reach_s, car_reach_d;
   std::vector<double> step_s, step_d, step_v, step_vd, step_dir_s, step_dir_d;
   double step_v_max = std::numeric_limits<double>::infinity();  // >= every step_v (inf: unknown)
   std::uint64_t traffic_stamp = 0;  // changes whenever the traffic arrays above are rewritten
