@@ -117,7 +117,19 @@ class GoalCost : public CostTerm {
                  a.h + f * (b.h - a.h)};
       best = std::min(best, MissAt(g, m));
     };
+    // A term's least value over a piece is 0 where its quantity passes its interval, else the
+    // smaller end's: their sum bounds the piece's least miss from below, and a piece whose
+    // bound is no better than the best so far needs no crossings.
+    auto least = [](double qa, double qb, double lo, double hi, double inv) {
+      if (std::max(qa, qb) >= lo && std::min(qa, qb) <= hi) return 0.0;
+      return std::min(Out(qa, lo, hi), Out(qb, lo, hi)) * inv;
+    };
     auto piece = [&](double ta, double tb, const At& a, const At& b) {
+      const double bound = least(a.s, b.s, g.s_lo, g.s_hi, inv_s_) +
+                           least(Across(g, a), Across(g, b), g.d_lo, g.d_hi, inv_d_) +
+                           least(a.v, b.v, g.v_lo, g.v_hi, inv_v_) +
+                           least(a.h, b.h, g.h_lo, g.h_hi, inv_h_);
+      if (!(bound < best)) return;
       if (has_s) {
         cross(ta, tb, a, b, a.s, b.s, g.s_lo);
         cross(ta, tb, a, b, a.s, b.s, g.s_hi);
