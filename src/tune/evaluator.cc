@@ -57,25 +57,26 @@ constexpr double kStop = 0, kEvaluate = 1;
 }  // namespace
 
 nlohmann::json Metrics::ToJson() const {
+  if (problems > 0) {  // a CommonRoad suite's: the drive fields mean nothing there
+    return {{"objective", objective},
+            {"episodes", episodes},
+            {"problems", problems},
+            {"solved", solved},
+            {"mean_cost", mean_cost}};
+  }
   nlohmann::json per = nlohmann::json::object();
   for (int k = 0; k < sim::kIncidentKinds; ++k) {
     per[sim::ToString(static_cast<sim::IncidentKind>(k))] = per_mile[k];
   }
-  nlohmann::json j = {{"objective", objective},
-                      {"episodes", episodes},
-                      {"miles", miles},
-                      {"incidents_per_mile", per},
-                      {"incidents_per_100_miles", incidents_per_100_miles},
-                      {"avg_speed_mph", avg_speed_mph},
-                      {"mean_squared_jerk", mean_squared_jerk},
-                      {"min_headway_s", min_headway_s},
-                      {"headway_deficit_s", headway_deficit_s}};
-  if (problems > 0) {
-    j["problems"] = problems;
-    j["solved"] = solved;
-    j["mean_cost"] = mean_cost;
-  }
-  return j;
+  return {{"objective", objective},
+          {"episodes", episodes},
+          {"miles", miles},
+          {"incidents_per_mile", per},
+          {"incidents_per_100_miles", incidents_per_100_miles},
+          {"avg_speed_mph", avg_speed_mph},
+          {"mean_squared_jerk", mean_squared_jerk},
+          {"min_headway_s", min_headway_s},
+          {"headway_deficit_s", headway_deficit_s}};
 }
 
 double CommonRoadObjective(int problems, int solved, double mean_cost, double cost_scale) {
@@ -90,6 +91,12 @@ StatusOr<Metrics> Metrics::FromJson(const nlohmann::json& j) {
   try {
     m.objective = j.at("objective").get<double>();
     m.episodes = j.at("episodes").get<int>();
+    if (j.contains("problems")) {
+      m.problems = j.at("problems").get<int>();
+      m.solved = j.at("solved").get<int>();
+      m.mean_cost = j.at("mean_cost").get<double>();
+      return m;
+    }
     m.miles = j.at("miles").get<double>();
     for (int k = 0; k < sim::kIncidentKinds; ++k) {
       m.per_mile[k] =
@@ -100,11 +107,6 @@ StatusOr<Metrics> Metrics::FromJson(const nlohmann::json& j) {
     m.mean_squared_jerk = j.at("mean_squared_jerk").get<double>();
     m.min_headway_s = j.at("min_headway_s").get<double>();
     m.headway_deficit_s = j.at("headway_deficit_s").get<double>();
-    if (j.contains("problems")) {
-      m.problems = j.at("problems").get<int>();
-      m.solved = j.at("solved").get<int>();
-      m.mean_cost = j.at("mean_cost").get<double>();
-    }
   } catch (const nlohmann::json::exception& e) {
     return Status::Error(std::string("bad metrics: ") + e.what());
   }

@@ -243,8 +243,11 @@ TEST_F(CommonRoadSuiteTest, ObjectiveRanksAnUnsolvingConfigWorse) {
   EXPECT_LT(fast->objective, slow->objective);
   EXPECT_DOUBLE_EQ(fast->objective, CommonRoadObjective(2, 2, fast->mean_cost, 100));
   // The log's JSON round-trips the CommonRoad fields.
+  EXPECT_FALSE(fast->ToJson().contains("miles"));
   auto back = Metrics::FromJson(fast->ToJson());
   ASSERT_TRUE(back.ok()) << back.message();
+  EXPECT_EQ(back->objective, fast->objective);
+  EXPECT_EQ(back->problems, 2);
   EXPECT_EQ(back->solved, 2);
   EXPECT_EQ(back->mean_cost, fast->mean_cost);
 

@@ -39,7 +39,9 @@ struct Metrics {
   // (CommonRoadSuite::cost_function) of the solved ones (0 when none is).
   int problems = 0, solved = 0;
   double mean_cost = 0;
-  nlohmann::json ToJson() const;  // finite numbers only; the CommonRoad fields when problems > 0
+  // Finite numbers only; with problems > 0 the CommonRoad fields (objective, episodes,
+  // problems, solved, mean_cost) and no others.
+  nlohmann::json ToJson() const;
   static StatusOr<Metrics> FromJson(const nlohmann::json& j);
 };
 
