@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <ctime>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "frenetic/map/reference_line.h"
+#include "frenetic/map/road.h"
 #include "frenetic/map/track.h"
 #include "frenetic/net/protocol.h"
 #include "frenetic/plan/planner.h"
@@ -43,6 +45,11 @@ struct Scene {
   std::vector<double> t;               // simulated time of each message, s
   std::vector<std::string> wire;       // each message's telemetry frame as the simulator sent it
   std::vector<plan::Telemetry> messages;
+  // CommonRoad scenes (commonroad_scenes.cc): the road and the configuration the runner planned
+  // with; the messages carry recorded futures and goals, and no wire frames. Null for Udacity
+  // scenes, which are planned on map_path's line with the benchmark's configuration.
+  std::shared_ptr<const map::Road> road;
+  std::shared_ptr<const plan::PlannerConfig> config;
 };
 
 inline std::string SceneDir() { return FRENETIC_SOURCE_DIR "/bench/scenes"; }
@@ -189,8 +196,9 @@ inline Scene WithVehicles(const Scene& in, int vehicles, const map::ReferenceLin
 // Replays a scene's messages through a planner so that every measured cycle is a warm one with
 // continuity: the first message of a pass is planned after Reset() (cold, not measured), and
 // every later message gets, as previous_path, the unconsumed rest of the path the planner itself
-// sent last (as float32, like the simulator), with as many points consumed as in the recording.
-// So the planner stays in sync whatever its configuration; ego pose and traffic are as recorded.
+// sent last (as float32, like the simulator; as double on a CommonRoad scene, like its runner),
+// with as many points consumed as in the recording. So the planner stays in sync whatever its
+// configuration; ego pose, traffic, futures and goals are as recorded.
 class Replay {
  public:
   Replay(plan::Planner* planner, const Scene* scene) : planner_(planner), scene_(scene) {
@@ -225,6 +233,8 @@ class Replay {
     work_.previous_path_x.assign(last_x_.begin() + consumed, last_x_.end());
     work_.previous_path_y.assign(last_y_.begin() + consumed, last_y_.end());
     work_.sensor_fusion.assign(rec.sensor_fusion.begin(), rec.sensor_fusion.end());
+    work_.futures = rec.futures;
+    work_.goals = rec.goals;
   }
 
   // The measured cycle.
@@ -240,9 +250,10 @@ class Replay {
   void Remember(const plan::PlanResult& r) {
     last_x_.clear();
     last_y_.clear();
+    const bool wire = scene_->road == nullptr;
     for (std::size_t i = 0; i < r.x.size(); ++i) {
-      last_x_.push_back(static_cast<float>(r.x[i]));
-      last_y_.push_back(static_cast<float>(r.y[i]));
+      last_x_.push_back(wire ? static_cast<float>(r.x[i]) : r.x[i]);
+      last_y_.push_back(wire ? static_cast<float>(r.y[i]) : r.y[i]);
     }
   }
 
@@ -257,6 +268,26 @@ class Replay {
 // are loaded; `scenes` outlives the run).
 void RegisterPlanBenchmarks(const std::vector<Scene>& scenes);
 void RegisterStageBenchmarks(const std::vector<Scene>& scenes);
+// BM_PlanCommonRoad/<scenario id> per US-101 file and BM_PlanCommonRoadSet/US101 over all of
+// them (plan_bench.cc); nothing, with a note on stderr, without the shared files.
+void RegisterCommonRoadBenchmarks();
+
+// CommonRoad scenes (commonroad_scenes.cc). The scenario files of the US-101 examples present in
+// the shared directory ($FRENETIC_SHARED_DIR, else the build's FRENETIC_SHARED_DIR) under
+// commonroad/: none when it is absent.
+std::vector<std::string> CommonRoadSceneFiles();
+// The scene of one such file: every cycle of its first planning problem's closed-loop run
+// (commonroad::RunScenario as `frenetic commonroad` runs it: config/planner.yaml +
+// config/commonroad.yaml, KS2, recorded predictions, the deadlines pinned), as the planner was
+// given it. Captured on first use and kept (the run takes a few seconds).
+StatusOr<const Scene*> CommonRoadScene(const std::string& path);
+
+// CPU time of the calling thread, s (what a cycle costs whatever else the machine runs).
+inline double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 // p in [0, 1] of a sample (sorts it).
 inline double Percentile(std::vector<double>* v, double p) {

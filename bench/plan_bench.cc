@@ -30,7 +30,8 @@ using Clock = std::chrono::steady_clock;
 
 // Sums over the measured cycles of one benchmark run, turned into counters at the end.
 struct CycleStats {
-  std::vector<double> us;  // wall time of each measured Plan(), microseconds
+  std::vector<double> us;      // wall time of each measured Plan(), microseconds
+  std::vector<double> cpu_us;  // the thread's CPU time in it (not inflated by other processes)
   double generated = 0, scored = 0, checked = 0, feasible = 0, seconds = 0;
   double score_ms = 0, generate_ms = 0, check_ms = 0, refine_ms = 0, output_ms = 0;
   double best_cost = 0;
@@ -38,9 +39,11 @@ struct CycleStats {
   double rejections[static_cast<int>(plan::Reject::kCount)] = {};
   std::int64_t allocations = 0;
 
-  void Add(const plan::PlanResult& r, double seconds_wall, std::int64_t allocs) {
+  void Add(const plan::PlanResult& r, double seconds_wall, double seconds_cpu,
+           std::int64_t allocs) {
     const plan::PlanSummary& s = r.summary;
     us.push_back(seconds_wall * 1e6);
+    cpu_us.push_back(seconds_cpu * 1e6);
     seconds += seconds_wall;
     generated += s.candidates_generated;
     scored += s.candidates_scored;
@@ -95,6 +98,8 @@ struct CycleStats {
     c["p50_us"] = Percentile(&us, 0.50);
     c["p99_us"] = Percentile(&us, 0.99);
     c["max_us"] = us.back();  // sorted by Percentile
+    c["p50_cpu_us"] = Percentile(&cpu_us, 0.50);
+    c["p99_cpu_us"] = Percentile(&cpu_us, 0.99);
   }
 };
 
@@ -106,9 +111,14 @@ struct Rig {
 };
 
 StatusOr<Rig> MakeRig(const Scene& scene, const plan::PlannerConfig& config) {
-  auto line = LineFor(scene.map_path);
-  if (!line.ok()) return line.status();
-  auto planner = plan::MakePlanner("search", config, *line);
+  StatusOr<std::unique_ptr<plan::Planner>> planner = Status::Error("no planner");
+  if (scene.road != nullptr) {
+    planner = plan::MakePlanner("search", config, scene.road);
+  } else {
+    auto line = LineFor(scene.map_path);
+    if (!line.ok()) return line.status();
+    planner = plan::MakePlanner("search", config, *line);
+  }
   if (!planner.ok()) return planner.status();
   Rig rig;
   rig.planner = std::move(planner).value();
@@ -119,6 +129,7 @@ StatusOr<Rig> MakeRig(const Scene& scene, const plan::PlannerConfig& config) {
 // The measured loop over one or more rigs, round robin (one cycle per iteration).
 void RunCycles(benchmark::State& state, std::vector<Rig>& rigs, CycleStats* stats) {
   stats->us.reserve(1 << 16);
+  stats->cpu_us.reserve(1 << 16);
   // FRENETIC_BENCH_TRACE=1 prints every measured cycle's summary and stage times to stderr
   // (diagnosis only).
   static const bool trace = std::getenv("FRENETIC_BENCH_TRACE") != nullptr;
@@ -130,13 +141,15 @@ void RunCycles(benchmark::State& state, std::vector<Rig>& rigs, CycleStats* stat
     rig.replay->Prepare();
     g_allocations.store(0, std::memory_order_relaxed);
     state.ResumeTiming();
+    const double cpu0 = ThreadCpuSeconds();
     const auto t0 = Clock::now();
     g_count_allocations.store(true, std::memory_order_relaxed);
     const plan::PlanResult& r = rig.replay->Run();
     g_count_allocations.store(false, std::memory_order_relaxed);
     const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double cpu = ThreadCpuSeconds() - cpu0;
     state.PauseTiming();
-    stats->Add(r, dt, g_allocations.load(std::memory_order_relaxed));
+    stats->Add(r, dt, cpu, g_allocations.load(std::memory_order_relaxed));
     if (trace) {
       const auto& rej = r.summary.rejections;
       std::fprintf(stderr,
@@ -214,7 +227,51 @@ const Scene* Find(const std::vector<Scene>& scenes, const std::string& name) {
   return scenes.empty() ? nullptr : &scenes.front();
 }
 
+// Plan() on CommonRoad scenes (captured on first use), round robin over several: every cycle
+// of each closed-loop run, with the configuration the runner planned with (its deadlines
+// pinned, so no cycle is cut short; every cycle searches: a step drives 5 ticks, more than
+// continuity.replan_min_ticks).
+void PlanCommonRoad(benchmark::State& state, const std::vector<std::string>& paths) {
+  std::vector<Rig> rigs;
+  double vehicles = 0, cycles = 0, lanes = 0;
+  for (const std::string& path : paths) {
+    auto scene = CommonRoadScene(path);
+    if (!scene.ok()) return state.SkipWithError(scene.message().c_str());
+    auto rig = MakeRig(**scene, *(*scene)->config);
+    if (!rig.ok()) return state.SkipWithError(rig.message().c_str());
+    rigs.push_back(std::move(rig).value());
+    for (const plan::Telemetry& m : (*scene)->messages) vehicles += m.sensor_fusion.size();
+    cycles += (*scene)->messages.size();
+    lanes = std::max(lanes, static_cast<double>((*scene)->road->num_lanes()));
+  }
+  CycleStats stats;
+  RunCycles(state, rigs, &stats);
+  stats.Report(state);
+  state.counters["vehicles"] = cycles > 0 ? vehicles / cycles : 0;  // mean sensor rows
+  state.counters["scene_cycles"] = cycles;
+  state.counters["lanes"] = lanes;
+}
+
 }  // namespace
+
+void RegisterCommonRoadBenchmarks() {
+  const std::vector<std::string> files = CommonRoadSceneFiles();
+  if (files.empty()) {
+    std::fprintf(stderr,
+                 "frenetic_bench: no US-101 scenario files under $FRENETIC_SHARED_DIR/commonroad: "
+                 "BM_PlanCommonRoad is not registered\n");
+    return;
+  }
+  for (const std::string& path : files) {
+    const std::string id = std::filesystem::path(path).stem().string();
+    benchmark::RegisterBenchmark(("BM_PlanCommonRoad/" + id).c_str(), [path](benchmark::State& st) {
+      PlanCommonRoad(st, {path});
+    })->Unit(benchmark::kMicrosecond);
+  }
+  benchmark::RegisterBenchmark("BM_PlanCommonRoadSet/US101", [files](benchmark::State& st) {
+    PlanCommonRoad(st, files);
+  })->Unit(benchmark::kMicrosecond);
+}
 
 void RegisterPlanBenchmarks(const std::vector<Scene>& scenes) {
   if (scenes.empty()) return;
@@ -295,6 +352,7 @@ int main(int argc, char** argv) {
     scenes.push_back(std::move(scene).value());
   }
   frenetic::bench::RegisterPlanBenchmarks(scenes);
+  frenetic::bench::RegisterCommonRoadBenchmarks();
   frenetic::bench::RegisterStageBenchmarks(scenes);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -20,6 +20,7 @@
 #include "apps/commands.h"
 #include "frenetic/commonroad/cost.h"
 #include "frenetic/commonroad/runner.h"
+#include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
 #include "frenetic/plan/planner_config.h"
 
@@ -45,29 +46,6 @@ struct Args {
 int Fail(const std::string& message) {
   std::fprintf(stderr, "frenetic commonroad: %s\n", message.c_str());
   return 1;
-}
-
-// The scenario files named: files as given, directories' *.xml sorted by name.
-StatusOr<std::vector<std::string>> Files(const std::vector<std::string>& paths) {
-  std::vector<std::string> out;
-  for (const std::string& p : paths) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(p, ec)) {
-      std::vector<std::string> dir;
-      for (const auto& e : std::filesystem::directory_iterator(p, ec)) {
-        if (e.path().extension() == ".xml") dir.push_back(e.path().string());
-      }
-      if (ec) return Status::Error(p + ": cannot list the directory: " + ec.message());
-      std::sort(dir.begin(), dir.end());
-      out.insert(out.end(), dir.begin(), dir.end());
-    } else if (std::filesystem::exists(p, ec)) {
-      out.push_back(p);
-    } else {
-      return Status::Error(p + ": no such file or directory");
-    }
-  }
-  if (out.empty()) return Status::Error("no scenario files (*.xml) in the paths given");
-  return out;
 }
 
 // One file's outcome.
@@ -210,7 +188,7 @@ int Run(const Args& a) {
   options.vehicle_type = a.vehicle;
   options.timing = !a.no_timing;
   if (Status st = options.Validate(); !st.ok()) return Fail("--vehicle: " + st.message());
-  auto files = Files(a.paths);
+  auto files = cr::ScenarioFiles(a.paths);
   if (!files.ok()) return Fail(files.message());
   if (!a.solution_dir.empty()) {
     std::error_code ec;
@@ -219,12 +197,8 @@ int Run(const Args& a) {
   }
   const std::string config_path =
       a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
-  auto base = plan::PlannerConfig::Load(config_path);
+  auto base = cr::LoadBaseConfig(config_path, a.overlay_path);
   if (!base.ok()) return Fail(base.message());
-  const std::string overlay_path =
-      a.overlay_path.empty() ? std::string(FRENETIC_SOURCE_DIR "/") + cr::kCommonRoadConfig
-                             : a.overlay_path;
-  if (Status st = base->OverlayFile(overlay_path); !st.ok()) return Fail(st.message());
   auto config = cr::CommonRoadConfig(*base, *cr::VehicleParamsForType(a.vehicle), *prediction);
   if (!config.ok()) return Fail(config_path + ": " + config.message());
 

@@ -73,7 +73,7 @@ int RunTune(const TuneArgs& args) {
   if (!suite.ok()) {
     error = suite.message();
   } else {
-    if (!args.map.empty()) suite->map_path = args.map;
+    if (!args.map.empty()) suite->map_path = args.map;  // unused by a CommonRoad suite
     if (args.budget < 0 || args.jobs < 0) {
       error = "--budget and --jobs must be >= 0";
     } else {
@@ -129,7 +129,12 @@ int RunTune(const TuneArgs& args) {
     if (args.output.empty()) {
       std::fprintf(stderr, "frenetic tune: use -o FILE.yaml to save the tuned config\n");
     } else {
-      std::printf("tuned config written to %s (load it with --config)\n", args.output.c_str());
+      // A CommonRoad suite's config already has config/commonroad.yaml in it: loaded with
+      // --config, that file would be laid over it again.
+      std::printf("tuned config written to %s (load it with %s)\n", args.output.c_str(),
+                  suite->kind == tune::SuiteKind::kCommonRoad
+                      ? "frenetic commonroad --commonroad-config"
+                      : "--config");
     }
   }
   return 0;
@@ -141,7 +146,10 @@ void RegisterTune(CLI::App& app) {
   auto args = std::make_shared<TuneArgs>();
   auto* sub = app.add_subcommand(
       "tune", "Search planner cost weights on a seeded scenario suite (threads and MPI ranks)");
-  sub->add_option("--suite", args->suite, "Suite file, e.g. config/tune/default.yaml")->required();
+  sub->add_option("--suite", args->suite,
+                  "Suite file, e.g. config/tune/default.yaml (Udacity scenarios and seeds) or "
+                  "config/tune/commonroad.yaml (a directory of CommonRoad scenarios)")
+      ->required();
   sub->add_option("-o,--output", args->output, "Write the tuned planner config (YAML) here");
   sub->add_option("--map", args->map, "Track file (overrides the suite's map)");
   sub->add_option("--budget", args->budget, "Search evaluations (default: the suite's budget)");

@@ -488,6 +488,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       const bool tracing = spdlog::should_log(spdlog::level::trace);
       plan::CycleTrace trace;
       if (tracing) (*planner)->set_trace(&trace, 200);
+      if (options.on_cycle) options.on_cycle({problem, k, built->road, problem_config, t});
       const auto t0 = std::chrono::steady_clock::now();
       const plan::PlanResult& res = (*planner)->Plan(t);
       if (tracing) {

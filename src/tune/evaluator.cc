@@ -1,8 +1,9 @@
 // The Evaluator: one evaluation = every (scenario, seed) episode of a seed set driven with one
-// planner configuration. Episodes are dealt to ranks round-robin and, inside a rank, to threads
-// from a shared counter; each episode's numbers land in its own slot of a fixed-layout buffer,
-// and the objective is computed from the slots in episode order on rank 0, so the result is
-// the same for any number of ranks or threads.
+// planner configuration, or on a CommonRoad suite every planning problem of the set's scenario
+// files run closed-loop. Units of work (episodes, files) are dealt to ranks round-robin and,
+// inside a rank, to threads from a shared counter; each episode's (or problem's) numbers land in
+// its own slot of a fixed-layout buffer, and the objective is computed from the slots in order on
+// rank 0, so the result is the same for any number of ranks or threads.
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -12,6 +13,9 @@
 #include <mutex>
 #include <thread>
 
+#include "frenetic/commonroad/cost.h"
+#include "frenetic/commonroad/runner.h"
+#include "frenetic/commonroad/setup.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/sim/episode.h"
@@ -34,6 +38,15 @@ enum Slot : int {
   kSlots = kIncidents + sim::kIncidentKinds,
 };
 
+// Per-problem slot layout of a CommonRoad suite.
+enum CommonRoadSlot : int {
+  kCrDone,     // 1 when the problem ran
+  kCrSolved,   // 1 when the verdict solved it
+  kCrHasCost,  // 1 when its cost was evaluated (solved problems)
+  kCrCost,     // the suite's cost function
+  kCrSlots,
+};
+
 // Below this a drive counts as this long for incidents per mile, so that a car that barely
 // moved does not divide by zero; the speed term already punishes it.
 constexpr double kMinMiles = 0.01;
@@ -44,6 +57,13 @@ constexpr double kStop = 0, kEvaluate = 1;
 }  // namespace
 
 nlohmann::json Metrics::ToJson() const {
+  if (problems > 0) {  // a CommonRoad suite's: the drive fields mean nothing there
+    return {{"objective", objective},
+            {"episodes", episodes},
+            {"problems", problems},
+            {"solved", solved},
+            {"mean_cost", mean_cost}};
+  }
   nlohmann::json per = nlohmann::json::object();
   for (int k = 0; k < sim::kIncidentKinds; ++k) {
     per[sim::ToString(static_cast<sim::IncidentKind>(k))] = per_mile[k];
@@ -59,11 +79,24 @@ nlohmann::json Metrics::ToJson() const {
           {"headway_deficit_s", headway_deficit_s}};
 }
 
+double CommonRoadObjective(int problems, int solved, double mean_cost, double cost_scale) {
+  if (problems <= 0) return 0;
+  const double c = std::max(0.0, mean_cost);
+  const double tie = cost_scale > 0 ? c / (c + cost_scale) : 0.0;  // in [0, 1)
+  return (problems - solved + tie) / problems;
+}
+
 StatusOr<Metrics> Metrics::FromJson(const nlohmann::json& j) {
   Metrics m;
   try {
     m.objective = j.at("objective").get<double>();
     m.episodes = j.at("episodes").get<int>();
+    if (j.contains("problems")) {
+      m.problems = j.at("problems").get<int>();
+      m.solved = j.at("solved").get<int>();
+      m.mean_cost = j.at("mean_cost").get<double>();
+      return m;
+    }
     m.miles = j.at("miles").get<double>();
     for (int k = 0; k < sim::kIncidentKinds; ++k) {
       m.per_mile[k] =
@@ -84,17 +117,51 @@ struct Evaluator::Impl {
   Suite suite;
   int jobs = 1;
   const Cluster* cluster = nullptr;
+  plan::PlannerConfig start;
+  bool stopped = false;
+  // Udacity suites.
   std::shared_ptr<const sim::World> world;
   std::vector<sim::Scenario> scenarios;
-  plan::PlannerConfig start;
   sim::EpisodeLimits limits;
-  bool stopped = false;
+  // CommonRoad suites, per set: the scenario files and the slot of each file's first problem
+  // (one more entry: the set's problem count).
+  struct CommonRoadSet {
+    std::vector<commonroad::Scenario> files;
+    std::vector<int> first_problem{0};
+  };
+  CommonRoadSet cr_sets[2];
+  commonroad::RunOptions cr_options;
+  commonroad::VehicleParams vehicle;
+
+  bool commonroad() const { return suite.kind == SuiteKind::kCommonRoad; }
+  const CommonRoadSet& CrSet(SeedSet set) const { return cr_sets[set == SeedSet::kTrain ? 0 : 1]; }
 
   const std::vector<std::uint64_t>& Seeds(SeedSet set) const {
     return set == SeedSet::kTrain ? suite.train_seeds : suite.holdout_seeds;
   }
+  // Units of work of a set: episodes, or scenario files.
   int Episodes(SeedSet set) const {
+    if (commonroad()) return static_cast<int>(CrSet(set).files.size());
     return static_cast<int>(scenarios.size() * Seeds(set).size());
+  }
+  std::size_t BufferSize(SeedSet set) const {
+    if (commonroad()) return static_cast<std::size_t>(CrSet(set).first_problem.back()) * kCrSlots;
+    return static_cast<std::size_t>(Episodes(set)) * kSlots;
+  }
+  // Whether unit e's slots were filled (a rank that failed leaves them 0).
+  bool UnitDone(const std::vector<double>& buffer, SeedSet set, int e) const {
+    if (!commonroad()) return buffer[static_cast<std::size_t>(e) * kSlots + kDone] == 1;
+    const std::vector<int>& first = CrSet(set).first_problem;
+    for (int i = first[e]; i < first[e + 1]; ++i) {
+      if (buffer[static_cast<std::size_t>(i) * kCrSlots + kCrDone] != 1) return false;
+    }
+    return true;
+  }
+  std::string UnitName(SeedSet set, int e) const {
+    if (commonroad()) return "scenario " + CrSet(set).files[e].source;
+    const std::vector<std::uint64_t>& seeds = Seeds(set);
+    return "scenario " + scenarios[e / seeds.size()].name + " seed " +
+           std::to_string(seeds[e % seeds.size()]);
   }
 
   StatusOr<plan::PlannerConfig> ConfigFor(std::span<const double> values, bool pin) const {
@@ -132,29 +199,69 @@ struct Evaluator::Impl {
     return sim::RunEpisode(world, scenario, seed, limits, **planner, options);
   }
 
-  // Runs this rank's share of the episodes of `set` into `buffer` (Episodes(set) * kSlots,
+  // One scenario file of a CommonRoad suite, as `frenetic commonroad` runs it, into its
+  // problems' slots. `config` has the vehicle applied (CommonRoadConfig).
+  Status RunFile(const plan::PlannerConfig& config, SeedSet set, int e, double* slots) const {
+    const commonroad::Scenario& sc = CrSet(set).files[e];
+    const commonroad::ScenarioRun run = commonroad::RunScenario(sc, config, cr_options);
+    if (run.problems.size() != sc.problems.size()) {
+      return Status::Error("the run has " + std::to_string(run.problems.size()) +
+                           " problems, the file " + std::to_string(sc.problems.size()));
+    }
+    for (std::size_t i = 0; i < run.problems.size(); ++i) {
+      const commonroad::ProblemRun& p = run.problems[i];
+      double* slot = slots + i * kCrSlots;
+      slot[kCrDone] = 1;
+      slot[kCrSolved] = p.verdict.solved ? 1 : 0;
+      if (!p.verdict.solved) continue;
+      auto cost = commonroad::EvaluateCost(suite.commonroad.cost_function, sc, sc.problems[i],
+                                           vehicle, p.trajectory);
+      if (!cost.ok()) {
+        return Status::Error("problem " + std::to_string(p.problem_id) + ": " + cost.message());
+      }
+      slot[kCrHasCost] = 1;
+      slot[kCrCost] = cost->total;
+    }
+    return Status::Ok();
+  }
+
+  // Runs this rank's share of the episodes (or files) of `set` into `buffer` (BufferSize(set),
   // zero elsewhere). The first failure message of this rank goes to `error`.
   void RunShare(const plan::PlannerConfig& config, SeedSet set, std::vector<double>* buffer,
                 std::string* error) const {
     const std::vector<std::uint64_t>& seeds = Seeds(set);
     const int total = Episodes(set);
-    buffer->assign(static_cast<std::size_t>(total) * kSlots, 0.0);
+    buffer->assign(BufferSize(set), 0.0);
     std::vector<int> mine;
     for (int e = cluster->rank(); e < total; e += cluster->size()) mine.push_back(e);
     std::atomic<int> next{0};
     std::mutex error_mutex;
+    auto fail = [&](int e, const std::string& message) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (error->empty()) *error = UnitName(set, e) + ": " + message;
+    };
+    StatusOr<plan::PlannerConfig> cr_config = config;
+    if (commonroad()) {
+      cr_config = commonroad::CommonRoadConfig(config, vehicle, cr_options.prediction);
+      if (!cr_config.ok()) {
+        *error = suite.source + ": " + cr_config.message();
+        return;
+      }
+    }
     auto worker = [&] {
       for (int i = next++; i < static_cast<int>(mine.size()); i = next++) {
         const int e = mine[i];
+        if (commonroad()) {
+          double* slots =
+              buffer->data() + static_cast<std::size_t>(CrSet(set).first_problem[e]) * kCrSlots;
+          if (Status st = RunFile(*cr_config, set, e, slots); !st.ok()) fail(e, st.message());
+          continue;
+        }
         const sim::Scenario& scenario = scenarios[e / seeds.size()];
         const std::uint64_t seed = seeds[e % seeds.size()];
         StatusOr<sim::DriveReport> report = RunOne(config, scenario, seed);
         if (!report.ok()) {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (error->empty()) {
-            *error = "scenario " + scenario.name + " seed " + std::to_string(seed) + ": " +
-                     report.message();
-          }
+          fail(e, report.message());
           continue;
         }
         double* slot = buffer->data() + static_cast<std::size_t>(e) * kSlots;
@@ -175,6 +282,26 @@ struct Evaluator::Impl {
     for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
+  }
+
+  Metrics ScoreCommonRoad(const std::vector<double>& buffer, SeedSet set) const {
+    Metrics m;
+    m.episodes = Episodes(set);
+    m.problems = CrSet(set).first_problem.back();
+    double cost_sum = 0;
+    int costs = 0;
+    for (int i = 0; i < m.problems; ++i) {
+      const double* slot = buffer.data() + static_cast<std::size_t>(i) * kCrSlots;
+      m.solved += slot[kCrSolved] > 0;
+      if (slot[kCrHasCost] > 0) {
+        cost_sum += slot[kCrCost];
+        ++costs;
+      }
+    }
+    m.mean_cost = costs > 0 ? cost_sum / costs : 0;
+    m.objective =
+        CommonRoadObjective(m.problems, m.solved, m.mean_cost, suite.commonroad.cost_scale);
+    return m;
   }
 
   Metrics Score(const std::vector<double>& buffer, int total) const {
@@ -224,6 +351,52 @@ StatusOr<std::unique_ptr<Evaluator>> Evaluator::Create(const Suite& suite, int j
   impl->suite = suite;
   impl->cluster = &cluster;
   impl->jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (suite.kind == SuiteKind::kCommonRoad) {
+    auto start = LoadStartConfig(suite);
+    if (!start.ok()) return start.status();
+    impl->start = std::move(*start);
+    const CommonRoadSuite& c = suite.commonroad;
+    auto prediction = commonroad::ParsePredictionMode(c.prediction);
+    if (!prediction.ok()) {
+      return Status::Error(suite.source + ": 'prediction': " + prediction.message());
+    }
+    impl->cr_options.prediction = *prediction;
+    impl->cr_options.vehicle_type = c.vehicle;
+    impl->cr_options.timing = false;
+    auto vehicle = commonroad::VehicleParamsForType(c.vehicle);
+    if (!vehicle.ok()) return Status::Error(suite.source + ": 'vehicle': " + vehicle.message());
+    impl->vehicle = *vehicle;
+    // The evaluation configuration must build from the start one (a tuned key may be one the
+    // vehicle sets: it is overridden, as the command overrides it).
+    if (auto checked = commonroad::CommonRoadConfig(impl->start, impl->vehicle, *prediction);
+        !checked.ok()) {
+      return Status::Error(suite.source + ": " + checked.message());
+    }
+    const std::pair<const char*, const std::vector<std::string>*> sets[] = {
+        {"commonroad", &c.train}, {"holdout", &c.holdout}};
+    for (int k = 0; k < 2; ++k) {
+      if (sets[k].second->empty()) continue;  // no held-out set
+      auto files = commonroad::ScenarioFiles(*sets[k].second);
+      if (!files.ok()) {
+        return Status::Error(suite.source + ": '" + sets[k].first + "': " + files.message());
+      }
+      Impl::CommonRoadSet& set = impl->cr_sets[k];
+      for (const std::string& f : *files) {
+        auto sc = commonroad::LoadScenario(f);
+        if (!sc.ok()) {
+          return Status::Error(suite.source + ": '" + sets[k].first + "': " + sc.message());
+        }
+        set.first_problem.push_back(set.first_problem.back() +
+                                    static_cast<int>(sc->problems.size()));
+        set.files.push_back(std::move(*sc));
+      }
+      if (set.first_problem.back() == 0) {
+        return Status::Error(suite.source + ": '" + sets[k].first + "': no planning problem in " +
+                             std::to_string(set.files.size()) + " scenario file(s)");
+      }
+    }
+    return std::unique_ptr<Evaluator>(new Evaluator(std::move(impl)));
+  }
   const std::vector<std::string> names = plan::PlannerNames();
   if (std::find(names.begin(), names.end(), suite.planner) == names.end()) {
     return Status::Error(suite.source + ": 'planner' '" + suite.planner + "' is not a planner");
@@ -273,6 +446,8 @@ StatusOr<Metrics> Evaluator::Evaluate(std::span<const double> values, SeedSet se
   const Cluster& cluster = *impl_->cluster;
   if (cluster.rank() != 0) return Status::Error("Evaluate runs on rank 0 only");
   if (impl_->stopped) return Status::Error("the evaluator was stopped");
+  const int total = impl_->Episodes(set);
+  if (total == 0) return Status::Error(impl_->suite.source + ": the set has nothing to run");
   auto config = impl_->ConfigFor(values, impl_->suite.deterministic);
   if (!config.ok()) return config.status();
   if (cluster.distributed()) {
@@ -284,16 +459,14 @@ StatusOr<Metrics> Evaluator::Evaluate(std::span<const double> values, SeedSet se
   std::string error;
   impl_->RunShare(*config, set, &buffer, &error);
   cluster.SumToRoot(&buffer);
-  const int total = impl_->Episodes(set);
   if (!error.empty()) return Status::Error(error);
   for (int e = 0; e < total; ++e) {
-    if (buffer[static_cast<std::size_t>(e) * kSlots + kDone] != 1) {
-      const auto& seeds = impl_->Seeds(set);
-      return Status::Error("scenario " + impl_->scenarios[e / seeds.size()].name + " seed " +
-                           std::to_string(seeds[e % seeds.size()]) + " failed on rank " +
+    if (!impl_->UnitDone(buffer, set, e)) {
+      return Status::Error(impl_->UnitName(set, e) + " failed on rank " +
                            std::to_string(e % cluster.size()) + " (see its log)");
     }
   }
+  if (impl_->commonroad()) return impl_->ScoreCommonRoad(buffer, set);
   return impl_->Score(buffer, total);
 }
 
@@ -306,7 +479,7 @@ Status Evaluator::Serve() {
     cluster.Broadcast(&message);
     if (message.empty() || message[0] == kStop) return Status::Ok();
     const SeedSet set = message[1] == 0 ? SeedSet::kTrain : SeedSet::kHoldout;
-    std::vector<double> buffer(static_cast<std::size_t>(impl_->Episodes(set)) * kSlots, 0.0);
+    std::vector<double> buffer(impl_->BufferSize(set), 0.0);
     std::string error;
     if (message.size() != 2 + n) {
       error = "bad evaluation message from rank 0";

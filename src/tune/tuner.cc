@@ -299,14 +299,19 @@ StatusOr<TuneResult> Tune(const Suite& suite, const TuneOptions& options, Evalua
   }
   result.start_train = *start_train;
   result.tuned_train = search.best();
-  auto start_holdout =
-      search.Evaluate(start_values, SeedSet::kHoldout, "start_holdout", nullptr, &replayed);
-  if (!start_holdout.ok()) return start_holdout.status();
-  auto tuned_holdout =
-      search.Evaluate(tuned_values, SeedSet::kHoldout, "tuned_holdout", nullptr, &replayed);
-  if (!tuned_holdout.ok()) return tuned_holdout.status();
-  result.start_holdout = *start_holdout;
-  result.tuned_holdout = *tuned_holdout;
+  result.commonroad = suite.kind == SuiteKind::kCommonRoad;
+  if (result.commonroad) result.cost_function = suite.commonroad.cost_function;
+  result.has_holdout = evaluator.episodes(SeedSet::kHoldout) > 0;
+  if (result.has_holdout) {
+    auto start_holdout =
+        search.Evaluate(start_values, SeedSet::kHoldout, "start_holdout", nullptr, &replayed);
+    if (!start_holdout.ok()) return start_holdout.status();
+    auto tuned_holdout =
+        search.Evaluate(tuned_values, SeedSet::kHoldout, "tuned_holdout", nullptr, &replayed);
+    if (!tuned_holdout.ok()) return tuned_holdout.status();
+    result.start_holdout = *start_holdout;
+    result.tuned_holdout = *tuned_holdout;
+  }
   auto config = evaluator.ConfigFor(tuned_values);
   if (!config.ok()) return config.status();
   result.tuned_yaml = config->ToYaml();
@@ -324,7 +329,9 @@ nlohmann::json TuneResult::ToJson() const {
           {"best_x", best_x},
           {"params", params_j},
           {"train", {{"default", start_train.ToJson()}, {"tuned", tuned_train.ToJson()}}},
-          {"holdout", {{"default", start_holdout.ToJson()}, {"tuned", tuned_holdout.ToJson()}}}};
+          {"holdout", has_holdout ? nlohmann::json{{"default", start_holdout.ToJson()},
+                                                   {"tuned", tuned_holdout.ToJson()}}
+                                  : nlohmann::json(nullptr)}};
 }
 
 std::string TuneResult::ToTable() const {
@@ -335,18 +342,35 @@ std::string TuneResult::ToTable() const {
     std::snprintf(buf, sizeof buf, "%-30s %10.4g  %10.4g\n", p.key.c_str(), p.start, p.tuned);
     os << buf;
   }
-  os << "\nseeds     config    objective  incidents/100mi  avg mph  comfort (m^2/s^6)\n";
-  auto row = [&](const char* seeds, const char* which, const Metrics& m) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%-9s %-8s %10s %16s %8s %18s\n", seeds, which,
-                  Fixed(m.objective, 3).c_str(), Fixed(m.incidents_per_100_miles, 1).c_str(),
-                  Fixed(m.avg_speed_mph, 2).c_str(), Fixed(m.mean_squared_jerk, 3).c_str());
-    os << buf;
-  };
-  row("train", "default", start_train);
-  row("train", "tuned", tuned_train);
-  row("held-out", "default", start_holdout);
-  row("held-out", "tuned", tuned_holdout);
+  if (commonroad) {
+    os << "\nfiles     config    objective  solved     mean " << cost_function << " (solved)\n";
+    auto row = [&](const char* files, const char* which, const Metrics& m) {
+      char buf[160];
+      const std::string solved = std::to_string(m.solved) + "/" + std::to_string(m.problems);
+      std::snprintf(buf, sizeof buf, "%-9s %-8s %10s  %-9s  %10s\n", files, which,
+                    Fixed(m.objective, 4).c_str(), solved.c_str(), Fixed(m.mean_cost, 2).c_str());
+      os << buf;
+    };
+    row("train", "default", start_train);
+    row("train", "tuned", tuned_train);
+    if (has_holdout) {
+      row("held-out", "default", start_holdout);
+      row("held-out", "tuned", tuned_holdout);
+    }
+  } else {
+    os << "\nseeds     config    objective  incidents/100mi  avg mph  comfort (m^2/s^6)\n";
+    auto row = [&](const char* seeds, const char* which, const Metrics& m) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%-9s %-8s %10s %16s %8s %18s\n", seeds, which,
+                    Fixed(m.objective, 3).c_str(), Fixed(m.incidents_per_100_miles, 1).c_str(),
+                    Fixed(m.avg_speed_mph, 2).c_str(), Fixed(m.mean_squared_jerk, 3).c_str());
+      os << buf;
+    };
+    row("train", "default", start_train);
+    row("train", "tuned", tuned_train);
+    row("held-out", "default", start_holdout);
+    row("held-out", "tuned", tuned_holdout);
+  }
   os << "(" << evaluations << " evaluations, best #" << best_evaluation;
   if (replayed > 0) os << ", " << replayed << " replayed from the log";
   os << ")\n";

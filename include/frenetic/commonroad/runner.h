@@ -19,6 +19,8 @@
 // for goals without one, the scenario's last recorded step), at most kMaxSteps.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,8 +29,10 @@
 #include "frenetic/commonroad/scenario.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/commonroad/verdict.h"
+#include "frenetic/map/road.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
 
 namespace frenetic::commonroad {
@@ -39,10 +43,21 @@ StatusOr<PredictionMode> ParsePredictionMode(std::string_view text);
 
 inline constexpr int kMaxSteps = 3000;
 
+// What the planner is given at one cycle of a run (RunOptions::on_cycle).
+struct CycleInput {
+  const PlanningProblem& problem;
+  int step;
+  const std::shared_ptr<const map::Road>& road;
+  const plan::PlannerConfig& config;  // the problem's (its speed limit raised: CommonRoadConfig)
+  const plan::Telemetry& telemetry;
+};
+
 struct RunOptions {
   PredictionMode prediction = PredictionMode::kRecorded;
   int vehicle_type = 2;  // CommonRoad vehicle 1, 2 or 3 (KS1..KS3)
   bool timing = true;    // false: planning times are recorded as 0 (byte-stable output)
+  // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
+  std::function<void(const CycleInput&)> on_cycle;
   Status Validate() const;
 };
 

@@ -52,8 +52,29 @@ struct SearchOptions {
   std::uint64_t seed = 1;
 };
 
+// A CommonRoad suite (`commonroad:` in the file, instead of scenarios and seeds): every planning
+// problem of the scenario files is run closed-loop as `frenetic commonroad` runs it
+// (commonroad::RunScenario, planning times not measured), with the tuned planner keys applied on
+// top of start_config (config/planner.yaml) + overlay (config/commonroad.yaml) + start_set, then
+// the vehicle's limits (commonroad::CommonRoadConfig, which pins the deadlines). Objective, lower
+// is better: the share of problems not solved, then the mean cost of the solved ones as a
+// tie-break worth less than one problem (CommonRoadObjective in tuner.h).
+struct CommonRoadSuite {
+  std::vector<std::string> train;       // scenario files or directories of them (*.xml)
+  std::vector<std::string> holdout;     // likewise; empty = no held-out set
+  std::string prediction = "recorded";  // or "constant-velocity"
+  int vehicle = 2;                      // CommonRoad vehicle type 1, 2 or 3 (KS model)
+  std::string overlay;                  // "" = config/commonroad.yaml
+  std::string cost_function = "WX1";    // the tie-break's cost: WX1 or JB1
+  double cost_scale = 100;              // the mean cost at which the tie-break is half a problem
+};
+
+enum class SuiteKind { kUdacity, kCommonRoad };
+
 struct Suite {
   std::string source;       // file it was read from (named in errors)
+  SuiteKind kind = SuiteKind::kUdacity;
+  CommonRoadSuite commonroad;  // kCommonRoad only
   std::string map_path;     // "" = map::DefaultTrackPath()
   std::string planner = "search";
   std::vector<std::string> scenarios;  // names (config/scenarios/NAME.yaml) or file paths
@@ -75,14 +96,17 @@ struct Suite {
   bool deterministic = true;
 };
 
-// Parses suite YAML. Relative paths (start_config, map, scenario files) are resolved against
-// `base_dir` ("" = as given). Errors name `source` and the key.
+// Parses suite YAML. Relative paths (start_config, map, scenario files, commonroad, holdout,
+// commonroad_config) are resolved against `base_dir` ("" = as given). Errors name `source` and
+// the key. A CommonRoad suite rejects the Udacity suite's keys (map, planner, scenarios, seeds,
+// episode_seconds, latency, deterministic) and takes objective.cost and objective.cost_scale only.
 StatusOr<Suite> ParseSuite(std::string_view yaml_text, std::string_view source,
                            const std::string& base_dir);
 // Reads a suite file; relative paths inside resolve against the file's directory.
 StatusOr<Suite> LoadSuite(const std::string& path);
 
-// The start configuration of `suite` (start_config plus start_set), with every tuned key checked
+// The start configuration of `suite` (start_config, on a CommonRoad suite with the overlay on top,
+// plus start_set), with every tuned key checked
 // against its declared parameters: unknown keys and bounds outside the declared range are errors
 // naming the key and the suite file.
 StatusOr<plan::PlannerConfig> LoadStartConfig(const Suite& suite);

@@ -23,10 +23,11 @@
 
 namespace frenetic::tune {
 
-// What one evaluation measured over its episodes (scenario-major, seeds in suite order).
+// What one evaluation measured over its episodes (scenario-major, seeds in suite order), or on a
+// CommonRoad suite over its scenario files (the Udacity fields then stay 0).
 struct Metrics {
-  double objective = 0;  // see ObjectiveWeights; lower is better
-  int episodes = 0;
+  double objective = 0;             // see ObjectiveWeights or CommonRoadObjective; lower is better
+  int episodes = 0;                 // Udacity: drives; CommonRoad: scenario files
   double miles = 0;                 // total over the episodes
   std::array<double, sim::kIncidentKinds> per_mile{};  // incidents of each kind / total miles
   double incidents_per_100_miles = 0;  // all kinds
@@ -34,17 +35,32 @@ struct Metrics {
   double mean_squared_jerk = 0;     // m^2/s^6, mean over episodes (comfort)
   double min_headway_s = 0;         // mean over the episodes that had a car ahead (0 if none)
   double headway_deficit_s = 0;     // mean over episodes of max(0, target - min headway)
-  nlohmann::json ToJson() const;    // finite numbers only
+  // CommonRoad suites: planning problems, how many the verdict solved, and the mean cost
+  // (CommonRoadSuite::cost_function) of the solved ones (0 when none is).
+  int problems = 0, solved = 0;
+  double mean_cost = 0;
+  // Finite numbers only; with problems > 0 the CommonRoad fields (objective, episodes,
+  // problems, solved, mean_cost) and no others.
+  nlohmann::json ToJson() const;
   static StatusOr<Metrics> FromJson(const nlohmann::json& j);
 };
 
+// The objective of a CommonRoad suite, lower is better: the share of problems not solved, then
+// the mean cost c of the solved ones as a tie-break worth less than one problem,
+//   J = (problems - solved + c / (c + cost_scale)) / problems,
+// so that one more solved problem always wins over any cost. 0 problems give 0.
+double CommonRoadObjective(int problems, int solved, double mean_cost, double cost_scale);
+
+// The training or the held-out part of a suite: seeds (Udacity), scenario files (CommonRoad).
 enum class SeedSet { kTrain, kHoldout };
 
 // Scores parameter vectors. Every rank of `cluster` builds one (same suite); rank 0 calls
 // Evaluate() and finally Stop(), the other ranks call Serve(), which returns after Stop().
 class Evaluator {
  public:
-  // Loads the map, scenarios and start configuration. `jobs` threads per rank (0 = all cores).
+  // Loads the map, scenarios and start configuration (on a CommonRoad suite, reads every
+  // scenario file: an unreadable one is an error naming it). `jobs` threads per rank (0 = all
+  // cores).
   static StatusOr<std::unique_ptr<Evaluator>> Create(const Suite& suite, int jobs,
                                                      const Cluster& cluster);
   ~Evaluator();
@@ -64,6 +80,8 @@ class Evaluator {
   // Rank 0: releases the other ranks from Serve() (no-op on one process; idempotent).
   void Stop();
 
+  // Episodes (Udacity) or scenario files (CommonRoad) of a set; 0 for a CommonRoad suite
+  // without a held-out set.
   int episodes(SeedSet set) const;
 
  private:
@@ -100,9 +118,12 @@ struct TuneResult {
   int replayed = 0;                // of them, answered from the resume log
   int best_evaluation = -1;        // index of the best search evaluation
   Metrics start_train, tuned_train, start_holdout, tuned_holdout;
+  bool has_holdout = true;         // false: a CommonRoad suite without `holdout` (not evaluated)
+  bool commonroad = false;         // the metrics are a CommonRoad suite's
+  std::string cost_function;       // CommonRoad: the tie-break's cost (WX1, JB1)
   std::string tuned_yaml;          // PlannerConfig::ToYaml of the tuned configuration
   nlohmann::json ToJson() const;
-  std::string ToTable() const;     // default vs tuned, training and held-out seeds
+  std::string ToTable() const;  // default vs tuned, training and held-out seeds (or files)
 };
 
 // Runs the search on rank 0 of the evaluator's cluster (stops the workers when done). The log

@@ -1,0 +1,274 @@
+// `frenetic commonroad` as a user runs it, on hand-made scenario files written by the test: the
+// verdict in the text, the JSON's structure, solution files, one-line errors, --help, and results
+// that do not depend on --jobs.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps_test_util.h"
+#include "commonroad/scenario_xml.h"
+#include "frenetic/commonroad/runner.h"
+#include "frenetic/commonroad/scenario.h"
+#include "frenetic/commonroad/setup.h"
+#include "frenetic/commonroad/solution.h"
+
+namespace frenetic::testing {
+namespace {
+
+namespace fs = std::filesystem;
+namespace crt = commonroad::testing;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+// A goal 140 m ahead at the ego's speed, within 5-9 s: solved.
+std::string SolvableXml() {
+  crt::ScenarioXml xml("ZAM_Reach-1_1_T-1");
+  crt::AddStraightRoad(xml, 400).Problem(1, {10, -1.75}, 0, 20,
+                                         {crt::GoalRectangleXml({150, -1.75}, 10, 3, 0, 50, 90)});
+  return xml.Str();
+}
+
+// 590 m in 3 s from 20 m/s: no vehicle gets there; the verdict names the goal.
+std::string UnsolvableXml() {
+  crt::ScenarioXml xml("ZAM_Far-1_1_T-1");
+  crt::AddStraightRoad(xml, 800).Problem(1, {10, -1.75}, 0, 20,
+                                         {crt::GoalRectangleXml({600, -1.75}, 10, 3, 0, 0, 30)});
+  return xml.Str();
+}
+
+// A lanelet whose point has no y: the reader names this line.
+std::string MalformedXml() {
+  crt::ScenarioXml xml("ZAM_Broken-1_1_T-1");
+  crt::AddStraightRoad(xml, 100).Raw(
+      "<lanelet id=\"7\">\n<leftBound>\n<point><x>1</x></point>\n</leftBound>\n</lanelet>\n");
+  return xml.Str();
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+class CommonRoadCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("frenetic_cr_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_ / "set");
+    std::ofstream(dir_ / "set" / "a_reach.xml") << SolvableXml();
+    std::ofstream(dir_ / "set" / "b_far.xml") << UnsolvableXml();
+    fs::create_directories(dir_ / "mixed");
+    std::ofstream(dir_ / "mixed" / "a_broken.xml") << MalformedXml();
+    std::ofstream(dir_ / "mixed" / "b_reach.xml") << SolvableXml();
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  void SetUp() override {
+    if (!fs::exists(FRENETIC_BINARY)) GTEST_SKIP() << "no executable at " << FRENETIC_BINARY;
+  }
+
+  static std::string Set() { return (dir_ / "set").string(); }
+  static inline fs::path dir_;
+};
+
+TEST_F(CommonRoadCliTest, TextNamesEachProblemsVerdict) {
+  CommandResult r = RunFrenetic("commonroad " + Set() + " --no-timing");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const std::vector<std::string> lines = Lines(r.out);
+  auto verdict_after = [&](const std::string& id) -> std::string {
+    for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
+      if (lines[i].rfind(id, 0) == 0) return lines[i + 1];
+    }
+    return "<" + id + " not found>";
+  };
+  EXPECT_THAT(verdict_after("ZAM_Reach-1_1_T-1"),
+              ::testing::MatchesRegex("    solved, goal at step [0-9]+"));
+  EXPECT_THAT(verdict_after("ZAM_Far-1_1_T-1"), HasSubstr("FAILED: goal at step"));
+  EXPECT_THAT(r.out, HasSubstr("solved 1 / 2 problems (recorded predictions, KS2)"));
+  EXPECT_THAT(r.out, HasSubstr("failures: goal 1\n"));
+  EXPECT_THAT(r.out, HasSubstr("WX1 "));
+}
+
+TEST_F(CommonRoadCliTest, JsonHasScenariosProblemsAndSummary) {
+  CommandResult r = RunFrenetic("commonroad " + Set() + " --json --no-timing");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = json::parse(r.out, nullptr, false);
+  ASSERT_FALSE(j.is_discarded()) << r.out;
+  ASSERT_EQ(j.at("scenarios").size(), 2u);
+  int solved = 0;
+  for (const json& s : j.at("scenarios")) {
+    ASSERT_TRUE(s.at("path").is_string());
+    ASSERT_EQ(s.at("problems").size(), 1u);
+    const json& p = s.at("problems")[0];
+    EXPECT_EQ(p.at("problem"), 1);
+    ASSERT_TRUE(p.at("solved").is_boolean());
+    ASSERT_TRUE(p.at("failures").is_array());
+    for (const char* k : {"p50", "p99", "max"}) EXPECT_TRUE(p.at("plan_ms").at(k).is_number()) << k;
+    for (const char* k : {"WX1", "JB1"}) {
+      ASSERT_TRUE(p.at("costs").at(k).is_number()) << k;
+      EXPECT_GT(p.at("costs").at(k).get<double>(), 0) << k;
+    }
+    const std::string id = s.at("benchmark_id");
+    if (id == "ZAM_Reach-1_1_T-1") {
+      EXPECT_TRUE(p.at("solved").get<bool>());
+      EXPECT_TRUE(p.at("failures").empty());
+      EXPECT_EQ(p.at("goal_step"), p.at("steps"));
+      EXPECT_EQ(p.at("stop"), "goal");
+    } else {
+      EXPECT_EQ(id, "ZAM_Far-1_1_T-1");
+      EXPECT_FALSE(p.at("solved").get<bool>());
+      ASSERT_EQ(p.at("failures").size(), 1u) << p.dump();
+      EXPECT_EQ(p.at("failures")[0].at("kind"), "goal");
+      EXPECT_TRUE(p.at("failures")[0].at("step").is_number_integer());
+      EXPECT_TRUE(p.at("goal_step").is_null());
+    }
+    solved += p.at("solved").get<bool>();
+  }
+  EXPECT_EQ(solved, 1);
+  const json& sum = j.at("summary");
+  EXPECT_EQ(sum.at("problems"), 2);
+  EXPECT_EQ(sum.at("solved"), 1);
+  EXPECT_EQ(sum.at("failures"), json({{"goal", 1}}));
+  EXPECT_EQ(sum.at("unreadable_files"), 0);
+  EXPECT_EQ(sum.at("prediction"), "recorded");
+  for (const char* k : {"p50", "p99", "max"}) {
+    EXPECT_EQ(sum.at("plan_ms").at(k), 0.0) << k << ": --no-timing reports 0";
+  }
+  EXPECT_GT(sum.at("cycles").get<int>(), 0);
+}
+
+// The solution file, read back, holds the trajectory the runner drove (the same config run in
+// process gives the same states, bit for bit: the file's numbers round-trip).
+TEST_F(CommonRoadCliTest, SolutionDirWritesFilesThatReadBack) {
+  const fs::path out = dir_ / "solutions";
+  CommandResult r = RunFrenetic("commonroad " + (dir_ / "set" / "a_reach.xml").string() +
+                                " --json --no-timing --solution-dir " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = json::parse(r.out);
+  const std::string name = "solution_KS2:WX1:ZAM_Reach-1_1_T-1:2020a.xml";
+  EXPECT_EQ(j.at("scenarios")[0].at("solution_file"), name);
+  ASSERT_TRUE(fs::exists(out / name)) << r.out;
+  auto solution = commonroad::LoadSolution((out / name).string());
+  ASSERT_TRUE(solution.ok()) << solution.message();
+  EXPECT_EQ(solution->scenario_id, "ZAM_Reach-1_1_T-1");
+  EXPECT_FALSE(solution->computation_time.has_value()) << "--no-timing";
+  ASSERT_EQ(solution->trajectories.size(), 1u);
+  const commonroad::SolutionTrajectory& t = solution->trajectories[0];
+  EXPECT_EQ(t.problem_id, 1);
+  EXPECT_EQ(t.vehicle_type, 2);
+  EXPECT_EQ(t.cost_function, "WX1");
+  const int steps = j.at("scenarios")[0].at("problems")[0].at("steps");
+  ASSERT_EQ(static_cast<int>(t.states.size()), steps + 1);
+  EXPECT_EQ(t.states.front().time_step, 0);
+  EXPECT_EQ(t.states.front().x, 10);
+  EXPECT_EQ(t.states.front().y, -1.75);
+  EXPECT_EQ(t.states.back().time_step, j.at("scenarios")[0].at("problems")[0].at("goal_step"));
+
+  auto scenario = commonroad::ParseScenario(SolvableXml(), "a_reach.xml");
+  ASSERT_TRUE(scenario.ok()) << scenario.message();
+  auto base = commonroad::LoadBaseConfig();
+  ASSERT_TRUE(base.ok()) << base.message();
+  auto config = commonroad::CommonRoadConfig(*base, commonroad::VehicleParams(),
+                                             commonroad::PredictionMode::kRecorded);
+  ASSERT_TRUE(config.ok()) << config.message();
+  commonroad::RunOptions options;
+  options.timing = false;
+  const commonroad::ScenarioRun run = commonroad::RunScenario(*scenario, *config, options);
+  ASSERT_EQ(run.problems.size(), 1u);
+  const std::vector<commonroad::KsState>& driven = run.problems[0].trajectory;
+  ASSERT_EQ(driven.size(), t.states.size());
+  for (std::size_t i = 0; i < driven.size(); ++i) {
+    EXPECT_EQ(t.states[i].time_step, driven[i].time_step) << i;
+    EXPECT_EQ(t.states[i].x, driven[i].x) << i;
+    EXPECT_EQ(t.states[i].y, driven[i].y) << i;
+    EXPECT_EQ(t.states[i].velocity, driven[i].velocity) << i;
+    EXPECT_EQ(t.states[i].orientation, driven[i].orientation) << i;
+    EXPECT_EQ(t.states[i].steering_angle, driven[i].steering_angle) << i;
+  }
+}
+
+TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {
+  const std::string broken = (dir_ / "mixed" / "a_broken.xml").string();
+  const int line = crt::LineOf(MalformedXml(), "<point><x>1</x></point>");
+  ASSERT_GT(line, 0);
+  CommandResult r = RunFrenetic("commonroad " + (dir_ / "mixed").string() + " --no-timing 2>&1");
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  int naming = 0;
+  for (const std::string& l : Lines(r.out)) {
+    if (l.find(broken + ":") == std::string::npos) continue;
+    ++naming;
+    EXPECT_THAT(l, HasSubstr(broken + ":" + std::to_string(line) + ":")) << l;
+  }
+  EXPECT_EQ(naming, 1) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("solved 1 / 1 problems"));
+  EXPECT_THAT(r.out, HasSubstr("1 file(s) unreadable"));
+
+  CommandResult j = RunFrenetic("commonroad " + (dir_ / "mixed").string() + " --json --no-timing");
+  EXPECT_EQ(j.exit_code, 1);
+  const json doc = json::parse(j.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded()) << j.out;
+  ASSERT_EQ(doc.at("scenarios").size(), 2u);
+  const std::string error = doc.at("scenarios")[0].at("error");
+  EXPECT_THAT(error, HasSubstr(broken + ":" + std::to_string(line) + ":"));
+  EXPECT_EQ(error.find('\n'), std::string::npos);
+  EXPECT_TRUE(doc.at("scenarios")[1].at("problems")[0].at("solved").get<bool>());
+  EXPECT_EQ(doc.at("summary").at("unreadable_files"), 1);
+}
+
+TEST_F(CommonRoadCliTest, BadArgumentsFailWithOneLine) {
+  struct Case {
+    std::string args, needle;
+  };
+  const Case cases[] = {
+      {"commonroad /nonexistent/scenario.xml", "/nonexistent/scenario.xml: no such file"},
+      {"commonroad " + Set() + " --prediction bogus", "'bogus'"},
+      {"commonroad " + Set() + " --config /nonexistent/planner.yaml", "/nonexistent/planner.yaml"},
+      {"commonroad " + Set() + " --commonroad-config /nonexistent/cr.yaml", "/nonexistent/cr.yaml"},
+  };
+  for (const Case& c : cases) {
+    CommandResult r = RunFrenetic(c.args + " 2>&1");
+    EXPECT_EQ(r.exit_code, 1) << c.args << ": " << r.out;
+    EXPECT_THAT(r.out, HasSubstr(c.needle)) << c.args;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << c.args << ": " << r.out;
+    EXPECT_EQ(r.out.rfind("frenetic commonroad: ", 0), 0u) << r.out;
+  }
+}
+
+// Every option is listed; every option that takes a value gives its default.
+TEST_F(CommonRoadCliTest, HelpListsEveryOptionWithItsDefault) {
+  CommandResult r = RunFrenetic("commonroad --help");
+  ASSERT_EQ(r.exit_code, 0);
+  for (const char* option : {"--prediction", "--vehicle", "--config", "--commonroad-config",
+                             "--solution-dir", "--jobs"}) {
+    const std::size_t at = r.out.find(std::string("  ") + option + " ");
+    ASSERT_NE(at, std::string::npos) << option << " missing from\n" << r.out;
+    const std::size_t next = r.out.find("\n  -", at + 1);
+    const std::string entry =
+        r.out.substr(at, next == std::string::npos ? std::string::npos : next - at);
+    EXPECT_THAT(entry, HasSubstr("Default")) << entry;
+  }
+  for (const char* flag : {"--json", "--progress", "--no-timing", "paths"}) {
+    EXPECT_THAT(r.out, HasSubstr(flag));
+  }
+}
+
+TEST_F(CommonRoadCliTest, JobsDoNotChangeTheResults) {
+  const std::string common = "commonroad " + Set() + " " +
+                             (dir_ / "mixed" / "b_reach.xml").string() + " --json --no-timing";
+  CommandResult one = RunFrenetic(common + " --jobs 1");
+  CommandResult two = RunFrenetic(common + " --jobs 2");
+  ASSERT_EQ(one.exit_code, 0) << one.out;
+  ASSERT_EQ(two.exit_code, 0) << two.out;
+  EXPECT_EQ(json::parse(one.out).at("scenarios").size(), 3u);
+  EXPECT_EQ(one.out, two.out);
+}
+
+}  // namespace
+}  // namespace frenetic::testing
