@@ -231,13 +231,17 @@ class Session : public std::enable_shared_from_this<Session> {
         return true;
       }
       case FrameKind::kOtherEvent:
-      case FrameKind::kMalformed: {
+      case FrameKind::kMalformed:
+      case FrameKind::kRefused: {
         {
           std::lock_guard lock(server_->mutex);
-          ++(parsed.kind == FrameKind::kMalformed ? st.malformed_frames : st.other_events);
+          ++(parsed.kind == FrameKind::kMalformed ? st.malformed_frames
+             : parsed.kind == FrameKind::kRefused ? st.refused_frames
+                                                  : st.other_events);
           ++st.manual_replies;
         }
         Problem(std::string(parsed.kind == FrameKind::kMalformed ? "malformed frame"
+                            : parsed.kind == FrameKind::kRefused ? "frame over the limits"
                                                                  : "unexpected event") +
                 " answered manual: " + parsed.error);
         reply_ = kManualFrame;
@@ -408,11 +412,11 @@ std::string Server::Impl::StatusLine() {
   std::string line = fmt::format(
       "status: {} open connections, {} cycles (+{}), plan p50 {:.2f} ms p99 {:.2f} ms, {}; "
       "incidents: short paths {}, bad plans {}, fallback {}, invalid input {}, over budget {}, "
-      "planner exceptions {}; frames: manual {}, malformed {}, repaired {}, binary {}, "
-      "oversize {}",
+      "planner exceptions {}; frames: manual {}, malformed {}, repaired {}, over limits {}, "
+      "binary {}, oversize {}",
       s.open_connections, s.cycles, s.cycles - iv.cycles_at_start, p50, p99, ego, s.short_paths,
       s.bad_plans, s.fallback, s.invalid_input, s.over_budget, s.planner_exceptions,
-      s.manual_replies, s.malformed_frames, s.repaired_frames, s.binary_frames,
+      s.manual_replies, s.malformed_frames, s.repaired_frames, s.refused_frames, s.binary_frames,
       s.oversize_frames);
   iv.plan_ms.clear();
   iv.cycles_at_start = s.cycles;

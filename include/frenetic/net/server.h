@@ -51,6 +51,7 @@ struct ServerStats {
   std::int64_t null_telemetry = 0;
   std::int64_t other_events = 0;
   std::int64_t malformed_frames = 0;  // 42 frames that could not be understood
+  std::int64_t refused_frames = 0;    // 42 frames over net::FrameLimits (answered manual)
   std::int64_t repaired_frames = 0;   // telemetry with dropped rows / cut arrays, still planned
   std::int64_t binary_frames = 0;     // ignored
   std::int64_t oversize_frames = 0;   // connection closed
