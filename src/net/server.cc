@@ -1,9 +1,13 @@
-// One io_context on the thread that calls Run(); each connection is a Session driven by async
-// callbacks on that thread, so sessions need no locks and the planner (≈1 ms) runs synchronously
-// per message. The simulator sends only after a reply (§2), so read → plan → write → read keeps
-// at most one write in flight per connection, which is also the back-pressure against floods.
+// One io_context on the thread that calls Run() moves the bytes; every 42 frame is handed to a
+// planning pool, which converts it, plans and formats the reply, then posts the write back to
+// the I/O thread. A session reads its next frame only after its reply is written, so it has at
+// most one frame in the pool: its planner is never used by two threads at once, and a session
+// that floods or stops reading delays only itself (the simulator sends only after a reply, §2).
+// The pool is a priority queue by recent planning time, so a session that keeps the pool busy
+// cannot push a well-paced one behind a queue of its own frames.
 #include "frenetic/net/server.h"
 
+#include <malloc.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -11,24 +15,29 @@
 #include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
+#include <deque>
 #include <exception>
 #include <map>
 #include <mutex>
+#include <thread>
 #include <vector>
-
-#include "frenetic/net/protocol.h"
 
 namespace frenetic::net {
 
 namespace asio = boost::asio;
 namespace beast = boost::beast;
+namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
+using Clock = std::chrono::steady_clock;
 
 Status ServerOptions::Validate() const {
   if (port < 0 || port > 65535) {
@@ -47,7 +56,19 @@ Status ServerOptions::Validate() const {
   if (!std::isfinite(handshake_timeout) || handshake_timeout <= 0) {
     return Status::Error("handshake timeout: must be a finite number of seconds > 0");
   }
+  if (!std::isfinite(write_timeout) || write_timeout <= 0) {
+    return Status::Error("write timeout: must be a finite number of seconds > 0");
+  }
   if (max_logged_problems < 0) return Status::Error("max logged problems: must be >= 0");
+  if (max_connections < 1 || max_connections > 10000) {
+    return Status::Error("max connections: " + std::to_string(max_connections) +
+                         " is not in [1, 10000]");
+  }
+  if (planning_threads < 0 || planning_threads > 256) {
+    return Status::Error("planning threads: " + std::to_string(planning_threads) +
+                         " is not in [0, 256] (0 = one per core)");
+  }
+  if (Status s = frame_limits.Validate(); !s.ok()) return Status::Error("frame " + s.message());
   return Status::Ok();
 }
 
@@ -70,13 +91,117 @@ double Percentile(std::vector<double>* v, double q) {
   return (*v)[k];
 }
 
+// A reply queued behind one the peer does not read is planned for nobody: a small send buffer
+// (the kernel doubles it) stops a non-reading client after a few dozen replies, not thousands.
+constexpr int kSendBufferBytes = 64 << 10;
+// A frame buffer grown past this by a large frame is given back once the frame is handled.
+constexpr std::size_t kKeptBufferBytes = 64 << 10;
+// How long an over-capacity connection may take to send its upgrade request before the 503.
+constexpr auto kRefusalTimeout = std::chrono::seconds(2);
+// Refusals in progress at once, as a multiple of max_connections; beyond, a connection is closed
+// at once without an answer.
+constexpr int kRefusalsPerConnection = 4;
+// Refusals logged per status interval; the rest are counted in the status line.
+constexpr int kLoggedRefusals = 5;
+// The half-life-like time constant of a session's planning usage (pool priority).
+constexpr double kUsageTau = 1.0;
+// Memory given back to the system after planners are freed, at most this often.
+constexpr auto kTrimDelay = std::chrono::milliseconds(100);
+
+// Runs queued sessions' work on a few threads; picks the waiting session with the least decayed
+// planning time (ties: the first queued).
+class PlanningPool {
+ public:
+  using Work = std::function<void()>;
+
+  void Start(int threads) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Loop(); });
+  }
+  // Stops the threads after the work in hand; queued work is dropped. Idempotent.
+  void Stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+      queue_.clear();
+    }
+    cv_.notify_all();
+    for (std::thread& t : threads_) t.join();
+    threads_.clear();
+  }
+  ~PlanningPool() { Stop(); }
+
+  // Queues `work` for the session whose usage slot is `usage` (owned by the session, read and
+  // written only under the pool's lock). `keep` holds the session alive until the work ran.
+  void Submit(double* usage, Clock::time_point* usage_at, std::shared_ptr<void> keep, Work work) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return;
+      queue_.push_back({usage, usage_at, std::move(keep), std::move(work)});
+    }
+    cv_.notify_one();
+  }
+
+ private:
+  struct Item {
+    double* usage;
+    Clock::time_point* usage_at;
+    std::shared_ptr<void> keep;
+    Work work;
+  };
+
+  static double Decayed(const Item& item, Clock::time_point now) {
+    const double age = std::chrono::duration<double>(now - *item.usage_at).count();
+    return *item.usage * std::exp(-std::max(0.0, age) / kUsageTau);
+  }
+
+  void Loop() {
+    for (;;) {
+      Item item;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+        if (stopping_) return;
+        const Clock::time_point now = Clock::now();
+        auto best = queue_.begin();
+        double best_usage = Decayed(*best, now);
+        for (auto it = std::next(queue_.begin()); it != queue_.end(); ++it) {
+          const double u = Decayed(*it, now);
+          if (u < best_usage) {
+            best = it;
+            best_usage = u;
+          }
+        }
+        item = std::move(*best);
+        queue_.erase(best);
+      }
+      const Clock::time_point start = Clock::now();
+      item.work();
+      const Clock::time_point end = Clock::now();
+      {
+        std::lock_guard lock(mutex_);
+        *item.usage = Decayed(item, end) + std::chrono::duration<double>(end - start).count();
+        *item.usage_at = end;
+      }
+      item.keep.reset();  // may destroy the session: outside the lock
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Item> queue_;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
 }  // namespace
 
 struct Server::Impl {
   Impl(const ServerOptions& o, PlannerFactory f) : options(o), factory(std::move(f)) {}
 
   void Accept();
+  void Refuse(tcp::socket socket, int id);
   void ScheduleStatus();
+  void ScheduleTrim();
   void LogStatus();
   std::string StatusLine();
   void DoStop();
@@ -85,11 +210,15 @@ struct Server::Impl {
   PlannerFactory factory;
   int bound_port = 0;
   int next_session_id = 1;
-  bool stopping = false;
+  bool stopping = false;  // I/O thread only
+  int live_sessions = 0;  // upgrading or upgraded; I/O thread only
+  int refusing = 0;       // 503 answers in progress; I/O thread only
+  bool trim_pending = false;
 
-  mutable std::mutex mutex;  // guards stats and interval (read by stats() from other threads)
+  mutable std::mutex mutex;  // guards stats, interval and logged_refusals
   ServerStats stats;
   Interval interval;
+  int logged_refusals = 0;
 
   // Live sessions, for closing them on Stop(). Declared before io so that handlers destroyed
   // with io (which own sessions) can still unregister.
@@ -98,23 +227,29 @@ struct Server::Impl {
   asio::io_context io{1};
   tcp::acceptor acceptor{io};
   asio::steady_timer status_timer{io};
+  asio::steady_timer trim_timer{io};
   asio::signal_set signals{io};
+  // Declared after io: its threads post to io, and the sessions it holds close their sockets.
+  PlanningPool pool;
 };
 
 namespace {
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
-  Session(Server::Impl* server, int id, tcp::socket socket,
-          std::unique_ptr<plan::Planner> planner)
-      : server_(server), id_(id), ws_(std::move(socket)), planner_(std::move(planner)) {
+  Session(Server::Impl* server, int id, tcp::socket socket)
+      : server_(server), id_(id), ws_(std::move(socket)), write_timer_(server->io) {
     beast::error_code ec;
     const auto remote = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
     peer_ = ec ? std::string("?") : remote.address().to_string() + ":" +
                                         std::to_string(remote.port());
+    ++server_->live_sessions;
   }
 
-  ~Session() { server_->sessions.erase(id_); }
+  ~Session() {
+    server_->sessions.erase(id_);
+    --server_->live_sessions;
+  }
 
   void Start() {
     server_->sessions[id_] = weak_from_this();
@@ -131,6 +266,8 @@ class Session : public std::enable_shared_from_this<Session> {
       std::lock_guard lock(server_->mutex);
       ++server_->stats.nodelay_connections;
     }
+    beast::error_code ignored;
+    socket.set_option(asio::socket_base::send_buffer_size(kSendBufferBytes), ignored);
     // One frame per reply (Beast would split replies over its 4096-byte write buffer into
     // continuation frames, which some Udacity-template programs mishandle).
     ws_.auto_fragment(false);
@@ -142,12 +279,16 @@ class Session : public std::enable_shared_from_this<Session> {
     ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
       res.set(beast::http::field::server, "frenetic");
     }));
+    ws_.control_callback([this](websocket::frame_type kind, beast::string_view) {
+      if (kind == websocket::frame_type::close) OnCloseFrame();
+    });
     // Any request target is accepted: Beast does not look at the path.
     ws_.async_accept(
         [self = shared_from_this()](beast::error_code ec) { self->OnAccept(ec); });
   }
 
   void Close() {
+    closing_ = true;
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().close(ec);
   }
@@ -186,22 +327,69 @@ class Session : public std::enable_shared_from_this<Session> {
         ++server_->stats.binary_frames;
       }
       Problem("binary frame of " + std::to_string(buffer_.size()) + " bytes ignored");
-      buffer_.consume(buffer_.size());
+      FrameDone();
       DoRead();
       return;
     }
+    const std::string_view frame = Frame();
+    if (frame.substr(0, 2) != "42") {
+      // engine.io packets need no JSON: answered (or not) here, without a trip to the pool.
+      Finish(Handle(frame));
+      return;
+    }
+    // The buffer is left alone until the work is done: no read is pending meanwhile.
+    {
+      std::lock_guard lock(server_->mutex);
+      ++server_->stats.waiting_frames;
+    }
+    server_->pool.Submit(&usage_, &usage_at_, shared_from_this(), [this] {
+      {
+        std::lock_guard lock(server_->mutex);
+        --server_->stats.waiting_frames;
+      }
+      const bool answer = Handle(Frame());
+      asio::post(server_->io, [self = shared_from_this(), answer] { self->Finish(answer); });
+    });
+  }
+
+  std::string_view Frame() const {
     const auto data = buffer_.data();
-    const std::string_view frame(static_cast<const char*>(data.data()), data.size());
-    const bool answer = Handle(frame);
+    return {static_cast<const char*>(data.data()), data.size()};
+  }
+
+  void FrameDone() {
     buffer_.consume(buffer_.size());
+    if (buffer_.capacity() > kKeptBufferBytes) buffer_.shrink_to_fit();
+  }
+
+  // I/O thread: the frame was handled (reply_ filled when `answer`).
+  void Finish(bool answer) {
+    FrameDone();
+    if (closing_ || server_->stopping) {
+      End(asio::error::operation_aborted);
+      return;
+    }
     if (!answer) {
       DoRead();
       return;
     }
     ws_.text(true);
+    write_timer_.expires_after(std::chrono::milliseconds(
+        static_cast<std::int64_t>(server_->options.write_timeout * 1000.0)));
+    write_timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (ec) return;  // cancelled: the write completed
+      self->stalled_ = true;
+      self->Close();
+    });
     ws_.async_write(asio::buffer(reply_),
                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                      if (ec) {
+                      self->write_timer_.cancel();
+                      if (self->reply_.capacity() > kKeptBufferBytes) {
+                        std::string().swap(self->reply_);
+                      }
+                      // Without a planner (the factory failed) the connection ends after the
+                      // manual answer.
+                      if (ec || self->close_connection_) {
                         self->End(ec);
                         return;
                       }
@@ -209,9 +397,30 @@ class Session : public std::enable_shared_from_this<Session> {
                     });
   }
 
-  // Fills reply_ and returns true when the frame needs an answer.
+  // A close frame arrived (its code is in ws_.reason()). Beast refuses the reserved codes itself
+  // (1005, 1006, 1015, 0-999, 1016-2999) with 1002, but echoes codes from 5000 up, which RFC 6455
+  // §7.4 leaves undefined: answer those with 1002 too, written here before Beast's echo, whose
+  // write then fails on the shut socket.
+  void OnCloseFrame() {
+    const std::uint16_t code = ws_.reason().code;
+    if (code < 5000) return;
+    {
+      std::lock_guard lock(server_->mutex);
+      ++server_->stats.bad_close_codes;
+    }
+    Problem("close frame with code " + std::to_string(code) +
+            ", which RFC 6455 §7.4 does not define: failed with 1002");
+    const char frame[4] = {static_cast<char>(0x88), 2, 0x03, static_cast<char>(0xEA)};
+    tcp::socket& socket = beast::get_lowest_layer(ws_).socket();
+    beast::error_code ignored;
+    asio::write(socket, asio::buffer(frame, sizeof frame), ignored);
+    socket.shutdown(tcp::socket::shutdown_both, ignored);
+  }
+
+  // Fills reply_ and returns true when the frame needs an answer. On a planning thread for 42
+  // frames (the I/O thread leaves this session alone meanwhile), on the I/O thread otherwise.
   bool Handle(std::string_view frame) {
-    ParsedFrame parsed = ParseFrame(frame);
+    ParsedFrame parsed = ParseFrame(frame, server_->options.frame_limits);
     ServerStats& st = server_->stats;
     switch (parsed.kind) {
       case FrameKind::kTelemetry:
@@ -262,8 +471,34 @@ class Session : public std::enable_shared_from_this<Session> {
     return false;
   }
 
+  // Builds the planner at the first telemetry; false (reply_ manual, the connection to close)
+  // when the factory fails.
+  bool EnsurePlanner() {
+    if (planner_) return true;
+    std::string why = "the planner factory returned nothing";
+    try {
+      planner_ = server_->factory();
+    } catch (const std::exception& e) {
+      why = std::string("the planner factory threw: ") + e.what();
+    }
+    std::lock_guard lock(server_->mutex);
+    if (planner_) {
+      ++server_->stats.planners_built;
+      return true;
+    }
+    ++server_->stats.refused_connections;
+    ++server_->stats.manual_replies;
+    spdlog::error("session {}: no planner, answered manual and closing: {}", id_, why);
+    close_connection_ = true;
+    return false;
+  }
+
   bool Plan(const plan::Telemetry& telemetry) {
-    const auto start = std::chrono::steady_clock::now();
+    if (!EnsurePlanner()) {
+      reply_ = kManualFrame;
+      return true;
+    }
+    const auto start = Clock::now();
     const plan::PlanResult* result = nullptr;
     try {  // Plan() never throws by contract; a planner that does must not take the server down.
       result = &planner_->Plan(telemetry);
@@ -277,9 +512,7 @@ class Session : public std::enable_shared_from_this<Session> {
       reply_ = kManualFrame;
       return true;
     }
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count();
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     const std::size_t written = FormatControl(result->x, result->y, &reply_);
     const bool bad = written != result->x.size() || written != result->y.size();
     {
@@ -317,6 +550,8 @@ class Session : public std::enable_shared_from_this<Session> {
   }
 
   void End(beast::error_code ec) {
+    if (ended_) return;
+    ended_ = true;
     if (ec == websocket::error::message_too_big) {
       {
         std::lock_guard lock(server_->mutex);
@@ -324,10 +559,21 @@ class Session : public std::enable_shared_from_this<Session> {
       }
       spdlog::warn("session {}: frame over {} bytes, connection closed", id_,
                    server_->options.max_frame_bytes);
+    } else if (stalled_) {
+      {
+        std::lock_guard lock(server_->mutex);
+        ++server_->stats.stalled_connections;
+      }
+      spdlog::warn(
+          "session {}: a reply was not taken within {} s (the peer does not read), "
+          "connection closed after {} frames",
+          id_, server_->options.write_timeout, frames_);
     } else if (ec == websocket::error::closed) {
       spdlog::info("session {}: closed by the peer after {} frames", id_, frames_);
-    } else if (ec == asio::error::operation_aborted && server_->stopping) {
+    } else if (server_->stopping) {
       spdlog::info("session {}: closed on shutdown after {} frames", id_, frames_);
+    } else if (close_connection_) {
+      spdlog::info("session {}: closed after {} frames: no planner", id_, frames_);
     } else {
       spdlog::info("session {}: disconnected after {} frames ({})", id_, frames_, ec.message());
     }
@@ -336,19 +582,75 @@ class Session : public std::enable_shared_from_this<Session> {
       std::lock_guard lock(server_->mutex);
       --server_->stats.open_connections;
     }
+    write_timer_.cancel();
     Close();
+    // No work is in the pool (End runs only between frames): the planner can go now, and its
+    // memory back to the system.
+    if (planner_) {
+      planner_.reset();
+      server_->ScheduleTrim();
+    }
   }
 
   Server::Impl* server_;
   int id_;
   websocket::stream<beast::tcp_stream> ws_;
+  asio::steady_timer write_timer_;
   std::unique_ptr<plan::Planner> planner_;
   beast::flat_buffer buffer_;
   std::string reply_;
   std::string peer_;
+  double usage_ = 0;  // pool priority: decayed planning seconds (the pool's lock guards them)
+  Clock::time_point usage_at_ = Clock::now();
   std::int64_t frames_ = 0;
   int problems_ = 0;
   bool upgraded_ = false;
+  bool closing_ = false;
+  bool ended_ = false;
+  bool stalled_ = false;
+  bool close_connection_ = false;
+};
+
+// Answers one connection over max_connections: reads its upgrade request (so that closing does
+// not reset the connection before the client reads the answer), writes a 503 naming the limit,
+// and closes.
+class Refusal : public std::enable_shared_from_this<Refusal> {
+ public:
+  Refusal(Server::Impl* server, tcp::socket socket) : server_(server), stream_(std::move(socket)) {
+    ++server_->refusing;
+    parser_.header_limit(8 << 10);
+    parser_.body_limit(0);
+  }
+  ~Refusal() { --server_->refusing; }
+
+  void Start(std::string reason) {
+    reason_ = std::move(reason);
+    stream_.expires_after(kRefusalTimeout);
+    http::async_read(
+        stream_, buffer_, parser_,
+        [self = shared_from_this()](beast::error_code ec, std::size_t) { self->OnRequest(ec); });
+  }
+
+ private:
+  void OnRequest(beast::error_code ec) {
+    if (ec) return;  // no request in time: closed without an answer
+    response_ =
+        "HTTP/1.1 503 Service Unavailable\r\nServer: frenetic\r\nRetry-After: 1\r\n"
+        "Content-Type: text/plain\r\nConnection: close\r\nContent-Length: " +
+        std::to_string(reason_.size() + 1) + "\r\n\r\n" + reason_ + "\n";
+    asio::async_write(stream_.socket(), asio::buffer(response_),
+                      [self = shared_from_this()](beast::error_code, std::size_t) {
+                        beast::error_code ignored;
+                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                        self->stream_.close();
+                      });
+  }
+
+  Server::Impl* server_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  http::request_parser<http::empty_body> parser_;
+  std::string reason_, response_;
 };
 
 }  // namespace
@@ -362,25 +664,46 @@ void Server::Impl::Accept() {
       return;
     }
     const int id = next_session_id++;
-    std::unique_ptr<plan::Planner> planner;
-    std::string why = "the planner factory returned nothing";
-    try {
-      planner = factory();
-    } catch (const std::exception& e) {
-      why = std::string("the planner factory threw: ") + e.what();
-    }
-    if (!planner) {
-      {
-        std::lock_guard lock(mutex);
-        ++stats.refused_connections;
-      }
-      spdlog::error("session {}: refused: {}", id, why);
-      beast::error_code ignored;
-      socket.close(ignored);
+    if (live_sessions >= options.max_connections) {
+      Refuse(std::move(socket), id);
     } else {
-      std::make_shared<Session>(this, id, std::move(socket), std::move(planner))->Start();
+      std::make_shared<Session>(this, id, std::move(socket))->Start();
     }
     Accept();
+  });
+}
+
+void Server::Impl::Refuse(tcp::socket socket, int id) {
+  const std::string reason = "frenetic serve: " + std::to_string(live_sessions) +
+                             " connections open, the limit (--max-connections " +
+                             std::to_string(options.max_connections) + "); try again later";
+  {
+    std::lock_guard lock(mutex);
+    ++stats.capacity_refusals;
+    if (logged_refusals < kLoggedRefusals) {
+      spdlog::warn("session {}: refused: {}", id, reason);
+    } else if (logged_refusals == kLoggedRefusals) {
+      spdlog::warn("further refusals are counted in the status line, not logged");
+    }
+    ++logged_refusals;
+  }
+  if (refusing >= kRefusalsPerConnection * options.max_connections) {
+    beast::error_code ignored;
+    socket.close(ignored);  // too many at once to answer each
+    return;
+  }
+  std::make_shared<Refusal>(this, std::move(socket))->Start(reason);
+}
+
+void Server::Impl::ScheduleTrim() {
+  if (trim_pending || stopping) return;
+  trim_pending = true;
+  trim_timer.expires_after(kTrimDelay);
+  trim_timer.async_wait([this](beast::error_code ec) {
+    trim_pending = false;
+    // glibc keeps freed memory in its arenas (one per planning thread) unless asked; a planner
+    // is several MB, so without this churn would only ever grow the resident set.
+    if (!ec) malloc_trim(0);
   });
 }
 
@@ -413,13 +736,15 @@ std::string Server::Impl::StatusLine() {
       "status: {} open connections, {} cycles (+{}), plan p50 {:.2f} ms p99 {:.2f} ms, {}; "
       "incidents: short paths {}, bad plans {}, fallback {}, invalid input {}, over budget {}, "
       "planner exceptions {}; frames: manual {}, malformed {}, repaired {}, over limits {}, "
-      "binary {}, oversize {}",
+      "binary {}, oversize {}; connections: refused at the limit {}, stalled {}, bad close "
+      "codes {}",
       s.open_connections, s.cycles, s.cycles - iv.cycles_at_start, p50, p99, ego, s.short_paths,
       s.bad_plans, s.fallback, s.invalid_input, s.over_budget, s.planner_exceptions,
       s.manual_replies, s.malformed_frames, s.repaired_frames, s.refused_frames, s.binary_frames,
-      s.oversize_frames);
+      s.oversize_frames, s.capacity_refusals, s.stalled_connections, s.bad_close_codes);
   iv.plan_ms.clear();
   iv.cycles_at_start = s.cycles;
+  logged_refusals = 0;
   return line;
 }
 
@@ -429,6 +754,7 @@ void Server::Impl::DoStop() {
   beast::error_code ec;
   acceptor.close(ec);
   status_timer.cancel();
+  trim_timer.cancel();
   signals.cancel(ec);
   // Copy first: closing makes sessions end, and their destructors unregister.
   std::vector<std::shared_ptr<Session>> live;
@@ -466,7 +792,12 @@ int Server::port() const { return impl_->bound_port; }
 
 void Server::Run() {
   Impl& s = *impl_;
-  spdlog::info("listening on ws://{}:{} (any path)", s.options.bind_address, s.bound_port);
+  int threads = s.options.planning_threads;
+  if (threads == 0) {
+    threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 2, 8);
+  }
+  spdlog::info("listening on ws://{}:{} (any path), {} planning threads, at most {} connections",
+               s.options.bind_address, s.bound_port, threads, s.options.max_connections);
   if (s.options.handle_signals) {
     s.signals.add(SIGINT);
     s.signals.add(SIGTERM);
@@ -476,9 +807,11 @@ void Server::Run() {
       s.DoStop();
     });
   }
+  s.pool.Start(threads);
   s.Accept();
   s.ScheduleStatus();
   s.io.run();
+  s.pool.Stop();
   if (s.options.status_interval > 0) s.LogStatus();
   spdlog::info("server stopped");
 }

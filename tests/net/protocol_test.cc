@@ -17,6 +17,9 @@ namespace {
 
 using nlohmann::json;
 using testing::FirstTelemetryFrame;
+using testing::FrameWithJunk;
+using testing::FrameWithPath;
+using testing::FrameWithRows;
 using testing::kFirstTelemetryJson;
 
 std::string Frame(const json& payload) { return "42[\"telemetry\"," + payload.dump() + "]"; }
@@ -307,50 +310,6 @@ TEST(ProtocolTest, ManyBadRowsStillGiveAShortMessage) {
   EXPECT_EQ(p.telemetry.sensor_fusion.size(), 12u);
   EXPECT_NE(p.error.find("and 49 more"), std::string::npos) << p.error;
   EXPECT_LT(p.error.size(), 200u);
-}
-
-// A row the simulator could send, for frames of any size.
-std::string SensorRow(int id) {
-  std::string row = "[";
-  row += std::to_string(id);
-  row += ",1056.788,1164.296,37.39919,15.43803,275.7777,5.999895]";
-  return row;
-}
-
-std::string FrameWithRows(int rows) {
-  std::string f = R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,)"
-                  R"("d":6.164833,"previous_path_x":[],"previous_path_y":[],"end_path_s":0,)"
-                  R"("end_path_d":0,"sensor_fusion":[)";
-  for (int i = 0; i < rows; ++i) {
-    if (i > 0) f += ',';
-    f += SensorRow(i);
-  }
-  return f + "]}]";
-}
-
-std::string FrameWithPath(int points) {
-  std::string xs, ys;
-  for (int i = 0; i < points; ++i) {
-    if (i > 0) {
-      xs += ',';
-      ys += ',';
-    }
-    xs += std::to_string(900 + i);
-    ys += "1128.671";
-  }
-  return R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,"d":6.164833,)"
-         R"("previous_path_x":[)" +
-         xs + R"(],"previous_path_y":[)" + ys +
-         R"(],"end_path_s":0,"end_path_d":0,"sensor_fusion":[]}])";
-}
-
-// A telemetry frame with `junk` as the value of an extra field.
-std::string FrameWithJunk(const std::string& junk) {
-  return R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,"d":6.164833,)"
-         R"("junk":)" +
-         junk +
-         R"(,"previous_path_x":[],"previous_path_y":[],"end_path_s":0,)"
-         R"("end_path_d":0,"sensor_fusion":[]}])";
 }
 
 void ExpectRefused(const ParsedFrame& p, const std::string& mentions) {
