@@ -9,6 +9,8 @@
 
 #include <malloc.h>
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <boost/asio/ip/tcp.hpp>
@@ -59,6 +61,9 @@ Status ServerOptions::Validate() const {
   if (!std::isfinite(write_timeout) || write_timeout <= 0) {
     return Status::Error("write timeout: must be a finite number of seconds > 0");
   }
+  if (!std::isfinite(max_read_bytes_per_second) || max_read_bytes_per_second < 0) {
+    return Status::Error("max read bytes per second: must be a finite number >= 0 (0 = no limit)");
+  }
   if (max_logged_problems < 0) return Status::Error("max logged problems: must be >= 0");
   if (max_connections < 1 || max_connections > 10000) {
     return Status::Error("max connections: " + std::to_string(max_connections) +
@@ -103,19 +108,50 @@ constexpr auto kRefusalTimeout = std::chrono::seconds(2);
 constexpr int kRefusalsPerConnection = 4;
 // Refusals logged per status interval; the rest are counted in the status line.
 constexpr int kLoggedRefusals = 5;
-// The half-life-like time constant of a session's planning usage (pool priority).
+// The time constant of a session's planning usage (pool priority), s.
 constexpr double kUsageTau = 1.0;
-// Memory given back to the system after planners are freed, at most this often.
-constexpr auto kTrimDelay = std::chrono::milliseconds(100);
+// Usage (s of work over ~kUsageTau) beyond which a session's work is heavy: a quarter of a
+// core. A simulator at 50 frames/s of ~1 ms each uses ~0.05.
+constexpr double kHeavyUsage = 0.25;
+// A session's first plans, counted as heavy work whatever its usage.
+constexpr int kYoungPlans = 10;
+// The niceness of the threads that run heavy work.
+constexpr int kHeavyNice = 5;
+// Memory is given back to the system once no connection has closed for this long: under churn
+// the freed planners' memory is reused by the next ones.
+constexpr auto kTrimDelay = std::chrono::milliseconds(500);
 
-// Runs queued sessions' work on a few threads; picks the waiting session with the least decayed
-// planning time (ties: the first queued).
+// A session's recent planning time, for the pool's choice: seconds of work, decayed with
+// kUsageTau. Read and written under the pool's lock only.
+struct Usage {
+  double seconds = 0;
+  Clock::time_point at = Clock::now();
+
+  double Now(Clock::time_point now) const {
+    const double age = std::chrono::duration<double>(now - at).count();
+    return seconds * std::exp(-std::max(0.0, age) / kUsageTau);
+  }
+};
+
+// Runs queued work on a few threads. It takes the waiting work of the session with the least
+// recent planning time (ties: the first queued). Heavy work (a session that has used more than
+// kHeavyUsage lately, building a planner, a session's first plans, giving memory back) never
+// runs on the first thread, kept for light work, and runs at a lower priority: a well-paced
+// session's frame waits for at most one light frame to finish, however many connections flood
+// or churn.
 class PlanningPool {
  public:
   using Work = std::function<void()>;
+  // Drops a session's reference once its work ran; the server drops it on the I/O thread, so
+  // that a session is never destroyed on a planning thread.
+  using Release = std::function<void(std::shared_ptr<void>)>;
 
-  void Start(int threads) {
-    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Loop(); });
+  void Start(int threads, Release release) {
+    release_ = std::move(release);
+    has_light_thread_ = threads > 1;
+    for (int i = 0; i < threads; ++i) {
+      threads_.emplace_back([this, light = has_light_thread_ && i == 0] { Loop(light); });
+    }
   }
   // Stops the threads after the work in hand; queued work is dropped. Idempotent.
   void Stop() {
@@ -130,59 +166,82 @@ class PlanningPool {
   }
   ~PlanningPool() { Stop(); }
 
-  // Queues `work` for the session whose usage slot is `usage` (owned by the session, read and
-  // written only under the pool's lock). `keep` holds the session alive until the work ran.
-  void Submit(double* usage, Clock::time_point* usage_at, std::shared_ptr<void> keep, Work work) {
+  // Queues `work` for the session whose usage is *usage (owned by the session; `keep` holds it
+  // alive until the work ran); `heavy` when the work is known to be long (a planner to build).
+  void Submit(Usage* usage, bool heavy, std::shared_ptr<void> keep, Work work) {
     {
       std::lock_guard lock(mutex_);
       if (stopping_) return;
-      queue_.push_back({usage, usage_at, std::move(keep), std::move(work)});
+      // Classified once, when queued: a class that changed while the work waits (the usage
+      // decays) could leave it to a thread that is not looking.
+      heavy = heavy || usage->Now(Clock::now()) > kHeavyUsage;
+      queue_.push_back({usage, heavy, std::move(keep), std::move(work)});
     }
-    cv_.notify_one();
+    cv_.notify_all();  // not every thread takes every work
   }
+  // Heavy work of no session (its usage is the pool's own).
+  void SubmitHeavy(Work work) { Submit(&own_usage_, true, nullptr, std::move(work)); }
 
  private:
   struct Item {
-    double* usage;
-    Clock::time_point* usage_at;
+    Usage* usage;
+    bool heavy;
     std::shared_ptr<void> keep;
     Work work;
   };
 
-  static double Decayed(const Item& item, Clock::time_point now) {
-    const double age = std::chrono::duration<double>(now - *item.usage_at).count();
-    return *item.usage * std::exp(-std::max(0.0, age) / kUsageTau);
+  // The queued item to run next (queue_.end() when none may run now).
+  // The queued item a thread runs next (queue_.end() when none is for it now). The light
+  // thread takes only light work; the others take any, light work only while the light thread
+  // is busy.
+  std::deque<Item>::iterator Pick(Clock::time_point now, bool light_thread) {
+    auto best = queue_.end();
+    double best_usage = 0;
+    for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+      if (light_thread ? it->heavy : !it->heavy && has_light_thread_ && !light_busy_) continue;
+      const double u = it->usage->Now(now);
+      if (best == queue_.end() || u < best_usage) {
+        best = it;
+        best_usage = u;
+      }
+    }
+    return best;
   }
 
-  void Loop() {
+  void Loop(bool light_thread) {
+    // Heavy work runs at a lower priority than the light thread and the I/O thread: when the
+    // machine is short of cores, floods and churn wait, not the simulators (nice is per thread
+    // on Linux; failing to set it is harmless).
+    if (has_light_thread_ && !light_thread) {
+      (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kHeavyNice);
+    }
     for (;;) {
       Item item;
       {
         std::unique_lock lock(mutex_);
-        cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+        auto next = queue_.end();
+        cv_.wait(lock, [&] {
+          if (stopping_) return true;
+          next = Pick(Clock::now(), light_thread);
+          return next != queue_.end();
+        });
         if (stopping_) return;
-        const Clock::time_point now = Clock::now();
-        auto best = queue_.begin();
-        double best_usage = Decayed(*best, now);
-        for (auto it = std::next(queue_.begin()); it != queue_.end(); ++it) {
-          const double u = Decayed(*it, now);
-          if (u < best_usage) {
-            best = it;
-            best_usage = u;
-          }
-        }
-        item = std::move(*best);
-        queue_.erase(best);
+        item = std::move(*next);
+        queue_.erase(next);
+        if (light_thread) light_busy_ = true;
       }
       const Clock::time_point start = Clock::now();
       item.work();
       const Clock::time_point end = Clock::now();
       {
         std::lock_guard lock(mutex_);
-        *item.usage = Decayed(item, end) + std::chrono::duration<double>(end - start).count();
-        *item.usage_at = end;
+        item.usage->seconds =
+            item.usage->Now(end) + std::chrono::duration<double>(end - start).count();
+        item.usage->at = end;
+        if (light_thread) light_busy_ = false;
       }
-      item.keep.reset();  // may destroy the session: outside the lock
+      if (light_thread) cv_.notify_all();  // light work left to the others goes back to it
+      if (item.keep) release_(std::move(item.keep));
     }
   }
 
@@ -190,6 +249,10 @@ class PlanningPool {
   std::condition_variable cv_;
   std::deque<Item> queue_;
   bool stopping_ = false;
+  bool has_light_thread_ = false;  // set before the threads start
+  bool light_busy_ = false;
+  Usage own_usage_;
+  Release release_;
   std::vector<std::thread> threads_;
 };
 
@@ -213,7 +276,6 @@ struct Server::Impl {
   bool stopping = false;  // I/O thread only
   int live_sessions = 0;  // upgrading or upgraded; I/O thread only
   int refusing = 0;       // 503 answers in progress; I/O thread only
-  bool trim_pending = false;
 
   mutable std::mutex mutex;  // guards stats, interval and logged_refusals
   ServerStats stats;
@@ -238,7 +300,12 @@ namespace {
 class Session : public std::enable_shared_from_this<Session> {
  public:
   Session(Server::Impl* server, int id, tcp::socket socket)
-      : server_(server), id_(id), ws_(std::move(socket)), write_timer_(server->io) {
+      : server_(server),
+        id_(id),
+        ws_(std::move(socket)),
+        write_timer_(server->io),
+        read_timer_(server->io),
+        read_tokens_(static_cast<double>(server->options.max_frame_bytes)) {
     beast::error_code ec;
     const auto remote = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
     peer_ = ec ? std::string("?") : remote.address().to_string() + ":" +
@@ -246,10 +313,8 @@ class Session : public std::enable_shared_from_this<Session> {
     ++server_->live_sessions;
   }
 
-  ~Session() {
-    server_->sessions.erase(id_);
-    --server_->live_sessions;
-  }
+  // Its place is given up in End() (or when the upgrade fails), on the I/O thread: the last
+  // reference may go anywhere.
 
   void Start() {
     server_->sessions[id_] = weak_from_this();
@@ -297,6 +362,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void OnAccept(beast::error_code ec) {
     if (ec) {
       spdlog::warn("session {} from {}: WebSocket upgrade failed: {}", id_, peer_, ec.message());
+      ended_ = true;
+      Forget();
       return;
     }
     {
@@ -306,7 +373,34 @@ class Session : public std::enable_shared_from_this<Session> {
     }
     upgraded_ = true;
     spdlog::info("session {} from {}: connected", id_, peer_);
+    read_refill_ = Clock::now();
     DoRead();
+  }
+
+  // Reads the next frame once the byte budget allows (ServerOptions::max_read_bytes_per_second,
+  // a bucket of max_frame_bytes): a client that sends megabytes as fast as it can is read at
+  // that rate, and the I/O thread's time goes to the others.
+  void ReadNext() {
+    const double rate = server_->options.max_read_bytes_per_second;
+    if (rate <= 0) {
+      DoRead();
+      return;
+    }
+    const Clock::time_point now = Clock::now();
+    read_tokens_ =
+        std::min(static_cast<double>(server_->options.max_frame_bytes),
+                 read_tokens_ + rate * std::chrono::duration<double>(now - read_refill_).count());
+    read_refill_ = now;
+    if (read_tokens_ >= 0) {
+      DoRead();
+      return;
+    }
+    read_timer_.expires_after(
+        std::chrono::microseconds(static_cast<std::int64_t>(-read_tokens_ / rate * 1e6) + 1));
+    read_timer_.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (ec || self->closing_ || self->server_->stopping) return;
+      self->ReadNext();
+    });
   }
 
   void DoRead() {
@@ -321,6 +415,7 @@ class Session : public std::enable_shared_from_this<Session> {
       return;
     }
     ++frames_;
+    read_tokens_ -= static_cast<double>(buffer_.size());
     if (!ws_.got_text()) {
       {
         std::lock_guard lock(server_->mutex);
@@ -328,28 +423,50 @@ class Session : public std::enable_shared_from_this<Session> {
       }
       Problem("binary frame of " + std::to_string(buffer_.size()) + " bytes ignored");
       FrameDone();
-      DoRead();
+      ReadNext();
       return;
     }
     const std::string_view frame = Frame();
     if (frame.substr(0, 2) != "42") {
       // engine.io packets need no JSON: answered (or not) here, without a trip to the pool.
-      Finish(Handle(frame));
+      ParsedFrame parsed = ParseFrame(frame, server_->options.frame_limits);
+      Finish(Handle(parsed));
       return;
     }
     // The buffer is left alone until the work is done: no read is pending meanwhile.
-    {
-      std::lock_guard lock(server_->mutex);
-      ++server_->stats.waiting_frames;
-    }
-    server_->pool.Submit(&usage_, &usage_at_, shared_from_this(), [this] {
-      {
-        std::lock_guard lock(server_->mutex);
-        --server_->stats.waiting_frames;
+    Waiting(+1);
+    // A session without a planner yet builds it first: heavy work (~20 ms) of its own, after
+    // which the frame is planned in its turn. A young session's first plans are heavy work
+    // too (a new planner's caches are cold): connections that come, plan and go cannot take
+    // the thread kept for established ones.
+    server_->pool.Submit(&usage_, /*heavy=*/Young(), shared_from_this(), [this] {
+      Waiting(-1);
+      auto parsed =
+          std::make_shared<ParsedFrame>(ParseFrame(Frame(), server_->options.frame_limits));
+      if (parsed->kind == FrameKind::kTelemetry && !planner_ && EnsurePlanner()) {
+        Waiting(+1);
+        server_->pool.Submit(&usage_, /*heavy=*/true, shared_from_this(), [this, parsed] {
+          Waiting(-1);
+          Done(Handle(*parsed));
+        });
+        return;
       }
-      const bool answer = Handle(Frame());
-      asio::post(server_->io, [self = shared_from_this(), answer] { self->Finish(answer); });
+      Done(Handle(*parsed));
     });
+  }
+
+  // Whether this session has yet to build its planner or to plan kYoungPlans frames. Read on
+  // the I/O thread between frames (the pool hands the session back through a post).
+  bool Young() const { return planner_ == nullptr || plans_ < kYoungPlans; }
+
+  void Waiting(int change) {
+    std::lock_guard lock(server_->mutex);
+    server_->stats.waiting_frames += change;
+  }
+
+  // On a planning thread: the frame was handled; the I/O thread takes over.
+  void Done(bool answer) {
+    asio::post(server_->io, [self = shared_from_this(), answer] { self->Finish(answer); });
   }
 
   std::string_view Frame() const {
@@ -370,7 +487,7 @@ class Session : public std::enable_shared_from_this<Session> {
       return;
     }
     if (!answer) {
-      DoRead();
+      ReadNext();
       return;
     }
     ws_.text(true);
@@ -393,7 +510,7 @@ class Session : public std::enable_shared_from_this<Session> {
                         self->End(ec);
                         return;
                       }
-                      self->DoRead();
+                      self->ReadNext();
                     });
   }
 
@@ -419,8 +536,8 @@ class Session : public std::enable_shared_from_this<Session> {
 
   // Fills reply_ and returns true when the frame needs an answer. On a planning thread for 42
   // frames (the I/O thread leaves this session alone meanwhile), on the I/O thread otherwise.
-  bool Handle(std::string_view frame) {
-    ParsedFrame parsed = ParseFrame(frame, server_->options.frame_limits);
+  // Telemetry is planned with the session's planner (built here if need be).
+  bool Handle(const ParsedFrame& parsed) {
     ServerStats& st = server_->stats;
     switch (parsed.kind) {
       case FrameKind::kTelemetry:
@@ -475,6 +592,7 @@ class Session : public std::enable_shared_from_this<Session> {
   // when the factory fails.
   bool EnsurePlanner() {
     if (planner_) return true;
+    if (close_connection_) return false;  // the factory failed already
     std::string why = "the planner factory returned nothing";
     try {
       planner_ = server_->factory();
@@ -498,6 +616,7 @@ class Session : public std::enable_shared_from_this<Session> {
       reply_ = kManualFrame;
       return true;
     }
+    ++plans_;
     const auto start = Clock::now();
     const plan::PlanResult* result = nullptr;
     try {  // Plan() never throws by contract; a planner that does must not take the server down.
@@ -549,9 +668,17 @@ class Session : public std::enable_shared_from_this<Session> {
     ++problems_;
   }
 
+  // I/O thread, once: the session no longer counts against max_connections nor gets closed by
+  // Stop().
+  void Forget() {
+    server_->sessions.erase(id_);
+    --server_->live_sessions;
+  }
+
   void End(beast::error_code ec) {
     if (ended_) return;
     ended_ = true;
+    Forget();
     if (ec == websocket::error::message_too_big) {
       {
         std::lock_guard lock(server_->mutex);
@@ -583,6 +710,7 @@ class Session : public std::enable_shared_from_this<Session> {
       --server_->stats.open_connections;
     }
     write_timer_.cancel();
+    read_timer_.cancel();
     Close();
     // No work is in the pool (End runs only between frames): the planner can go now, and its
     // memory back to the system.
@@ -596,13 +724,16 @@ class Session : public std::enable_shared_from_this<Session> {
   int id_;
   websocket::stream<beast::tcp_stream> ws_;
   asio::steady_timer write_timer_;
+  asio::steady_timer read_timer_;
+  double read_tokens_;  // bytes that may be read now (negative: owed)
+  Clock::time_point read_refill_;
   std::unique_ptr<plan::Planner> planner_;
   beast::flat_buffer buffer_;
   std::string reply_;
   std::string peer_;
-  double usage_ = 0;  // pool priority: decayed planning seconds (the pool's lock guards them)
-  Clock::time_point usage_at_ = Clock::now();
+  Usage usage_;  // pool priority (the pool's lock guards it)
   std::int64_t frames_ = 0;
+  std::int64_t plans_ = 0;  // Plan() calls (planning thread; read between frames)
   int problems_ = 0;
   bool upgraded_ = false;
   bool closing_ = false;
@@ -696,14 +827,15 @@ void Server::Impl::Refuse(tcp::socket socket, int id) {
 }
 
 void Server::Impl::ScheduleTrim() {
-  if (trim_pending || stopping) return;
-  trim_pending = true;
+  if (stopping) return;
+  // Each close pushes the trim back: it runs once connections have stopped closing for a while.
   trim_timer.expires_after(kTrimDelay);
   trim_timer.async_wait([this](beast::error_code ec) {
-    trim_pending = false;
+    if (ec || stopping) return;
     // glibc keeps freed memory in its arenas (one per planning thread) unless asked; a planner
-    // is several MB, so without this churn would only ever grow the resident set.
-    if (!ec) malloc_trim(0);
+    // is several MB, so without this churn would only ever grow the resident set. Walking the
+    // arenas takes a while: heavy work on a planning thread, not on the I/O thread.
+    pool.SubmitHeavy([] { malloc_trim(0); });
   });
 }
 
@@ -751,6 +883,8 @@ std::string Server::Impl::StatusLine() {
 void Server::Impl::DoStop() {
   if (stopping) return;
   stopping = true;
+  // Queued work is dropped (and the sessions it holds with it); the work in hand finishes.
+  pool.Stop();
   beast::error_code ec;
   acceptor.close(ec);
   status_timer.cancel();
@@ -807,7 +941,9 @@ void Server::Run() {
       s.DoStop();
     });
   }
-  s.pool.Start(threads);
+  s.pool.Start(threads, [&s](std::shared_ptr<void> session) {
+    asio::post(s.io, [session = std::move(session)] {});
+  });
   s.Accept();
   s.ScheduleStatus();
   s.io.run();

@@ -159,6 +159,13 @@ class GatedPlanner : public FakePlanner {
   std::atomic<int> in_plan_{0};
 };
 
+// Releases the gate when it goes: declared after the server, it goes first, so a failed test
+// does not leave a planning thread blocked while the server waits for it to stop.
+struct ReleaseAtEnd {
+  Gate* gate;
+  ~ReleaseAtEnd() { gate->Release(); }
+};
+
 PlannerFactory GatedFactory(Gate* gate) {
   return
       [gate]() -> std::unique_ptr<plan::Planner> { return std::make_unique<GatedPlanner>(gate); };
@@ -170,16 +177,51 @@ TEST(AbuseTest, NoConnectionWaitsForAnothersPlanner) {
   ServerOptions options;
   options.planning_threads = 2;
   TestServer server(options, GatedFactory(&gate));
+  ReleaseAtEnd release{&gate};
   TestClient stuck;
   ASSERT_TRUE(stuck.Connect(server.port()));
-  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(Gate::kBlockX, 0)));
+  for (int k = 1; k <= 12; ++k) {  // an established connection...
+    ASSERT_TRUE(IsControlFor(stuck.Exchange(TelemetryFrameAt(5, 0)), 5, 0, k));
+  }
+  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(Gate::kBlockX, 0)));  // ...whose planner stalls
   ASSERT_TRUE(Eventually([&] {
     std::lock_guard lock(gate.mutex);
     return gate.blocked;
   }));
   EXPECT_EQ(WellBehavedRun(server.port(), 30, 10), 30) << "answered while the other is stuck";
   gate.Release();
-  EXPECT_TRUE(IsControlFor(stuck.Receive(), Gate::kBlockX, 0, 1));
+  EXPECT_TRUE(IsControlFor(stuck.Receive(), Gate::kBlockX, 0, 13));
+}
+
+// Heavy work (building planners, a connection's first plans, a connection that uses more than
+// a quarter of a core) never takes the last planning thread: connections that come, plan and
+// go, or flood, cannot hold up an established one, even when their work stalls.
+TEST(AbuseTest, HeavyWorkLeavesAThreadForEstablishedConnections) {
+  Gate gate;
+  ServerOptions options;
+  options.planning_threads = 2;
+  TestServer server(options, GatedFactory(&gate));
+  ReleaseAtEnd release{&gate};
+  TestClient established, young, younger;
+  ASSERT_TRUE(established.Connect(server.port()) && young.Connect(server.port()) &&
+              younger.Connect(server.port()));
+  for (int k = 1; k <= 12; ++k) {
+    ASSERT_TRUE(IsControlFor(established.Exchange(TelemetryFrameAt(3, 0)), 3, 0, k));
+  }
+  ASSERT_FALSE(young.Send(TelemetryFrameAt(Gate::kBlockX, 0)));  // its first plan stalls
+  ASSERT_TRUE(Eventually([&] {
+    std::lock_guard lock(gate.mutex);
+    return gate.blocked;
+  }));
+  ASSERT_FALSE(younger.Send(TelemetryFrameAt(8, 0)));
+  ASSERT_TRUE(Eventually([&] { return server.server().stats().waiting_frames == 1; }));
+  for (int k = 13; k <= 30; ++k) {  // the kept thread answers the established connection...
+    ASSERT_TRUE(IsControlFor(established.Exchange(TelemetryFrameAt(3, 0)), 3, 0, k));
+  }
+  EXPECT_EQ(server.server().stats().waiting_frames, 1) << "...but not a young one";
+  gate.Release();
+  EXPECT_TRUE(IsControlFor(young.Receive(), Gate::kBlockX, 0, 1));
+  EXPECT_TRUE(IsControlFor(younger.Receive(), 8, 0, 1));
 }
 
 // With every planning thread taken, the waiting connection that has planned least lately goes
@@ -189,6 +231,7 @@ TEST(AbuseTest, ThePoolServesTheLeastBusyConnectionFirst) {
   ServerOptions options;
   options.planning_threads = 1;
   TestServer server(options, GatedFactory(&gate));
+  ReleaseAtEnd release{&gate};
   TestClient busy, stuck, fresh;
   ASSERT_TRUE(busy.Connect(server.port()) && stuck.Connect(server.port()) &&
               fresh.Connect(server.port()));
@@ -216,6 +259,7 @@ TEST(AbuseTest, PipelinedFramesAreAnsweredOneEachInOrder) {
   ServerOptions options;
   options.planning_threads = 4;
   TestServer server(options, GatedFactory(&gate));
+  ReleaseAtEnd release{&gate};
   RawSocket s = ConnectUpgraded(server.port());
   ASSERT_TRUE(s.ok());
   constexpr int kFrames = 40;
@@ -448,6 +492,39 @@ TEST(AbuseTest, ChurnLeavesNothingBehind) {
   EXPECT_TRUE(Eventually([&] { return server.server().stats().open_connections == 0; }));
   EXPECT_TRUE(Eventually([&] { return server.planners_made == planned; }));
   EXPECT_EQ(WellBehavedRun(server.port(), 20, 3), 20);
+}
+
+// Connections that come, plan once and go from several threads at once: each ends while its
+// last work may still be finishing on a planning thread (a session must then not be destroyed
+// there, under the I/O thread's feet). Every exchange is answered, the server stays up.
+TEST(AbuseTest, ParallelChurnIsAnsweredAndLeavesNothingBehind) {
+  ServerOptions options;
+  options.max_connections = 8;
+  TestServer server(options);
+  constexpr int kThreads = 6, kCycles = 60;
+  std::atomic<int> answered{0}, refused{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kThreads; ++i) {
+    threads.emplace_back([&, i] {
+      const std::string close = EncodeCloseFrame(1000, "", /*mask=*/true);
+      for (int k = 0; k < kCycles; ++k) {
+        RawSocket s = ConnectUpgraded(server.port());
+        if (!s.ok()) {
+          ++refused;  // at the cap for a moment: fine
+          continue;
+        }
+        s.WriteAll(ClientText(TelemetryFrameAt(100 * i + k, 1)));
+        const auto reply = ReadRawFrame(s);
+        if (reply.has_value() && IsControlFor(reply->payload, 100 * i + k, 1, 1)) ++answered;
+        if (k % 2 == 0) s.WriteAll(close);  // half close cleanly, half just drop
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(answered + refused, kThreads * kCycles);
+  EXPECT_GT(answered, kThreads * kCycles / 2);
+  EXPECT_TRUE(Eventually([&] { return server.server().stats().open_connections == 0; }));
+  EXPECT_EQ(WellBehavedRun(server.port(), 10, 1), 10);
 }
 
 // Resident memory of this process, bytes (/proc/self/statm).

@@ -20,7 +20,8 @@
 // A connection silent for 150 s gets a WebSocket ping and is closed after 300 s without any data
 // (Beast's suggested server timeouts), one whose upgrade takes over handshake_timeout or whose
 // reply cannot be written within write_timeout (the peer does not read) is closed, so stalled
-// connections do not hold their place.
+// connections do not hold their place. A connection is read at most max_read_bytes_per_second,
+// so megabyte frames sent back to back cost the I/O thread a bounded share of its time.
 #pragma once
 
 #include <cstddef>
@@ -55,6 +56,9 @@ struct ServerOptions {
   // Threads that convert frames and plan; 0 = one per core, at least 2 and at most 8.
   int planning_threads = 0;
   double write_timeout = 10.0;  // s a reply may take to be written before the connection closes
+  // Bytes a connection is read at, on average (bursts up to max_frame_bytes); 0 = no limit.
+  // A simulator sends ~0.3 MB/s, `drive --connect` up to ~10 MB/s.
+  double max_read_bytes_per_second = 16 << 20;
   FrameLimits frame_limits;     // sensor_fusion rows and path points a telemetry frame may hold
 
   Status Validate() const;  // a message naming the bad option
