@@ -10,8 +10,10 @@
 #   --seconds     length of each latency run (default: 20)
 #   --only        a comma-separated subset of: none,flood,pipeline,huge,dense,churn,refuse,rss
 #   --taskset S:C run the server on CPU list S and the clients on CPU list C (e.g. 0:1)
-#   --nice N      run the server and the clients at this niceness (e.g. -19 on a machine that
-#                 other work keeps busy, to measure the server rather than the machine's load)
+#   --rt          run the server's I/O and light planning threads and the timed client under
+#                 SCHED_FIFO (chrt -f 1; the heavy planning threads and the abusers stay at the
+#                 normal policy): on a machine that other work keeps busy, the figures are then
+#                 the server's, not the machine's load
 #
 # Latency: a simulator-like client sends the telemetry of a recorded drive, one frame every
 # 20 ms, and times each reply (send to last byte) while max_connections - 1 = 7 other
@@ -27,7 +29,7 @@ map="$here/../shared/data/highway_map.csv"
 seconds=20
 only="none,flood,pipeline,huge,dense,churn,refuse,rss"
 server_cpus=""
-niceness=""
+rt=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --build-dir) build="${2:?}"; shift 2 ;;
@@ -35,8 +37,8 @@ while [[ $# -gt 0 ]]; do
     --seconds) seconds="${2:?}"; shift 2 ;;
     --only) only="${2:?}"; shift 2 ;;
     --taskset) server_cpus="${2:?}"; shift 2 ;;
-    --nice) niceness="${2:?}"; shift 2 ;;
-    -h|--help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --rt) rt=1; shift ;;
+    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "serve-abuse.sh: unknown argument $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -58,9 +60,9 @@ if [[ -n "$server_cpus" ]]; then
   server_pin=(taskset -c "${server_cpus%%:*}")
   client_pin=(taskset -c "${server_cpus#*:}")
 fi
-if [[ -n "$niceness" ]]; then
-  server_pin=(nice -n "$niceness" "${server_pin[@]}")
-  client_pin=(nice -n "$niceness" "${client_pin[@]}")
+if [[ $rt -eq 1 ]]; then
+  server_pin=(chrt -f 1 "${server_pin[@]}")
+  client_pin=(chrt -f 1 "${client_pin[@]}")
 fi
 
 # The telemetry of a recorded drive (what a simulator would send), one frame per line.
@@ -96,7 +98,7 @@ stop_server() {
 rss_mb() { awk '/VmRSS/ {printf "%.1f", $2 / 1024}' "/proc/$server_pid/status"; }
 
 echo "# $(date -u +%FT%TZ) $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)," \
-  "map $(basename "$map"), nice ${niceness:-0}, taskset ${server_cpus:-none}"
+  "map $(basename "$map"), rt $rt, taskset ${server_cpus:-none}"
 for mode in ${only//,/ }; do
   case "$mode" in
     none|flood|pipeline|huge|dense|churn)

@@ -16,6 +16,8 @@
 // FILE holds one telemetry frame per line (42["telemetry",{...}]), replayed in order by every
 // client; without it a synthetic frame is used.
 #include <netinet/tcp.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <atomic>
@@ -184,9 +186,17 @@ void WellBehaved(const Args& a, const std::vector<std::string>& frames, Clock::t
   }
 }
 
+// Abusers run at the normal policy even when the tool runs under chrt (which then applies to
+// the timed client only).
+void Demote() {
+  const sched_param normal{};
+  (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+}
+
 // An abuser sending `frames` in turn; reads each reply unless `pipeline`.
 void Abuser(const Args& a, const std::vector<std::string>& frames, bool pipeline,
             Clock::time_point end, std::atomic<long>* sent) {
+  Demote();
   std::vector<std::string> masked;
   for (const std::string& f : frames) masked.push_back(Masked(f));
   t::RawSocket s = Open(a.port);
@@ -220,6 +230,7 @@ void Abuser(const Args& a, const std::vector<std::string>& frames, bool pipeline
 
 void Churner(const Args& a, const std::vector<std::string>& frames, Clock::time_point end,
              int max_cycles, std::atomic<long>* cycles) {
+  Demote();
   const std::string close = t::EncodeCloseFrame(1000, "", /*mask=*/true);
   for (long i = 0; Clock::now() < end && (max_cycles <= 0 || i < max_cycles); ++i) {
     t::RawSocket s = Open(a.port);

@@ -8,6 +8,8 @@
 #include "frenetic/net/server.h"
 
 #include <malloc.h>
+#include <pthread.h>
+#include <sched.h>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -213,6 +215,10 @@ class PlanningPool {
     // machine is short of cores, floods and churn wait, not the simulators (nice is per thread
     // on Linux; failing to set it is harmless).
     if (has_light_thread_ && !light_thread) {
+      // Also when the server runs under a real-time policy (chrt -f, to keep a busy machine's
+      // other work from delaying the simulator's replies): heavy work then stays out of it.
+      const sched_param normal{};
+      (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
       (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kHeavyNice);
     }
     for (;;) {
