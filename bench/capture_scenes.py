@@ -21,6 +21,7 @@ Example (bench/scenes/README.md has the commands for every committed scene):
   bench/capture_scenes.py /tmp/dense.jsonl bench/scenes/dense_traffic.jsonl dense_traffic --at 25
 """
 import argparse
+import gzip
 import json
 import os
 import sys
@@ -49,7 +50,9 @@ def main():
         fail("--count must be >= 2")
 
     header, exchanges = None, []
-    with open(a.record) as f:
+    with open(a.record, "rb") as probe:  # `drive --record run.jsonl.gz` writes gzip
+        gzipped = probe.read(2) == b"\x1f\x8b"
+    with (gzip.open(a.record, "rt") if gzipped else open(a.record)) as f:
         for n, line in enumerate(f, 1):
             try:
                 j = json.loads(line)

@@ -10,7 +10,7 @@ JOBS="${FRENETIC_JOBS:-$(nproc)}"
 BUILD_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libnlopt-cxx-dev libceres-dev libboost-dev
-  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libpugixml-dev
+  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libpugixml-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev libopenmpi-dev openmpi-bin
 )
 

@@ -22,8 +22,9 @@ struct ReportArgs {
   bool json = false;
 };
 
-// RUN.jsonl -> RUN.html next to it.
-std::string DefaultOutput(const std::string& run) {
+// RUN.jsonl (or RUN.jsonl.gz) -> RUN.html next to it.
+std::string DefaultOutput(std::string run) {
+  if (run.size() > 3 && run.compare(run.size() - 3, 3, ".gz") == 0) run.resize(run.size() - 3);
   const size_t slash = run.find_last_of('/');
   const size_t dot = run.find_last_of('.');
   const bool has_extension = dot != std::string::npos && (slash == std::string::npos || dot > slash);
@@ -82,7 +83,8 @@ void RegisterReport(CLI::App& app) {
       "a top-down replay with the cycle's candidates, plots of speed, acceleration, jerk, lane,\n"
       "gap, headway, planning time and cost terms over time, per-cycle cost tables and the\n"
       "drive's summary. The page works offline (everything is inlined).");
-  sub->add_option("run", args->run, "The record, JSON lines (header, exchanges, footer)")
+  sub->add_option("run", args->run,
+                  "The record, JSON lines (header, exchanges, footer), plain or gzip-compressed")
       ->required();
   sub->add_option("-o,--output", args->output,
                   "The HTML file to write (default: RUN with the extension .html)");

@@ -87,6 +87,7 @@ void RegisterServe(CLI::App& app) {
       "Run the planner as a WebSocket server for the Udacity simulator (or `frenetic drive\n"
       "--connect`). Every 42[\"telemetry\",{...}] frame gets one 42[\"control\",{...}] reply from\n"
       "the connection's own planner; null telemetry and anything else get 42[\"manual\",{}].\n"
+      "Telemetry over 64 sensor_fusion rows or 1000 path points is refused (manual).\n"
       "Stops cleanly on SIGINT/SIGTERM.");
   sub->add_option("--port", args->server.port,
                   "TCP port to listen on; 0 picks a free one and prints it (default: 4567, the "
@@ -111,6 +112,15 @@ void RegisterServe(CLI::App& app) {
                   "Largest incoming WebSocket message in bytes; a larger one closes that "
                   "connection (default: 1048576 = 1 MiB; a real telemetry frame is ~2-5 kB)")
       ->check(CLI::Range(std::size_t{1024}, std::size_t{1} << 30));
+  sub->add_option("--max-connections", args->server.max_connections,
+                  "Connections open at once (upgrading or upgraded); one more is answered HTTP "
+                  "503 with the reason and closed (default: 8, room for a few simulators)")
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--planning-threads", args->server.planning_threads,
+                  "Threads that convert frames and plan, shared by all connections (each "
+                  "connection's planner is used by one thread at a time); 0 = one per core, at "
+                  "least 2 and at most 8 (default: 0)")
+      ->check(CLI::Range(0, 256));
   sub->add_flag("--no-deadlines", args->no_deadlines,
                 "Switch the planner's wall-clock deadlines (budget_ms, refine.budget_ms) off, as "
                 "frenetic drive does, so every cycle searches and refines in full however long it "

@@ -44,33 +44,92 @@ class Problems {
 
 const char* TypeName(const json& j) { return j.type_name(); }
 
-// Bracket depth of the JSON text, skipping strings. Cheap pre-check before the real parse.
-bool DepthWithin(std::string_view text, int max_depth) {
-  int depth = 0;
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\') {
-        ++i;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > max_depth) return false;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return true;
+// What the linear pre-scan of a frame's JSON text found wrong; empty when nothing.
+struct Scan {
+  bool too_deep = false;  // malformed: no real frame nests that deep
+  std::string refused;    // over the limits: why
+};
+
+std::string LimitsText(const FrameLimits& limits) {
+  return "limits: " + std::to_string(limits.max_sensor_rows) + " sensor_fusion rows, " +
+         std::to_string(limits.max_path_points) + " path points";
 }
 
-// Parses the JSON after a "42" prefix; a discarded value on any syntax error.
-json ParseJson(std::string_view text, std::string* error) {
-  if (!DepthWithin(text, kMaxDepth)) {
+// One pass over the text (strings skipped by their quotes) that bounds what the JSON parser will
+// be given: nesting depth and, with limits, separators (so values), string and token lengths.
+// It stops at the first excess, so a hostile frame costs at most one read of its bytes.
+Scan ScanFrame(std::string_view text, const FrameLimits* limits) {
+  Scan scan;
+  constexpr std::size_t kUnlimited = std::numeric_limits<std::size_t>::max();
+  std::size_t max_separators = kUnlimited, max_string = kUnlimited, max_token = kUnlimited;
+  if (limits != nullptr) {
+    max_separators = 2 * static_cast<std::size_t>(limits->max_path_points) +
+                     8 * static_cast<std::size_t>(limits->max_sensor_rows) + 64;
+    max_string = kMaxFrameStringBytes;
+    max_token = kMaxFrameTokenBytes;
+    // Room for every value at its longest, with a separator and some indentation each: more
+    // than this is padding (whitespace), which is otherwise unlimited.
+    const std::size_t max_bytes = (max_separators + 1) * (kMaxFrameTokenBytes + 16);
+    if (text.size() > max_bytes) {
+      scan.refused = std::to_string(text.size()) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " the limits allow (" + LimitsText(*limits) + ")";
+      return scan;
+    }
+  }
+  int depth = 0;
+  std::size_t separators = 0, token = 0;
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n;) {
+    const char c = text[i++];
+    if (c == '"') {
+      const std::size_t start = i;
+      while (i < n && text[i] != '"') {
+        i += text[i] == '\\' ? 2 : 1;
+        if (i - start > max_string) {
+          scan.refused = "a string of more than " + std::to_string(max_string) + " bytes";
+          return scan;
+        }
+      }
+      ++i;  // the closing quote (a truncated string is left to the parser to report)
+      token = 0;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxDepth) {
+        scan.too_deep = true;
+        return scan;
+      }
+      token = 0;
+    } else if (c == ']' || c == '}' || c == ':' || c == ' ' || c == '\n' || c == '\r' ||
+               c == '\t') {
+      if (c == ']' || c == '}') --depth;
+      token = 0;
+    } else if (c == ',') {
+      if (++separators > max_separators) {
+        scan.refused =
+            "more than " + std::to_string(max_separators) + " values (" + LimitsText(*limits) + ")";
+        return scan;
+      }
+      token = 0;
+    } else if (++token > max_token) {
+      scan.refused =
+          "a number or literal of more than " + std::to_string(max_token) + " characters";
+      return scan;
+    }
+  }
+  return scan;
+}
+
+// Parses the JSON after a "42" prefix; a discarded value on any syntax error, or when the scan
+// refuses it under `limits` (nullptr: depth only), which sets *refused.
+json ParseJson(std::string_view text, const FrameLimits* limits, std::string* error,
+               bool* refused) {
+  const Scan scan = ScanFrame(text, limits);
+  if (scan.too_deep) {
     *error = "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels";
+    return json(json::value_t::discarded);
+  }
+  if (!scan.refused.empty()) {
+    *refused = true;
+    *error = "frame refused unread: " + scan.refused;
     return json(json::value_t::discarded);
   }
   // The exception is caught at once: its message locates the problem (column, token).
@@ -190,7 +249,7 @@ bool ReadSensorRow(const json& row, plan::SensorCar* car, std::string* why) {
   return true;
 }
 
-void ParseTelemetry(const json& payload, ParsedFrame* out) {
+void ParseTelemetry(const json& payload, const FrameLimits& limits, ParsedFrame* out) {
   Problems fatal;
   plan::Telemetry& t = out->telemetry;
   double yaw_deg = 0, speed_mph = 0;
@@ -211,6 +270,21 @@ void ParseTelemetry(const json& payload, ParsedFrame* out) {
     out->telemetry = plan::Telemetry();
     return;
   }
+  // More than the limits is refused whole: cutting rows could drop the car ahead, and no
+  // simulator sends that many.
+  const auto over = [&](const char* what, std::size_t n, int limit) {
+    out->kind = FrameKind::kRefused;
+    out->error = std::string("telemetry.") + what + ": " + std::to_string(n) +
+                 (what[0] == 's' ? " rows" : " points") + ", over the limit of " +
+                 std::to_string(limit) + "; frame refused";
+    out->telemetry = plan::Telemetry();
+  };
+  const auto max_points = static_cast<std::size_t>(limits.max_path_points);
+  if (rows->size() > static_cast<std::size_t>(limits.max_sensor_rows)) {
+    return over("sensor_fusion", rows->size(), limits.max_sensor_rows);
+  }
+  if (xs->size() > max_points) return over("previous_path_x", xs->size(), limits.max_path_points);
+  if (ys->size() > max_points) return over("previous_path_y", ys->size(), limits.max_path_points);
   t.yaw = wire::YawFromDegrees(yaw_deg);
   t.speed = wire::SpeedFromMph(speed_mph);
   Problems repairs;
@@ -283,8 +357,9 @@ void AppendTelemetryJson(const plan::Telemetry& t, std::string* out) {
 
 // Splits a "42" frame into its event name and payload; false with *error when it is not
 // ["<name>", payload].
-bool SplitEvent(std::string_view frame, json* doc, std::string* event, std::string* error) {
-  *doc = ParseJson(frame.substr(2), error);
+bool SplitEvent(std::string_view frame, const FrameLimits* limits, json* doc, std::string* event,
+                std::string* error, bool* refused) {
+  *doc = ParseJson(frame.substr(2), limits, error, refused);
   if (doc->is_discarded()) return false;
   if (!doc->is_array() || doc->empty()) {
     *error = std::string("expected [\"<event>\", payload] after 42, got ") + TypeName(*doc);
@@ -335,6 +410,7 @@ const char* ToString(FrameKind kind) {
     case FrameKind::kPing: return "ping";
     case FrameKind::kIgnored: return "ignored";
     case FrameKind::kMalformed: return "malformed";
+    case FrameKind::kRefused: return "refused";
   }
   return "?";
 }
@@ -350,7 +426,19 @@ const char* ToString(ReplyKind kind) {
   return "?";
 }
 
-ParsedFrame ParseFrame(std::string_view frame) {
+Status FrameLimits::Validate() const {
+  if (max_sensor_rows < 1 || max_sensor_rows > 100000) {
+    return Status::Error("max sensor rows: " + std::to_string(max_sensor_rows) +
+                         " is not in [1, 100000]");
+  }
+  if (max_path_points < 1 || max_path_points > 1000000) {
+    return Status::Error("max path points: " + std::to_string(max_path_points) +
+                         " is not in [1, 1000000]");
+  }
+  return Status::Ok();
+}
+
+ParsedFrame ParseFrame(std::string_view frame, const FrameLimits& limits) {
   ParsedFrame out;
   if (frame.empty()) return out;
   if (frame.substr(0, 2) != "42") {
@@ -360,8 +448,9 @@ ParsedFrame ParseFrame(std::string_view frame) {
   }
   json doc;
   std::string event;
-  if (!SplitEvent(frame, &doc, &event, &out.error)) {
-    out.kind = FrameKind::kMalformed;
+  bool refused = false;
+  if (!SplitEvent(frame, &limits, &doc, &event, &out.error, &refused)) {
+    out.kind = refused ? FrameKind::kRefused : FrameKind::kMalformed;
     return out;
   }
   if (event != "telemetry") {
@@ -384,7 +473,7 @@ ParsedFrame ParseFrame(std::string_view frame) {
                 TypeName(doc[1]);
     return out;
   }
-  ParseTelemetry(doc[1], &out);
+  ParseTelemetry(doc[1], limits, &out);
   return out;
 }
 
@@ -440,7 +529,8 @@ void ParseReply(std::string_view frame, ParsedReply* out) {
   json doc;
   std::string event;
   out->kind = ReplyKind::kMalformed;
-  if (!SplitEvent(frame, &doc, &event, &out->error)) return;
+  bool refused = false;
+  if (!SplitEvent(frame, nullptr, &doc, &event, &out->error, &refused)) return;
   if (event == "manual") {
     out->kind = ReplyKind::kManual;
     return;

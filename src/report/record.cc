@@ -1,5 +1,7 @@
 #include "frenetic/report/record.h"
 
+#include <zlib.h>
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -7,9 +9,10 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
+#include <streambuf>
 #include <utility>
 
 namespace frenetic::report {
@@ -53,10 +56,74 @@ std::vector<double> Numbers(const json* a) {
   return out;
 }
 
+// The text of a gzip-compressed record (`drive --record run.jsonl.gz`), inflated as it is read.
+// Concatenated gzip members read as one text. Data that ends early or is corrupt ends the text
+// there; error() then says why.
+class GzipStreambuf : public std::streambuf {
+ public:
+  explicit GzipStreambuf(std::istream& in) : in_(in), in_buf_(256 << 10), out_buf_(256 << 10) {
+    // 15 window bits + 32: a gzip (or zlib) header, detected.
+    if (inflateInit2(&zs_, 15 + 32) != Z_OK) {
+      error_ = "cannot start inflating";
+      done_ = true;
+    }
+  }
+  ~GzipStreambuf() override { inflateEnd(&zs_); }
+  GzipStreambuf(const GzipStreambuf&) = delete;
+  GzipStreambuf& operator=(const GzipStreambuf&) = delete;
+
+  const std::string& error() const { return error_; }
+
+ protected:
+  int_type underflow() override {
+    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+    while (!done_) {
+      if (zs_.avail_in == 0) {
+        in_.read(in_buf_.data(), static_cast<std::streamsize>(in_buf_.size()));
+        const auto n = static_cast<uInt>(in_.gcount());
+        if (n == 0) {
+          if (!member_ended_) error_ = "the compressed data ends early (the drive was cut short?)";
+          done_ = true;
+          break;
+        }
+        zs_.next_in = reinterpret_cast<Bytef*>(in_buf_.data());
+        zs_.avail_in = n;
+      }
+      if (member_ended_) {  // another gzip member follows
+        inflateReset(&zs_);
+        member_ended_ = false;
+      }
+      zs_.next_out = reinterpret_cast<Bytef*>(out_buf_.data());
+      zs_.avail_out = static_cast<uInt>(out_buf_.size());
+      const int rc = inflate(&zs_, Z_NO_FLUSH);
+      const std::size_t produced = out_buf_.size() - zs_.avail_out;
+      if (rc == Z_STREAM_END) {
+        member_ended_ = true;
+      } else if (rc != Z_OK && rc != Z_BUF_ERROR) {
+        error_ =
+            std::string("corrupt compressed data (") + (zs_.msg ? zs_.msg : "zlib error") + ")";
+        done_ = true;
+      }
+      if (produced > 0) {
+        setg(out_buf_.data(), out_buf_.data(), out_buf_.data() + produced);
+        return traits_type::to_int_type(*gptr());
+      }
+    }
+    return traits_type::eof();
+  }
+
+ private:
+  std::istream& in_;
+  std::vector<char> in_buf_, out_buf_;
+  z_stream zs_{};
+  bool member_ended_ = false, done_ = false;
+  std::string error_;
+};
+
 class Reader {
  public:
-  Reader(std::string_view source, const ReadOptions& options)
-      : source_(source), options_(options) {}
+  Reader(std::string_view source, const ReadOptions& options, const GzipStreambuf* gzip)
+      : source_(source), options_(options), gzip_(gzip) {}
 
   StatusOr<RunData> Read(std::istream& in) {
     std::string line;
@@ -102,6 +169,14 @@ class Reader {
       }
     }
     if (in.bad()) return Status::Error(std::string(source_) + ": read error");
+    const std::string gzip_error = gzip_ != nullptr ? gzip_->error() : std::string();
+    if (!gzip_error.empty()) {
+      if (!have_header_ || run_.size() == 0) {
+        return Status::Error(std::string(source_) + ": " + gzip_error);
+      }
+      // What was read stays usable, as a record without its last lines.
+      run_.warnings.push_back("after line " + std::to_string(line_number) + ": " + gzip_error);
+    }
     if (!have_header_) return Status::Error(std::string(source_) + ": record has no header line");
     if (run_.size() == 0) return Status::Error(std::string(source_) + ": no usable exchange");
     for (auto& [exchange, cycle] : kept_) run_.candidate_cycles.push_back(std::move(cycle));
@@ -405,6 +480,7 @@ class Reader {
 
   std::string_view source_;
   ReadOptions options_;
+  const GzipStreambuf* gzip_;  // the decompressor of a gzip record, else null
   RunData run_;
   bool have_header_ = false;
   bool incident_now_ = false;
@@ -433,7 +509,13 @@ StatusOr<RunData> ReadRecord(std::istream& in, std::string_view source,
   }
   // nlohmann is used without exceptions; this only converts bad_alloc and the like at the edge.
   try {
-    return Reader(source, options).Read(in);
+    // 0x1f (the first byte of gzip's magic) cannot start a line of JSON text.
+    if (in.peek() == 0x1f) {
+      GzipStreambuf inflated(in);
+      std::istream text(&inflated);
+      return Reader(source, options, &inflated).Read(text);
+    }
+    return Reader(source, options, nullptr).Read(in);
   } catch (const std::exception& e) {
     return Status::Error(std::string(source) + ": " + e.what());
   }

@@ -2,16 +2,17 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
-#include <atomic>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "frenetic/net/protocol.h"
 #include "net/net_test_util.h"
+#include "net/raw_websocket.h"
 
 namespace frenetic::net {
 namespace {
@@ -233,6 +234,120 @@ TEST(ClientTest, SilentServerTimesOut) {
   const Status s = RunClient(UrlFor(server.port()), endpoint, options);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("no reply within the timeout"), std::string::npos) << s.message();
+}
+
+// A hostile server written with raw sockets: upgrades, reads the ping and the first telemetry,
+// then sends `bytes` and leaves the connection open (no TCP close) until the client is done;
+// with `replies`, reads and answers up to that many more frames first, each with `reply`.
+// Returns the client's status; *echo gets the next frame the client sent (if any).
+Status RunAgainstRawServer(const std::string& bytes, std::optional<testing::RawFrame>* echo,
+                           ClientStats* stats, ToyEndpoint* endpoint, ClientOptions options = {},
+                           int replies = 0, const std::string& reply = "") {
+  testing::RawListener listener;
+  EXPECT_GT(listener.port(), 0);
+  options.timeout = 5.0;  // far beyond what acting "at once" takes: the messages tell them apart
+  Status status;
+  std::thread client(
+      [&] { status = RunClient(UrlFor(listener.port()), *endpoint, options, stats); });
+  testing::RawSocket s = listener.Accept();
+  std::string request;
+  if (s.ok() && testing::AcceptUpgradeByHand(s, &request)) {
+    const auto ping = testing::ReadRawFrame(s);
+    const auto telemetry = testing::ReadRawFrame(s);
+    EXPECT_TRUE(ping.has_value() && telemetry.has_value());
+    s.WriteAll(bytes);
+    for (int i = 0; i < replies; ++i) {
+      const auto frame = testing::ReadRawFrame(s);
+      if (!frame.has_value() || frame->opcode != testing::kOpText) {
+        *echo = frame;
+        break;
+      }
+      s.WriteAll(testing::EncodeRawFrame(testing::kOpText, reply, /*mask=*/false));
+    }
+    if (!echo->has_value()) *echo = testing::ReadRawFrame(s, 5.0);
+  }
+  client.join();  // the socket stays open until the client has given up
+  return status;
+}
+
+std::string TextFrame(std::string_view payload) {
+  return testing::EncodeRawFrame(testing::kOpText, payload, /*mask=*/false);
+}
+
+TEST(ClientTest, ASecondReplyToOneFrameIsAProtocolError) {
+  // Two controls for the first telemetry, in one write: both are there when frame 2 is due.
+  std::optional<testing::RawFrame> echo;
+  ClientStats stats;
+  ToyEndpoint endpoint(10);
+  const Status s = RunAgainstRawServer(TextFrame(kGoodControl) + TextFrame(kGoodControl), &echo,
+                                       &stats, &endpoint);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("a second reply to frame 1 arrived before frame 2 was sent"),
+            std::string::npos)
+      << s.message();
+  EXPECT_EQ(stats.frames_sent, 1);
+  EXPECT_EQ(stats.controls, 1);
+  EXPECT_EQ(stats.protocol_errors, 1);
+  ASSERT_TRUE(echo.has_value());
+  EXPECT_EQ(echo->opcode, testing::kOpClose) << "frame 2 must not have been sent";
+}
+
+TEST(ClientTest, ASecondReplyIsDroppedAndCountedWhenContinuing) {
+  std::optional<testing::RawFrame> echo;
+  ClientStats stats;
+  ToyEndpoint endpoint(3);
+  ClientOptions options;
+  options.continue_on_protocol_error = true;
+  const Status s = RunAgainstRawServer(TextFrame(kGoodControl) + TextFrame(kManualFrame), &echo,
+                                       &stats, &endpoint, options, /*replies=*/2, kGoodControl);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(stats.protocol_errors, 1);
+  EXPECT_EQ(stats.frames_sent, 3);
+  // Frames 2 and 3 were answered with controls: the extra manual was not taken for either.
+  EXPECT_EQ(stats.controls, 3);
+  EXPECT_EQ(stats.manuals, 0);
+  EXPECT_EQ(endpoint.manuals_seen, 0);
+  EXPECT_NE(stats.first_protocol_error.find("second reply to frame 1"), std::string::npos)
+      << stats.first_protocol_error;
+}
+
+TEST(ClientTest, ACloseFrameEndsTheRunAtOnceWithItsCodeAndReason) {
+  std::optional<testing::RawFrame> echo;
+  ClientStats stats;
+  ToyEndpoint endpoint(10);
+  const Status s =
+      RunAgainstRawServer(testing::EncodeCloseFrame(1001, "planner going away", /*mask=*/false),
+                          &echo, &stats, &endpoint);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().find("timeout"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("waiting for the reply to frame 1"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("closed the connection with code 1001 (\"planner going away\")"),
+            std::string::npos)
+      << s.message();
+  ASSERT_TRUE(echo.has_value()) << "the client answers the close frame";
+  EXPECT_EQ(echo->opcode, testing::kOpClose);
+  ASSERT_GE(echo->payload.size(), 2u);
+  EXPECT_EQ(testing::CloseCode(*echo), 1001);
+}
+
+TEST(ClientTest, AnOversizedFrameHeaderEndsTheRunAtOnce) {
+  // A text frame announcing 1 GiB, and nothing after the header.
+  std::string header = {static_cast<char>(0x81), 127};
+  for (int i = 7; i >= 0; --i)
+    header.push_back(static_cast<char>(((1ull << 30) >> (8 * i)) & 0xFF));
+  std::optional<testing::RawFrame> echo;
+  ClientStats stats;
+  ToyEndpoint endpoint(10);
+  const Status s = RunAgainstRawServer(header, &echo, &stats, &endpoint);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().find("timeout"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("a frame over the client's limit of 16777216 bytes"),
+            std::string::npos)
+      << s.message();
+  ASSERT_TRUE(echo.has_value()) << "the client fails the connection with a close frame";
+  EXPECT_EQ(echo->opcode, testing::kOpClose);
+  ASSERT_GE(echo->payload.size(), 2u);
+  EXPECT_EQ(testing::CloseCode(*echo), 1009);
 }
 
 }  // namespace

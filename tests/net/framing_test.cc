@@ -112,8 +112,11 @@ TEST(FramingTest, ClientSendsEachMessageAsOneMaskedTextFrame) {
       ASSERT_TRUE(f.has_value()) << "no frame " << i;
       ExpectOneTextFrame(*f, /*masked=*/true);
       EXPECT_GT(f->payload.size(), i + 1 == kFrames ? 64u << 10 : 4096u * 2);
-      // The whole message is in this one frame: it parses, and it is the i-th telemetry.
-      const ParsedFrame parsed = ParseFrame(f->payload);
+      // The whole message is in this one frame: it parses, and it is the i-th telemetry (the
+      // last one beyond the server's default limits).
+      FrameLimits limits;
+      limits.max_path_points = kHugePathPoints;
+      const ParsedFrame parsed = ParseFrame(f->payload, limits);
       ASSERT_EQ(parsed.kind, FrameKind::kTelemetry) << i << ": " << parsed.error;
       EXPECT_TRUE(parsed.error.empty()) << parsed.error;
       EXPECT_EQ(parsed.telemetry.x, 1000.0 + i);

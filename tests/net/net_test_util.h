@@ -46,6 +46,51 @@ inline std::string TelemetryFrameAt(double x, double y) {
          "]";
 }
 
+// Frames of any size, for limits and abuse: a row the simulator could send; the first
+// telemetry with `rows` such rows, or with a `points`-point previous path; with `junk` as the
+// value of an extra field.
+inline std::string SensorRow(int id) {
+  std::string row = "[";
+  row += std::to_string(id);
+  row += ",1056.788,1164.296,37.39919,15.43803,275.7777,5.999895]";
+  return row;
+}
+
+inline std::string FrameWithRows(int rows) {
+  std::string f = R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,)"
+                  R"("d":6.164833,"previous_path_x":[],"previous_path_y":[],"end_path_s":0,)"
+                  R"("end_path_d":0,"sensor_fusion":[)";
+  for (int i = 0; i < rows; ++i) {
+    if (i > 0) f += ',';
+    f += SensorRow(i);
+  }
+  return f + "]}]";
+}
+
+inline std::string FrameWithPath(int points) {
+  std::string xs, ys;
+  for (int i = 0; i < points; ++i) {
+    if (i > 0) {
+      xs += ',';
+      ys += ',';
+    }
+    xs += std::to_string(900 + i);
+    ys += "1128.671";
+  }
+  return R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,"d":6.164833,)"
+         R"("previous_path_x":[)" +
+         xs + R"(],"previous_path_y":[)" + ys +
+         R"(],"end_path_s":0,"end_path_d":0,"sensor_fusion":[]}])";
+}
+
+inline std::string FrameWithJunk(const std::string& junk) {
+  return R"(42["telemetry",{"x":909.48,"y":1128.67,"yaw":0,"speed":0,"s":124.8336,"d":6.164833,)"
+         R"("junk":)" +
+         junk +
+         R"(,"previous_path_x":[],"previous_path_y":[],"end_path_s":0,)"
+         R"("end_path_d":0,"sensor_fusion":[]}])";
+}
+
 // Deterministic planner: point i is (x + i, y + cycles), where cycles counts this instance's
 // Plan() calls from 1, so a reply tells both whose telemetry and which planner produced it.
 class FakePlanner : public plan::Planner {
@@ -86,16 +131,20 @@ class FakePlanner : public plan::Planner {
 // A server on 127.0.0.1, ephemeral port, running on its own thread until destruction.
 class TestServer {
  public:
-  explicit TestServer(ServerOptions options = {},
-                      FakePlanner::Mode mode = FakePlanner::Mode::kGood,
-                      bool refuse = false) {
+  explicit TestServer(ServerOptions options = {}, FakePlanner::Mode mode = FakePlanner::Mode::kGood,
+                      bool refuse = false)
+      : TestServer(options, [mode, refuse]() -> std::unique_ptr<plan::Planner> {
+          if (refuse) return nullptr;
+          return std::make_unique<FakePlanner>(mode);
+        }) {}
+  // With the given planners (planners_made counts the factory's calls).
+  TestServer(ServerOptions options, PlannerFactory factory) {
     options.bind_address = "127.0.0.1";
     options.port = 0;
     options.status_interval = 0;
-    auto server = Server::Create(options, [this, mode, refuse]() -> std::unique_ptr<plan::Planner> {
+    auto server = Server::Create(options, [this, factory]() -> std::unique_ptr<plan::Planner> {
       ++planners_made;
-      if (refuse) return nullptr;
-      return std::make_unique<FakePlanner>(mode);
+      return factory();
     });
     if (!server.ok()) {
       ADD_FAILURE() << server.message();

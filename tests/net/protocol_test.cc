@@ -17,6 +17,9 @@ namespace {
 
 using nlohmann::json;
 using testing::FirstTelemetryFrame;
+using testing::FrameWithJunk;
+using testing::FrameWithPath;
+using testing::FrameWithRows;
 using testing::kFirstTelemetryJson;
 
 std::string Frame(const json& payload) { return "42[\"telemetry\"," + payload.dump() + "]"; }
@@ -301,12 +304,81 @@ TEST(ProtocolTest, UnequalAndBrokenPathsAreCutToTheGoodPrefix) {
 
 TEST(ProtocolTest, ManyBadRowsStillGiveAShortMessage) {
   json j = FirstPayload();
-  for (int i = 0; i < 5000; ++i) j["sensor_fusion"].push_back({"bad", i});
+  for (int i = 0; i < 50; ++i) j["sensor_fusion"].push_back({"bad", i});
   const ParsedFrame p = ParseFrame(Frame(j));
   ASSERT_EQ(p.kind, FrameKind::kTelemetry);
   EXPECT_EQ(p.telemetry.sensor_fusion.size(), 12u);
-  EXPECT_NE(p.error.find("and 4999 more"), std::string::npos) << p.error;
+  EXPECT_NE(p.error.find("and 49 more"), std::string::npos) << p.error;
   EXPECT_LT(p.error.size(), 200u);
+}
+
+void ExpectRefused(const ParsedFrame& p, const std::string& mentions) {
+  EXPECT_EQ(p.kind, FrameKind::kRefused) << ToString(p.kind) << ": " << p.error;
+  EXPECT_NE(p.error.find(mentions), std::string::npos) << p.error;
+  EXPECT_EQ(p.error.find('\n'), std::string::npos) << p.error;
+  EXPECT_LT(p.error.size(), 200u) << p.error;
+  EXPECT_TRUE(p.telemetry.sensor_fusion.empty());
+  EXPECT_TRUE(p.telemetry.previous_path_x.empty());
+}
+
+TEST(ProtocolTest, RowsAndPointsUpToTheLimitsAreKept) {
+  const FrameLimits limits;
+  ParsedFrame p = ParseFrame(FrameWithRows(limits.max_sensor_rows));
+  ASSERT_EQ(p.kind, FrameKind::kTelemetry) << p.error;
+  EXPECT_EQ(p.telemetry.sensor_fusion.size(), static_cast<std::size_t>(limits.max_sensor_rows));
+  p = ParseFrame(FrameWithPath(limits.max_path_points));
+  ASSERT_EQ(p.kind, FrameKind::kTelemetry) << p.error;
+  EXPECT_EQ(p.telemetry.previous_path_x.size(), static_cast<std::size_t>(limits.max_path_points));
+  EXPECT_EQ(p.telemetry.previous_path_x.back(), 900 + limits.max_path_points - 1);
+}
+
+TEST(ProtocolTest, RowsOrPointsOverTheLimitsAreRefusedNamingTheField) {
+  FrameLimits limits;
+  limits.max_sensor_rows = 20;
+  limits.max_path_points = 60;
+  ExpectRefused(ParseFrame(FrameWithRows(21), limits),
+                "telemetry.sensor_fusion: 21 rows, over the limit of 20");
+  ExpectRefused(ParseFrame(FrameWithPath(61), limits),
+                "telemetry.previous_path_x: 61 points, over the limit of 60");
+  EXPECT_EQ(ParseFrame(FrameWithRows(20), limits).kind, FrameKind::kTelemetry);
+  EXPECT_EQ(ParseFrame(FrameWithPath(60), limits).kind, FrameKind::kTelemetry);
+}
+
+// The frames of issue 22, each under the server's 1 MiB frame limit, and pathological ones: all
+// are refused by the scan before any JSON value is built ("unread").
+TEST(ProtocolTest, HugeAndPathologicalFramesAreRefusedUnread) {
+  const std::size_t kMiB = 1 << 20;
+  std::string rows = FrameWithRows(12500);  // ~1 MB: 50,000 rows would not fit in 1 MiB here
+  ASSERT_LT(rows.size(), kMiB);
+  ExpectRefused(ParseFrame(rows), "refused unread");
+  ExpectRefused(ParseFrame(FrameWithPath(40000)), "refused unread");
+  // Each within the byte budget, but over another bound.
+  std::string values = "[1";
+  for (int i = 0; i < 3000; ++i) values += ",1";
+  ExpectRefused(ParseFrame(FrameWithJunk(values + "]")), "more than 2576 values");
+  ExpectRefused(ParseFrame(FrameWithJunk("\"" + std::string(300, 'a') + "\"")),
+                "a string of more than 256 bytes");
+  ExpectRefused(ParseFrame(FrameWithJunk("0." + std::string(40, '1'))),
+                "a number or literal of more than 32 characters");
+  ExpectRefused(ParseFrame(FrameWithJunk(std::string(200000, ' ') + "1")),
+                "more than the 123696 the limits allow");
+  // Nesting is still malformed, as before.
+  EXPECT_EQ(ParseFrame("42" + std::string(20000, '[')).kind, FrameKind::kMalformed);
+  // Long escapes count as they are written.
+  EXPECT_EQ(ParseFrame(FrameWithJunk("\"" + std::string(120, '\\') + "\"")).kind,
+            FrameKind::kTelemetry);
+  ExpectRefused(ParseFrame(FrameWithJunk("\"" + std::string(260, '\\') + "\"")),
+                "a string of more than 256 bytes");
+}
+
+TEST(ProtocolTest, FrameLimitsAreValidated) {
+  EXPECT_TRUE(FrameLimits().Validate().ok());
+  FrameLimits l;
+  l.max_sensor_rows = 0;
+  EXPECT_NE(l.Validate().message().find("max sensor rows"), std::string::npos);
+  l = FrameLimits();
+  l.max_path_points = -1;
+  EXPECT_NE(l.Validate().message().find("max path points"), std::string::npos);
 }
 
 TEST(ProtocolTest, FormatControlWritesEqualFiniteArrays) {

@@ -4,12 +4,14 @@
 #pragma once
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <boost/beast/websocket/detail/hybi13.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <optional>
@@ -44,6 +46,16 @@ class RawSocket {
       s.Close();
     }
     return s;
+  }
+
+  // Makes writes return at once when the socket's buffers are full (WriteSome).
+  bool SetNonBlocking() { return ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK) == 0; }
+  // Writes what fits now (non-blocking socket); the count written, or -1 on an error other
+  // than full buffers.
+  std::int64_t WriteSome(std::string_view data) {
+    const ssize_t n = ::send(fd_, data.data(), data.size(), MSG_NOSIGNAL);
+    if (n < 0) return errno == EAGAIN || errno == EWOULDBLOCK ? 0 : -1;
+    return n;
   }
 
   bool WriteAll(std::string_view data) {
@@ -216,5 +228,30 @@ inline bool UpgradeByHand(RawSocket& s, int port, std::string* response) {
   return s.WriteAll(request) && s.ReadUntil("\r\n\r\n", response);
 }
 inline constexpr std::string_view kSampleAccept = "s3pPLMBiTxaQ9kYGzzhZRbK+xOo=";
+
+// A connected, upgraded raw client (not ok() when the server did not answer 101); *response gets
+// the server's answer.
+inline RawSocket ConnectUpgraded(int port, std::string* response = nullptr) {
+  std::string local;
+  std::string& r = response != nullptr ? *response : local;
+  RawSocket s = RawSocket::Connect(port);
+  if (!s.ok() || !UpgradeByHand(s, port, &r) || r.rfind("HTTP/1.1 101", 0) != 0) s.Close();
+  return s;
+}
+
+// The status code of a close frame's payload (0 when it has none).
+inline int CloseCode(const RawFrame& f) {
+  if (f.payload.size() < 2) return 0;
+  return (static_cast<unsigned char>(f.payload[0]) << 8) | static_cast<unsigned char>(f.payload[1]);
+}
+
+// A close frame with `code` and `reason`, masked as a client sends it (or not, from a server).
+inline std::string EncodeCloseFrame(int code, std::string_view reason, bool mask) {
+  std::string payload;
+  payload.push_back(static_cast<char>((code >> 8) & 0xFF));
+  payload.push_back(static_cast<char>(code & 0xFF));
+  payload += reason;
+  return EncodeRawFrame(kOpClose, payload, mask);
+}
 
 }  // namespace frenetic::net::testing

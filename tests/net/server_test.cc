@@ -293,12 +293,18 @@ TEST(ServerTest, BadPlansAreSentEqualAndFiniteAndCounted) {
   }
 }
 
-TEST(ServerTest, RefusedConnectionLeavesTheServerRunning) {
+TEST(ServerTest, AFailingFactoryAnswersManualAndClosesOnlyThatConnection) {
   TestServer server({}, FakePlanner::Mode::kGood, /*refuse=*/true);
   TestClient client(2.0);
-  EXPECT_FALSE(client.Connect(server.port()));
+  ASSERT_TRUE(client.Connect(server.port()));
+  EXPECT_EQ(server.planners_made, 0) << "the planner is built at the first telemetry";
+  ExpectManual(client.Exchange(TelemetryFrameAt(1, 2)));
+  EXPECT_FALSE(client.Receive().has_value()) << "the connection must be closed";
   EXPECT_EQ(server.planners_made, 1);
   EXPECT_EQ(server.server().stats().refused_connections, 1);
+  TestClient next(2.0);
+  ASSERT_TRUE(next.Connect(server.port())) << "the server must still accept connections";
+  ExpectManual(next.Exchange(kNullTelemetryFrame));
 }
 
 TEST(ServerTest, StopClosesOpenConnections) {

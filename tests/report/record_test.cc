@@ -2,12 +2,14 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <set>
 #include <sstream>
 #include <string>
 
+#include "frenetic/report/page.h"
 #include "report/synthetic_record.h"
 
 namespace frenetic::report {
@@ -265,6 +267,75 @@ TEST(ReadRecordTest, RecordWithoutFooterStillReads) {
   EXPECT_FALSE(run->has_footer);
   EXPECT_EQ(run->footer_json, "null");
   EXPECT_EQ(run->size(), 10);
+}
+
+// `text` as a gzip stream (as `drive --record run.jsonl.gz` writes it), in `members` gzip
+// members one after another.
+std::string Gzip(const std::string& text, int members = 1) {
+  std::string out;
+  const std::size_t step = text.size() / members + 1;
+  for (std::size_t at = 0; at < text.size(); at += step) {
+    z_stream zs{};
+    EXPECT_EQ(deflateInit2(&zs, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY), Z_OK);
+    const std::string part = text.substr(at, step);
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(part.data()));
+    zs.avail_in = static_cast<uInt>(part.size());
+    std::string buf(deflateBound(&zs, zs.avail_in), '\0');
+    zs.next_out = reinterpret_cast<Bytef*>(buf.data());
+    zs.avail_out = static_cast<uInt>(buf.size());
+    EXPECT_EQ(deflate(&zs, Z_FINISH), Z_STREAM_END);
+    out += buf.substr(0, buf.size() - zs.avail_out);
+    deflateEnd(&zs);
+  }
+  return out;
+}
+
+// A compressed record reads as its text does: same columns, same page (so the same report),
+// whether in one gzip member or several.
+TEST(ReadRecordTest, AGzipRecordReadsAsItsText) {
+  SyntheticOptions options;
+  options.exchanges = 400;
+  options.incident = true;
+  const std::string text = SyntheticRecord(options);
+  auto plain = Read(text);
+  ASSERT_TRUE(plain.ok()) << plain.message();
+  for (int members : {1, 3}) {
+    auto gz = Read(Gzip(text, members));
+    ASSERT_TRUE(gz.ok()) << gz.message();
+    EXPECT_EQ(gz->size(), 400);
+    EXPECT_TRUE(gz->warnings.empty()) << gz->warnings.front();
+    EXPECT_EQ(PageDataJson(*gz, "run.jsonl"), PageDataJson(*plain, "run.jsonl")) << members;
+  }
+}
+
+// A drive that died leaves its compressed record cut short: what is there reads, with a warning
+// saying where it ends; damage in the middle ends it there too. With nothing usable, an error.
+TEST(ReadRecordTest, ACutOrDamagedGzipRecordReadsUpToTheDamage) {
+  SyntheticOptions options;
+  options.exchanges = 2000;
+  const std::string gz = Gzip(SyntheticRecord(options));
+  auto cut = Read(gz.substr(0, gz.size() / 2));
+  ASSERT_TRUE(cut.ok()) << cut.message();
+  EXPECT_GT(cut->size(), 100);
+  EXPECT_LT(cut->size(), 2000);
+  EXPECT_FALSE(cut->has_footer);
+  ASSERT_FALSE(cut->warnings.empty());
+  EXPECT_THAT(cut->warnings.back(), HasSubstr("the compressed data ends early"));
+
+  std::string damaged = gz;
+  for (std::size_t i = gz.size() / 2; i < gz.size() / 2 + 64; ++i) damaged[i] = '\x55';
+  auto bad = Read(damaged);
+  ASSERT_TRUE(bad.ok()) << bad.message();
+  EXPECT_LT(bad->size(), 2000);
+  ASSERT_FALSE(bad->warnings.empty());
+  EXPECT_THAT(bad->warnings.back(), HasSubstr("corrupt compressed data"));
+
+  auto header_only = Read(gz.substr(0, 30));
+  ASSERT_FALSE(header_only.ok());
+  EXPECT_THAT(header_only.message(), HasSubstr("run.jsonl: the compressed data ends early"));
+  auto garbage = Read(std::string("\x1f\x8bnot gzip at all"));
+  ASSERT_FALSE(garbage.ok());
+  EXPECT_THAT(garbage.message(), HasSubstr("run.jsonl: corrupt compressed data"));
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ struct ClientStats {
   std::int64_t frames_sent = 0;      // telemetry (real or null) frames
   std::int64_t controls = 0;
   std::int64_t manuals = 0;
-  std::int64_t protocol_errors = 0;  // malformed replies (unequal arrays, NaN, bad JSON)
+  // Malformed replies (unequal arrays, NaN, bad JSON) and second replies to one frame.
+  std::int64_t protocol_errors = 0;
   std::int64_t ignored_frames = 0;   // pongs, binary and other non-42 frames
   std::string first_protocol_error;  // one line, empty when none
   // TCP_NODELAY as read back (getsockopt) from the connected socket: the client sets it, so a
@@ -59,8 +60,11 @@ struct ClientStats {
 // Connects to `url` (ws://HOST[:PORT][/PATH], e.g.
 // ws://127.0.0.1:4567/socket.io/?EIO=4&transport=websocket; port 80 when omitted) and runs the
 // exchange until endpoint.Done(), then closes the connection cleanly. Errors: a bad URL, connect
-// or handshake failure, a timeout waiting for a reply, the server closing, or (unless
-// continue_on_protocol_error) a malformed reply. *stats (optional) is filled in every case.
+// or handshake failure (a refused upgrade with the server's status and reason), a timeout
+// waiting for a reply, the server closing (at once, with its close code and reason), a frame
+// whose header announces more than max_frame_bytes (at once), or (unless
+// continue_on_protocol_error) a malformed reply or a second reply to one frame (a 42 frame that
+// has arrived when the next frame is due to be sent). *stats (optional) is filled in every case.
 Status RunClient(const std::string& url, SimulatorEndpoint& endpoint, const ClientOptions& options,
                  ClientStats* stats = nullptr);
 

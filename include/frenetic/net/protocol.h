@@ -3,6 +3,7 @@
 // Units on the wire: speed mph, yaw degrees; converted here to and from plan::Telemetry (SI).
 #pragma once
 
+#include <cstddef>
 #include <span>
 #include <string>
 #include <string_view>
@@ -24,8 +25,26 @@ enum class FrameKind {
   kPing,           // engine.io "2": ignore (or answer "3")
   kIgnored,        // anything that is not a 42 frame and needs no answer
   kMalformed,      // a 42 frame that could not be understood: answer manual, log `error`
+  kRefused,        // a 42 frame over FrameLimits, not converted: answer manual, log `error`
 };
 const char* ToString(FrameKind kind);
+
+// What one frame may hold, far above what the simulator sends (12 cars, at most ~100 path
+// points), so that converting any frame costs at most ~1 ms however it is made: a frame over
+// them is refused (kRefused) before any JSON value is built, by a size check and then a single
+// scan of its text that stops at the first excess. Besides the two counts, the scan bounds
+// separators (so values: 2 * max_path_points + 8 * max_sensor_rows + 64), strings
+// (kMaxFrameStringBytes), other tokens such as numbers (kMaxFrameTokenBytes) and the text
+// itself ((separators + 1) * (kMaxFrameTokenBytes + 16) bytes, which leaves room for
+// indentation but not for megabytes of padding), whatever field they are in.
+struct FrameLimits {
+  int max_sensor_rows = 64;    // sensor_fusion rows
+  int max_path_points = 1000;  // previous_path_x / previous_path_y elements, each
+
+  Status Validate() const;  // a message naming the bad limit
+};
+inline constexpr std::size_t kMaxFrameStringBytes = 256;
+inline constexpr std::size_t kMaxFrameTokenBytes = 32;
 
 struct ParsedFrame {
   FrameKind kind = FrameKind::kIgnored;
@@ -33,15 +52,16 @@ struct ParsedFrame {
   std::string error;          // one line naming what was wrong (kMalformed, or repaired fields)
 };
 
-// Parses one text frame. Never throws; hostile input yields kMalformed with a message.
-// The whole frame is parsed as JSON. The ego fields (x, y, yaw, speed, s, d, end_path_s,
-// end_path_d) must be finite numbers and previous_path_x/y and sensor_fusion must be arrays,
-// else kMalformed naming the field. Within arrays everything good is kept: rows of
-// sensor_fusion that are malformed (not 7 finite numbers, id not an integer) are dropped,
+// Parses one text frame. Never throws; hostile input yields kMalformed (or kRefused, over
+// `limits`) with a message. The whole frame is parsed as JSON. The ego fields (x, y, yaw, speed,
+// s, d, end_path_s, end_path_d) must be finite numbers and previous_path_x/y and sensor_fusion
+// must be arrays, else kMalformed naming the field; more sensor_fusion rows or path points than
+// the limits allow make it kRefused, naming the field. Within arrays everything good is kept: rows
+// of sensor_fusion that are malformed (not 7 finite numbers, id not an integer) are dropped,
 // previous_path points are cut at the first non-finite or non-number element, and unequal
 // previous_path arrays are cut to the shorter one; `error` then names the first repair (and
 // counts the others) while kind stays kTelemetry. Wire mph/degrees become m/s and radians.
-ParsedFrame ParseFrame(std::string_view frame);
+ParsedFrame ParseFrame(std::string_view frame, const FrameLimits& limits = {});
 
 // Appends `42["control",{"next_x":[...],"next_y":[...]}]` to *out (cleared first). Only finite
 // numbers are written; both arrays always have the same length: min(x.size(), y.size()) points,

@@ -1,5 +1,6 @@
-// Reading a drive record (`frenetic drive --record run.jsonl`, JSON lines: one header, one line
-// per exchange, an optional footer) into compact columns for the HTML report.
+// Reading a drive record (`frenetic drive --record run.jsonl.gz`, JSON lines: one header, one
+// line per exchange, an optional footer; plain text or gzip-compressed, told apart by the first
+// byte, whatever the file's name) into compact columns for the HTML report.
 //
 // Units are the record's own, kept as written so the page can show what the simulator measured:
 // positions in m (map frame: x east, y north), time in simulated s, ego yaw in degrees
@@ -132,9 +133,11 @@ struct RunData {
   int size() const { return static_cast<int>(t.size()); }
 };
 
-// Reads a record. `source` names it in messages. Fails, with a one-line message, when there is
-// no header line before the first exchange, no exchange at all, or on invalid options; a
-// malformed or unusable line after the header is skipped with a warning naming its line number.
+// Reads a record, plain or gzip. `source` names it in messages. Fails, with a one-line message,
+// when there is no header line before the first exchange, no exchange at all, or on invalid
+// options; a malformed or unusable line after the header is skipped with a warning naming its
+// line number. Compressed data that ends early or is corrupt after some exchanges ends the
+// record there, with a warning saying so.
 StatusOr<RunData> ReadRecord(std::istream& in, std::string_view source,
                              const ReadOptions& options = {});
 
