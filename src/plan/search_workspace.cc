@@ -25,7 +25,7 @@ Workspace::Workspace(const Settings& cfg) {
   // The lattice's largest bundles (Lattice::Generate), with a little slack.
   const int max_lon = (cfg.speeds + cfg.num_lanes) * cfg.durations + cfg.durations +
                       2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
-                      cfg.brake_decels * cfg.brake_targets + 8;
+                      cfg.brake_decels * cfg.brake_targets + cfg.accels * (cfg.num_lanes + 1) + 8;
   const int max_lat =
       cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + 8;
   lon.reserve(max_lon);
