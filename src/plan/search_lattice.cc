@@ -16,6 +16,11 @@ constexpr double kAlongside = 20.0;
 constexpr double kStandingGoal = 0.5;
 // m/s: a lane whose limit is within this of the fastest lane's shares the grid's top end speed.
 constexpr double kLaneLimitStep = 0.05;
+// m/s: a lane's limit this far above the start's speed is worth a constant-acceleration run.
+constexpr double kAccelMinGain = 1.0;
+// m along s: the road is free for a constant-acceleration run when no car is from this far
+// behind to this far ahead of the ego (a run from a standstill to the limit takes ~60 m).
+constexpr double kAccelFreeBehind = 20.0, kAccelFreeAhead = 100.0;
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -83,6 +88,13 @@ LonTraj Lattice::MakeLon(cost::LonKind kind, int lane, double param, double T, i
       l.traj.poly.c[0] = s0.s;
       l.traj.poly.c[1] = s0.s_d;
       l.traj.poly.c[2] = -0.5 * param;
+      break;
+    case cost::LonKind::kAccelerating:
+      // Accelerate at `param` at once for T, then hold the speed reached.
+      l.traj.poly = {};
+      l.traj.poly.c[0] = s0.s;
+      l.traj.poly.c[1] = s0.s_d;
+      l.traj.poly.c[2] = 0.5 * param;
       break;
   }
   return l;
@@ -181,6 +193,36 @@ void Lattice::AddGapTargets(int lane, double T) {
   }
 }
 
+// On a free road, constant acceleration up to the fastest lane's limit (for every lane) and to
+// each slower reachable lane's own (with grid.lane_limit_speeds): a quartic starts and ends at zero acceleration, so it reaches the limit
+// from a standstill in about 1.5 v / a_peak; a step to a constant acceleration, which the
+// simulator's block means allow (udacity-sim.md §7.2, §7.3), takes v / a.
+void Lattice::AddAccelerating(const bool reachable[], double vmax) {
+  const double v0 = std::max(ws_.start.s_d, 0.0);
+  // On a free road only: in traffic the run meets slow cars and their cut-ins at the limit's
+  // closing speed, where the quartics' gentler run leaves time to see them (ungated, dense
+  // traffic had 4 incidents in 50 episodes instead of 0).
+  for (int c = 0; c < ws_.ctx.num_cars; ++c) {
+    const double ds = ws_.car_s0[c] - ws_.start.s;
+    if (ds > -kAccelFreeBehind && ds < kAccelFreeAhead) return;
+  }
+  for (int l = -1; l < cfg_.num_lanes; ++l) {
+    double target = vmax;
+    if (l >= 0) {
+      if (!cfg_.lane_limit_speeds || !reachable[l] ||
+          ws_.ctx.lane_speed_limit[l] >= vmax - kLaneLimitStep) {
+        continue;
+      }
+      target = ws_.ctx.lane_speed_limit[l];
+    }
+    if (target - v0 < kAccelMinGain) continue;
+    for (int ai = 0; ai < cfg_.accels; ++ai) {
+      const double a = Linspace(cfg_.accel_min, cfg_.accel_max, cfg_.accels, ai);
+      AddLon(MakeLon(cost::LonKind::kAccelerating, l, a, (target - v0) / a));
+    }
+  }
+}
+
 // The car in `lane` nearest to the ego along s within kAlongside at the start instant (context
 // index), or -1: the one a lane change into that lane must pass behind or in front of.
 int Lattice::Alongside(int lane) const {
@@ -238,7 +280,10 @@ void Lattice::Generate() {
       }
       AddLon(MakeLon(cost::LonKind::kStopping, -1, mid, T));
     }
-    if (di == 0) AddBraking();
+    if (di == 0) {
+      AddBraking();
+      AddAccelerating(reachable, vmax);
+    }
     for (int l = 0; l < cfg_.num_lanes; ++l) {
       if (!reachable[l]) continue;
       // Follow the lane's leader, and yield to (drop behind) the car alongside, which the

@@ -19,7 +19,8 @@ struct LonTraj {
   traj::Trajectory1d traj;
   cost::LonKind kind = cost::LonKind::kVelocityKeeping;
   int lane = -1;  // -1: usable in every lane; else only with this lane's lateral moves
-  // End speed (velocity keeping), extra gap (following), distance (stop), deceleration (braking).
+  // End speed (velocity keeping), extra gap (following), distance (stop), deceleration (braking),
+  // acceleration (accelerating).
   double param = 0;
   int lead = -1;  // following: the leader's index in the predictor's cars of this cycle
   double jerk2 = 0;
@@ -54,6 +55,7 @@ class Lattice {
   void AddLat(const LatTraj& l);
   void AddBraking();
   void AddGapTargets(int lane, double T);
+  void AddAccelerating(const bool reachable[], double vmax);
   int Leader(int lane) const;
   int Alongside(int lane) const;
 

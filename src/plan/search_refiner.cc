@@ -27,6 +27,10 @@ Refiner::Refiner(const Settings& cfg, const std::string& algorithm, Workspace& w
     constraints_ok_ =
         nlopt_add_inequality_constraint(opt_, &Refiner::Constraint, this, 1e-6) == NLOPT_SUCCESS;
     nlopt_set_maxeval(opt_, cfg_.refine_iterations);
+    // NLopt allocates its step array at the first call: here, not in the first refined cycle
+    // (which may come long after warm-up, e.g. after a constant-acceleration start).
+    const double step[4] = {1.0, 1.0, 1.0, 1.0};
+    nlopt_set_initial_step(opt_, step);
   }
 }
 
@@ -69,8 +73,9 @@ double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data
 void Refiner::Refine(PlanSummary& sum) {
   const LonTraj& lb = ws_.lon[ws_.winner_lon];
   const LatTraj& db = ws_.lat[ws_.winner_lat];
-  // Braking is the emergency family: it is sent as sampled, at once.
-  if (lb.kind == cost::LonKind::kBraking) return;
+  // Braking is the emergency family, and a constant acceleration already the quickest run up:
+  // both are sent as sampled.
+  if (lb.kind == cost::LonKind::kBraking || lb.kind == cost::LonKind::kAccelerating) return;
   double x[4] = {lb.param, lb.traj.duration, db.traj.duration, db.offset};
   double lo[4], hi[4];
   switch (lb.kind) {
@@ -87,6 +92,7 @@ void Refiner::Refine(PlanSummary& sum) {
       hi[0] = std::max(1.0, ws_.start.s_d * cfg_.max_duration);
       break;
     case cost::LonKind::kBraking:
+    case cost::LonKind::kAccelerating:
       return;
   }
   lo[1] = cfg_.min_duration;

@@ -51,6 +51,9 @@ Settings::Settings(const PlannerConfig& c) {
   brake_targets = c.int_value("grid.brake_targets");
   brake_min_decel = c.value("grid.brake_min_decel");
   brake_max_decel = c.value("grid.brake_max_decel");
+  accels = c.int_value("grid.accels");
+  accel_min = c.value("grid.min_accel");
+  accel_max = c.value("grid.max_accel");
   lat_durations = c.int_value("grid.lat_durations");
   lat_min_duration = c.value("grid.lat_min_duration");
   lat_max_duration = c.value("grid.lat_max_duration");

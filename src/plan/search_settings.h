@@ -53,6 +53,8 @@ struct Settings {
   bool stop;
   int brake_decels, brake_targets;
   double brake_min_decel, brake_max_decel;
+  int accels;
+  double accel_min, accel_max;  // grid.min_accel, grid.max_accel
   int lat_durations;
   double lat_min_duration, lat_max_duration;
   int lat_offsets;

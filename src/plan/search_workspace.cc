@@ -26,7 +26,8 @@ Workspace::Workspace(const Settings& cfg) {
   const int max_lon = (cfg.speeds + cfg.num_lanes) * cfg.durations + cfg.durations +
                       2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
                       cfg.num_lanes * cfg.gap_targets * cfg.durations +
-                      cfg.brake_decels * cfg.brake_targets + cost::kMaxGoalRegions * cfg.durations + 8;
+                      cfg.brake_decels * cfg.brake_targets + cost::kMaxGoalRegions * cfg.durations +
+                      cfg.accels * (cfg.num_lanes + 1) + 8;
   const int max_lat =
       cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + 8;
   lon.reserve(max_lon);

@@ -200,7 +200,9 @@ TEST(PlannerFactoryTest, NamesAndErrors) {
   EXPECT_NE(bad.message().find("teleport"), std::string::npos);
 }
 
-TEST(SearchPlannerTest, FromStandstillReaches45MphInUnder5point5SecondsWithinLimits) {
+constexpr int kBlockTicks = 10;  // the simulator's acceleration blocks (0.2 s)
+
+TEST(SearchPlannerTest, FromStandstillReaches48MphInUnder3SecondsWithinLimits) {
   REQUIRE_MAP(line);
   auto planner = Make("search", line);
   ASSERT_NE(planner, nullptr);
@@ -211,15 +213,21 @@ TEST(SearchPlannerTest, FromStandstillReaches45MphInUnder5point5SecondsWithinLim
     loop.Cycle();
     ASSERT_FALSE(HasFatalFailure());
     ++cycles;
-    if (reached < 0 && loop.speed() >= 45 * kMph) reached = loop.driven_x_.size() * kTickSeconds;
+    if (reached < 0 && loop.speed() >= 48 * kMph) reached = loop.driven_x_.size() * kTickSeconds;
   }
-  RecordProperty("seconds_to_45mph", std::to_string(reached));
-  EXPECT_GT(reached, 0) << "never reached 45 mph in 15 s";
-  // Progress outweighs comfort (the jerk and acceleration limits are hard checks): with the
-  // comfort terms at weight 1 the ego took 6.9 s.
-  EXPECT_LT(reached, 5.5);
-  for (int phase = 0; phase < 10; ++phase) {
-    const XyMeasure m = MeasureLikeSimulator(loop.driven_x_, loop.driven_y_, phase);
+  RecordProperty("seconds_to_48mph", std::to_string(reached));
+  EXPECT_GT(reached, 0) << "never reached 48 mph in 15 s";
+  // A constant-acceleration run up to the limit, as the simulator's block means allow (the
+  // jerk and acceleration limits are hard checks): 21.5 m/s at 8.5 m/s^2 is 2.5 s. Quartics
+  // alone, whose acceleration starts and ends at 0, took 4.8 s.
+  EXPECT_LT(reached, 3.0);
+  // The simulator records from the scene's start, while the ego waits at rest for its first
+  // path: every block phase sees blocks at rest before the first move.
+  std::vector<double> x(kBlockTicks, loop.driven_x_.front()), y(kBlockTicks, loop.driven_y_.front());
+  x.insert(x.end(), loop.driven_x_.begin(), loop.driven_x_.end());
+  y.insert(y.end(), loop.driven_y_.begin(), loop.driven_y_.end());
+  for (int phase = 0; phase < kBlockTicks; ++phase) {
+    const XyMeasure m = MeasureLikeSimulator(x, y, phase);
     EXPECT_LT(m.max_speed, 50 * kMph) << "phase " << phase;
     EXPECT_LE(m.max_accel, 9.0) << "phase " << phase;
     EXPECT_LE(m.max_jerk, 9.0) << "phase " << phase;
@@ -318,7 +326,9 @@ TEST(SearchPlannerTest, SummaryIsFilled) {
   EXPECT_GE(s.candidates_generated, 300);
   EXPECT_EQ(s.candidates_scored, s.candidates_generated);
   EXPECT_GE(s.candidates_checked, 1);
-  EXPECT_EQ(s.candidates_feasible, 1);
+  // The lazy check's first pass, or the later ones cheaper than the best so far.
+  EXPECT_GE(s.candidates_feasible, 1);
+  EXPECT_LE(s.candidates_feasible, s.candidates_checked);
   EXPECT_EQ(s.points_kept, 6);
   EXPECT_EQ(r.x.size(), 100u);
   ASSERT_EQ(s.winner_costs.size(), static_cast<size_t>(config.cost_terms().size()));

@@ -49,7 +49,8 @@ TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   EXPECT_EQ(Count(ws, cost::LonKind::kStopping), c.durations);
   EXPECT_EQ(Count(ws, cost::LonKind::kBraking), c.brake_decels * c.brake_targets);
   EXPECT_EQ(Count(ws, cost::LonKind::kFollowing), 0);
-  ASSERT_EQ(ws.lon.size(), 87u) << "the shipped grid: 12 x 6 + 6 + 3 x 3";
+  EXPECT_EQ(Count(ws, cost::LonKind::kAccelerating), c.accels);  // below the limit: runs up
+  ASSERT_EQ(ws.lon.size(), 90u) << "the shipped grid: 12 x 6 + 6 + 3 x 3 + 3";
   // Own lane centred and at rest: one move; each neighbour: every duration plus the delays.
   int per_lane[3] = {};
   for (const LatTraj& l : ws.lat) ++per_lane[l.lane];
@@ -80,7 +81,7 @@ TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabl
   PrepareCentred(slow, 0.5);
   slow.lattice.Generate();
   EXPECT_EQ(Count(slow.ws, cost::LonKind::kBraking), 0);
-  EXPECT_EQ(slow.ws.lon.size(), 78u);
+  EXPECT_EQ(slow.ws.lon.size(), 81u);
 
   PlannerConfig config = GridOnly();
   ASSERT_TRUE(config.Set("grid.stop", 0).ok());
@@ -88,7 +89,7 @@ TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabl
   PrepareCentred(no_stop, 20);
   no_stop.lattice.Generate();
   EXPECT_EQ(Count(no_stop.ws, cost::LonKind::kStopping), 0);
-  EXPECT_EQ(no_stop.ws.lon.size(), 81u);
+  EXPECT_EQ(no_stop.ws.lon.size(), 84u);
 }
 
 TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
@@ -123,6 +124,7 @@ TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
   }
   // Only the own lane's single move pairs with them.
   EXPECT_EQ(following_pairs, c.durations * c.follow_gaps);
+  // (No constant-acceleration run: the leader is within 100 m.)
   EXPECT_EQ(ws.cand_lon.size(), 87u * ws.lat.size() + following_pairs);
   for (const LonTraj& l : ws.lon) {
     if (l.kind != cost::LonKind::kFollowing) continue;
@@ -198,6 +200,51 @@ TEST(SearchLatticeTest, MakeLonHitsEachFamilysEndCondition) {
   const LonTraj brake = st.lattice.MakeLon(cost::LonKind::kBraking, -1, 5.0, 2.0);
   EXPECT_DOUBLE_EQ(brake.traj.At(1.0).a, -5.0);
   EXPECT_NEAR(brake.traj.At(2.0).v, 10.0, 1e-12);
+  // A constant acceleration at once, then the speed reached is held.
+  const LonTraj run = st.lattice.MakeLon(cost::LonKind::kAccelerating, -1, 1.5, 1.0);
+  EXPECT_DOUBLE_EQ(run.traj.At(0.5).a, 1.5);
+  EXPECT_NEAR(run.traj.At(1.0).v, 21.5, 1e-12);
+  EXPECT_NEAR(run.traj.At(3.0).v, 21.5, 1e-12);
+  EXPECT_NEAR(run.traj.At(3.0).a, 0.0, 1e-12);
+}
+
+// From a standstill the lattice offers constant-acceleration runs up to the fastest lane's limit
+// (grid.min_accel to grid.max_accel, reaching it in v / a), none once within 1 m/s of it.
+TEST(SearchLatticeTest, RunsUpToTheLimitAtConstantAccelerationBelowIt) {
+  REQUIRE_UDACITY_MAP();
+  Stages st(GridOnly());
+  PrepareCentred(st, 0.0);
+  st.lattice.Generate();
+  const Settings& c = st.cfg;
+  const double* lim = st.ws.ctx.lane_speed_limit;
+  const double vmax = std::max({lim[0], lim[1], lim[2]});
+  ASSERT_EQ(Count(st.ws, cost::LonKind::kAccelerating), c.accels);
+  double top = 0;
+  for (const LonTraj& l : st.ws.lon) {
+    if (l.kind != cost::LonKind::kAccelerating) continue;
+    EXPECT_EQ(l.lane, -1);
+    EXPECT_GE(l.param, c.accel_min);
+    EXPECT_LE(l.param, c.accel_max);
+    EXPECT_NEAR(l.traj.duration, vmax / l.param, 1e-9);
+    EXPECT_NEAR(l.traj.At(l.traj.duration).v, vmax, 1e-9);
+    top = std::max(top, l.param);
+  }
+  EXPECT_DOUBLE_EQ(top, c.accel_max);
+  Stages fast(GridOnly());
+  PrepareCentred(fast, vmax - 0.5);
+  fast.lattice.Generate();
+  EXPECT_EQ(Count(fast.ws, cost::LonKind::kAccelerating), 0);
+  // On a free road only: not with a car 90 m ahead in another lane, nor one 15 m behind.
+  for (const SceneCar& car : {SceneCar{kS + 90, 10.0, 20.0}, SceneCar{kS - 15, 2.0, 20.0}}) {
+    Stages busy(GridOnly());
+    PrepareCentred(busy, 0.0, 0, {car});
+    busy.lattice.Generate();
+    EXPECT_EQ(Count(busy.ws, cost::LonKind::kAccelerating), 0) << car.s - kS;
+  }
+  Stages far(GridOnly());
+  PrepareCentred(far, 0.0, 0, {{kS + 110, 10.0, 20.0}});
+  far.lattice.Generate();
+  EXPECT_EQ(Count(far.ws, cost::LonKind::kAccelerating), c.accels);
 }
 
 // On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets

@@ -79,9 +79,12 @@ struct CostContext {
 };
 
 // Longitudinal families: quartic velocity keeping, quintic following (time-gap law) and
-// stopping, and constant-deceleration braking to a lower speed (the strongest, fastest braking
-// the lattice can express; Apollo's backup profiles).
-enum class LonKind : int { kVelocityKeeping = 0, kFollowing = 1, kStopping = 2, kBraking = 3 };
+// stopping, constant-deceleration braking to a lower speed (the strongest, fastest braking
+// the lattice can express; Apollo's backup profiles) and constant-acceleration runs up to a
+// lane's limit (the quickest way up that the acceleration and jerk limits allow).
+enum class LonKind : int {
+  kVelocityKeeping = 0, kFollowing = 1, kStopping = 2, kBraking = 3, kAccelerating = 4
+};
 
 // One candidate, as sampled for scoring (struct of arrays, ctx.num_samples long).
 struct CostInput {
