@@ -4,7 +4,9 @@ NGSIM ones: one of the recorded vehicles is taken out of the traffic and becomes
 initial state the problem's, and the goal is where that vehicle was at the end of a time window
 (a rectangle along its heading, its lane's width, velocity and orientation intervals around its
 recorded ones, like the goals of USA_US101-10_1_T-1). The recorded vehicle reached it, so a
-solution exists. Writes one file per vehicle whose recording is long enough.
+solution exists, unless the recorded vehicle starts off the lanelets (its box over a road edge at
+the initial state, which CommonRoad's road rule fails whatever follows): such vehicles are not
+taken. Writes one file per vehicle whose recording is long enough.
 
     scripts/commonroad-derive.py SCENARIO.xml OUT_DIR [--horizon 8] [--goal-length 4]
 
@@ -41,6 +43,49 @@ def interval(parent, name, lo, hi, integer=False):
     ET.SubElement(node, "intervalEnd").text = fmt(hi)
 
 
+def extend(a, b, margin=5.0):
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    n = math.hypot(dx, dy) or 1.0
+    return (b[0] + margin * dx / n, b[1] + margin * dy / n)
+
+
+def lanelet_polygons(root):
+    out = []
+    for ll in root.findall("lanelet"):
+        left = [(float(p.find("x").text), float(p.find("y").text)) for p in ll.findall("leftBound/point")]
+        right = [(float(p.find("x").text), float(p.find("y").text)) for p in ll.findall("rightBound/point")]
+        # Open ends go on 5 m (RoadArea::kDefaultOpenEndMargin), as the verdict's road does.
+        if ll.find("successor") is None:
+            left, right = left + [extend(left[-2], left[-1])], right + [extend(right[-2], right[-1])]
+        if ll.find("predecessor") is None:
+            left, right = [extend(left[1], left[0])] + left, [extend(right[1], right[0])] + right
+        out.append(left + right[::-1])
+    return out
+
+
+def inside(poly, x, y):
+    # Even-odd rule, with a few centimetres of tolerance left to the verdict's own.
+    hit = False
+    n = len(poly)
+    for i in range(n):
+        (x1, y1), (x2, y2) = poly[i], poly[(i + 1) % n]
+        if (y1 > y) != (y2 > y) and x < x1 + (y - y1) * (x2 - x1) / (y2 - y1):
+            hit = not hit
+    return hit
+
+
+def on_lanelets(polys, state, length, width):
+    x, y = position(state)
+    h = value(state, "orientation") or 0.0
+    c, s = math.cos(h), math.sin(h)
+    for a, b in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+        px = x + a * 0.5 * length * c - b * 0.5 * width * s
+        py = y + a * 0.5 * length * s + b * 0.5 * width * c
+        if not any(inside(p, px, py) for p in polys):
+            return False
+    return True
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scenario")
@@ -58,6 +103,7 @@ def main():
     window = int(round(args.window / dt))
     base_id = root.get("benchmarkID")
     os.makedirs(args.out_dir, exist_ok=True)
+    polys = lanelet_polygons(root)
     made = 0
     for obstacle in root.findall("dynamicObstacle"):
         st = states(obstacle)
@@ -66,6 +112,11 @@ def main():
             continue
         v0 = value(st[0], "velocity")
         if v0 is None or v0 < args.min_speed:
+            continue
+        length = float(obstacle.find("shape/rectangle/length").text)
+        w = float(obstacle.find("shape/rectangle/width").text)
+        if not on_lanelets(polys, st[0], length - 0.1, w - 0.1):
+            print(f"vehicle {obstacle.get('id')}: starts off the lanelets; not taken", file=sys.stderr)
             continue
         goal = st[steps]
         gx, gy = position(goal)
@@ -100,6 +151,8 @@ def main():
         interval(gs, "time", steps - window, steps, integer=True)
         interval(gs, "velocity", max(0.0, v_goal - 3.0), v_goal + 3.0)
         name = f"{base_id}_ego{obstacle.get('id')}"
+        if args.horizon != 8.0:  # several horizons side by side
+            name += f"_h{args.horizon:g}"
         new_root.set("benchmarkID", name)
         ET.ElementTree(new_root).write(os.path.join(args.out_dir, name + ".xml"),
                                        encoding="unicode", xml_declaration=True)
