@@ -385,8 +385,8 @@ void RegisterCommonRoad(CLI::App& app) {
                   "<scenario id>_<problem id>.jsonl.gz, the drive record's format with the "
                   "road's lane borders, the goal regions, the obstacles with their sizes, the "
                   "ego, its planned path and up to 40 candidates per cycle; `frenetic report "
-                  "FILE` replays it. The results do not change (the planning times include "
-                  "tracing the candidates). Default: none");
+                  "FILE` replays it. The results do not change (the candidates are traced by a "
+                  "replica of the planner, off the planning thread). Default: none");
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
                   "Scenario files planned in parallel (0 = all cores). Results do not depend on "

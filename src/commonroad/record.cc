@@ -1,5 +1,7 @@
 #include "frenetic/commonroad/record.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -21,6 +23,11 @@ constexpr double kBorderStep = 2.0;  // m between the points of a lane border
 constexpr int kCirclePoints = 24;    // a goal circle's outline
 constexpr double kMpsToMph = 1.0 / 0.44704;
 constexpr double kDegrees = 180.0 / std::numbers::pi;
+// The planning thread waits for the queued lines to be written every this many cycles (fewer
+// than sim::RecordWriter's batch, which wakes its thread): the writer's thread, and the replica
+// planning on it, then works only while the planner waits between cycles, never beside it, so
+// the planning times measured stay those of a run without a record.
+constexpr int kDrainLines = 32;
 
 // Rounded to `decimals` digits (finite values; others become 0, as the drive record's path).
 double Round(double v, int decimals) {
@@ -99,6 +106,18 @@ json GoalsJson(const Scenario& sc, const PlanningProblem& problem) {
   return goals;
 }
 
+}  // namespace
+
+// The planner that traces the candidates: a replica of the one that drives, planning every cycle
+// again on the writer's thread (as sim::RecordWriter::TraceByReplay does for a drive), so the
+// planner that drives is not slowed by tracing. Used on the writer's thread only.
+struct RunRecorder::Replica {
+  std::unique_ptr<plan::Planner> planner;  // null once it planned otherwise (or never built)
+  plan::CycleTrace trace;
+};
+
+namespace {
+
 // An obstacle row of the telemetry, with what the drawing needs beyond the planner's row.
 struct CarRow {
   plan::SensorCar car;
@@ -135,7 +154,6 @@ RunRecorder::RunRecorder(const Scenario& scenario, std::string dir, int vehicle_
 RunRecorder::~RunRecorder() = default;
 
 void RunRecorder::Attach(RunOptions* options) {
-  options->trace_candidates = kRecordCandidates;
   options->on_plan = [this](const CycleInput& in, const plan::PlanResult& result,
                             const plan::CycleTrace* trace) { OnPlan(in, result, trace); };
   options->on_problem_end = [this](const PlanningProblem& problem, const ProblemRun& run) {
@@ -184,6 +202,15 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result,
               {"road", RoadJson(road)},
               {"goals", GoalsJson(scenario_, in.problem)}};
     writer_->WriteLine([text = h.dump()](std::string* line) { *line += text; });
+    replica_ = std::make_shared<Replica>();
+    auto planner = plan::MakePlanner("search", in.config, in.road);
+    if (planner.ok()) {
+      replica_->planner = std::move(planner).value();
+      replica_->planner->set_trace(&replica_->trace, kRecordCandidates);
+    } else {
+      spdlog::warn("record {}: no planner to trace the candidates ({}); they are left out", path_,
+                   planner.message());
+    }
   }
   // Copies for the writer's thread.
   const plan::Telemetry& t = in.telemetry;
@@ -202,9 +229,33 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result,
                       y = t.y, yaw = t.yaw, speed = t.speed, s = t.s, d = t.d,
                       lane = road.LaneOf(t.s, t.d), cars = std::move(cars), path_x = result.x,
                       path_y = result.y, status = result.status, summary = result.summary, scale,
-                      candidates = trace != nullptr
-                                       ? trace->candidates
-                                       : std::vector<plan::CandidateTrace>()](std::string* line) {
+                      candidates = trace != nullptr ? trace->candidates
+                                                    : std::vector<plan::CandidateTrace>(),
+                      telemetry = t, replica = replica_, path = path_](std::string* line) mutable {
+    // The candidates, traced by the replica; its counts with the driving planner's times.
+    if (replica->planner) {
+      replica->trace.candidates.clear();
+      const plan::PlanResult& r = replica->planner->Plan(telemetry);
+      if (r.x == path_x && r.y == path_y) {
+        plan::PlanSummary traced = r.summary;
+        traced.ms_prepare = summary.ms_prepare;
+        traced.ms_generate = summary.ms_generate;
+        traced.ms_score = summary.ms_score;
+        traced.ms_check = summary.ms_check;
+        traced.ms_refine = summary.ms_refine;
+        traced.ms_output = summary.ms_output;
+        traced.ms_total = summary.ms_total;
+        traced.deadline_stage = summary.deadline_stage;
+        summary = std::move(traced);
+        candidates.swap(replica->trace.candidates);
+      } else {
+        spdlog::warn(
+            "record {}: the replica that traces the candidates planned cycle {} otherwise "
+            "than the planner that drove; candidates are left out from there on",
+            path, i);
+        replica->planner.reset();
+      }
+    }
     json rows = json::array();
     for (const CarRow& r : cars) {
       const plan::SensorCar& c = r.car;
@@ -233,6 +284,14 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result,
                     {"incidents", json::array()}};
     *line += e.dump();
   });
+  if (index_ % kDrainLines == 0) {
+    if (const Status st = writer_->status(); !st.ok()) {
+      if (status_.ok()) status_ = st;
+      failed_ = true;
+      writer_.reset();
+      replica_.reset();
+    }
+  }
 }
 
 void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun& run) {
@@ -283,6 +342,7 @@ void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun&
                      /*last=*/true);
   const Status st = writer_->status();
   writer_.reset();
+  replica_.reset();
   if (!st.ok()) {
     if (status_.ok()) status_ = st;
     return;

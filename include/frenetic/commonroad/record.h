@@ -20,8 +20,11 @@
 // ([{kind, step, detail, obstacle}]), and the run's "steps", "distance_m", "sim_seconds",
 // "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max} and "plan_fallbacks".
 //
-// Recording does not change the run: the planner traces its candidates (which costs planning
-// time, not decisions) and the lines are formatted off the planning thread.
+// Recording does not change the run, nor its planning times: the candidates are traced by a
+// replica of the planner that plans every cycle again on the writer's thread (checked to send
+// the same path; should it ever not, a warning is logged and candidates are left out from there
+// on), and the lines are formatted there too, while the planning thread waits between cycles
+// (every 32 cycles and at the problem's end), not while it plans.
 #pragma once
 
 #include <memory>
@@ -56,8 +59,8 @@ class RunRecorder {
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
 
-  // Sets options->on_plan, on_problem_end and trace_candidates to record through this recorder
-  // (which must outlive the run).
+  // Sets options->on_plan and on_problem_end to record through this recorder (which must
+  // outlive the run).
   void Attach(RunOptions* options);
   // The first error opening or writing a record (naming its path); Ok when none.
   const Status& status() const { return status_; }
@@ -80,6 +83,8 @@ class RunRecorder {
   int problem_ = 0;                            // its id
   int index_ = 0;                              // the next exchange's "i"
   bool failed_ = false;                        // the current problem's record could not open
+  struct Replica;
+  std::shared_ptr<Replica> replica_;  // the current problem's, handed to its lines
 };
 
 }  // namespace frenetic::commonroad

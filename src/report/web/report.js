@@ -57,7 +57,7 @@
   // each at the cycle of its time step.
   for (const f of (D.footer && Array.isArray(D.footer.failures) ? D.footer.failures : [])) {
     const e = nearestIndexOfTime(f.step * H.dt);
-    D.incidents.push({ e, t: f.step * H.dt, s: E.s[e], d: E.d[e], lane: E.lane[e], kind: f.kind,
+    D.incidents.push({ e, t: T[e], s: E.s[e], d: E.d[e], lane: E.lane[e], kind: f.kind,
                        value: num(f.obstacle) ? f.obstacle : null });
   }
   D.incidents.sort((a, b) => a.e - b.e);
