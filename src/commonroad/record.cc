@@ -154,15 +154,15 @@ RunRecorder::RunRecorder(const Scenario& scenario, std::string dir, int vehicle_
 RunRecorder::~RunRecorder() = default;
 
 void RunRecorder::Attach(RunOptions* options) {
-  options->on_plan = [this](const CycleInput& in, const plan::PlanResult& result,
-                            const plan::CycleTrace* trace) { OnPlan(in, result, trace); };
+  options->on_plan = [this](const CycleInput& in, const plan::PlanResult& result) {
+    OnPlan(in, result);
+  };
   options->on_problem_end = [this](const PlanningProblem& problem, const ProblemRun& run) {
     OnProblemEnd(problem, run);
   };
 }
 
-void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result,
-                         const plan::CycleTrace* trace) {
+void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
   if (failed_) return;
   const map::Road& road = *in.road;
   if (!writer_) {
@@ -229,9 +229,8 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result,
                       y = t.y, yaw = t.yaw, speed = t.speed, s = t.s, d = t.d,
                       lane = road.LaneOf(t.s, t.d), cars = std::move(cars), path_x = result.x,
                       path_y = result.y, status = result.status, summary = result.summary, scale,
-                      candidates = trace != nullptr ? trace->candidates
-                                                    : std::vector<plan::CandidateTrace>(),
-                      telemetry = t, replica = replica_, path = path_](std::string* line) mutable {
+                      candidates = std::vector<plan::CandidateTrace>(), telemetry = t,
+                      replica = replica_, path = path_](std::string* line) mutable {
     // The candidates, traced by the replica; its counts with the driving planner's times.
     if (replica->planner) {
       replica->trace.candidates.clear();

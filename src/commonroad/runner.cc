@@ -322,9 +322,6 @@ Status RunOptions::Validate() const {
   if (vehicle_type < 1 || vehicle_type > 3) {
     return Status::Error("vehicle type must be 1, 2 or 3, got " + std::to_string(vehicle_type));
   }
-  if (trace_candidates < 0) {
-    return Status::Error("trace_candidates must be >= 0, got " + std::to_string(trace_candidates));
-  }
   return Status::Ok();
 }
 
@@ -426,7 +423,6 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     ego.steering_angle = problem.initial.steering_angle.value_or(0.0);
     run.trajectory.push_back(ego);
     plan::Telemetry t;
-    plan::CycleTrace trace;
     std::vector<double> path_x, path_y;
     run.stop_reason = "time";
     for (int k = start; k < end; ++k) {
@@ -492,17 +488,14 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         t.goals.push_back(r);
       }
       const bool tracing = spdlog::should_log(spdlog::level::trace);
-      const int traced = std::max(tracing ? 200 : 0, options.trace_candidates);
-      trace.candidates.clear();
-      if (traced > 0) (*planner)->set_trace(&trace, traced);
+      plan::CycleTrace trace;
+      if (tracing) (*planner)->set_trace(&trace, 200);
       const CycleInput input{problem, k, built->road, problem_config, t};
       if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
       const plan::PlanResult& res = (*planner)->Plan(t);
       const auto t_planned = std::chrono::steady_clock::now();
-      if (options.on_plan) {
-        options.on_plan(input, res, options.trace_candidates > 0 ? &trace : nullptr);
-      }
+      if (options.on_plan) options.on_plan(input, res);
       if (tracing) {
         // The best candidate of each lane: its cost by term and what became of it.
         std::vector<bool> seen(16, false);
@@ -518,8 +511,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                         c.reject >= 0 ? plan::ToString(static_cast<plan::Reject>(c.reject)) : "-",
                         c.reject_car, c.reject_time, terms);
         }
+        (*planner)->set_trace(nullptr, 0);
       }
-      if (traced > 0) (*planner)->set_trace(nullptr, 0);
       const double ms = std::chrono::duration<double, std::milli>(t_planned - t0).count();
       RunCycle cyc;
       cyc.step = k;

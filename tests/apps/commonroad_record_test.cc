@@ -108,7 +108,7 @@ TEST_F(CommonRoadRecordTest, RecordReadsBackWithLanesCarsAndOneExchangePerStep) 
   EXPECT_NEAR(run->t.back(), (steps - 1) * 0.1, 1e-9);
   EXPECT_NEAR(run->x.front(), 10, 1e-6);
   EXPECT_NEAR(run->y.front(), -1.75, 1e-6);
-  EXPECT_GT(run->path_offset[1], run->path_offset[0]);  // the plan's path
+  EXPECT_GT(run->path_offset[1], run->path_offset[0]);                  // the plan's path
   EXPECT_EQ(run->candidate_cycles.size(), static_cast<size_t>(steps));  // replica never diverged
   // Both cars at the first step with their sizes; the parked one at its own heading.
   ASSERT_EQ(run->traffic_offset.size(), static_cast<size_t>(steps) + 1);
@@ -145,6 +145,8 @@ TEST_F(CommonRoadRecordTest, RecordReadsBackWithLanesCarsAndOneExchangePerStep) 
   CommandResult rep = RunFrenetic("report " + file.string() + " -o " + html.string());
   ASSERT_EQ(rep.exit_code, 0) << rep.out;
   EXPECT_THAT(rep.out, HasSubstr(std::to_string(steps) + " exchanges"));
+  EXPECT_THAT(rep.out,
+              HasSubstr(p["solved"].get<bool>() ? "; solved, goal at step " : "; NOT solved:"));
   EXPECT_GT(fs::file_size(html), 40000u);
 }
 

@@ -68,7 +68,7 @@ class RunRecorder {
   const std::vector<std::string>& files() const { return files_; }
 
  private:
-  void OnPlan(const CycleInput& in, const plan::PlanResult& result, const plan::CycleTrace* trace);
+  void OnPlan(const CycleInput& in, const plan::PlanResult& result);
   void OnProblemEnd(const PlanningProblem& problem, const ProblemRun& run);
 
   const Scenario& scenario_;

@@ -60,12 +60,9 @@ struct RunOptions {
   bool timing = true;    // false: planning times are recorded as 0 (byte-stable output)
   // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
   std::function<void(const CycleInput&)> on_cycle;
-  // Called after each Plan() with its input, its result and, when trace_candidates > 0, the
-  // candidates it traced (else null); may be empty. The ego has not moved yet.
-  std::function<void(const CycleInput&, const plan::PlanResult&, const plan::CycleTrace*)> on_plan;
-  // Candidates traced per cycle for on_plan (best first; 0: none). Tracing does not change the
-  // plans, only lengthens the planning time measured (~13%).
-  int trace_candidates = 0;
+  // Called after each Plan() with its input and result (the ego has not moved yet; the time it
+  // takes is not planning time); may be empty.
+  std::function<void(const CycleInput&, const plan::PlanResult&)> on_plan;
   // Called once a problem's run is complete (verdict included), also for one that never ran
   // (no road); may be empty.
   std::function<void(const PlanningProblem&, const ProblemRun&)> on_problem_end;
