@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -19,6 +21,7 @@
 
 #include "apps/commands.h"
 #include "frenetic/commonroad/cost.h"
+#include "frenetic/commonroad/record.h"
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
@@ -37,6 +40,7 @@ struct Args {
   std::string config_path;
   std::string overlay_path;
   std::string solution_dir;
+  std::string record_dir;
   bool json = false;
   int jobs = 0;
   bool progress = false;
@@ -57,6 +61,7 @@ struct FileResult {
   std::vector<std::map<std::string, double>> costs;
   std::string solution_file;
   Status solution_status;
+  Status record_status;  // the records' (--record)
 };
 
 double Percentile(std::vector<double> v, double q) {
@@ -66,8 +71,26 @@ double Percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
+// --record DIR: created when missing; an error names it when it is no writable directory.
+Status RecordDirWritable(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Status::Error("--record " + dir + ": " + ec.message());
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return Status::Error("--record " + dir + ": not a directory");
+  }
+  const std::filesystem::path probe =
+      std::filesystem::path(dir) / (".frenetic-record-" + std::to_string(::getpid()));
+  std::FILE* f = std::fopen(probe.c_str(), "wb");
+  if (f == nullptr) return Status::Error("--record " + dir + ": " + std::strerror(errno));
+  std::fclose(f);
+  std::filesystem::remove(probe, ec);
+  return Status::Ok();
+}
+
 FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
-                   const cr::RunOptions& options, const std::string& solution_dir) {
+                   const cr::RunOptions& options, const std::string& solution_dir,
+                   const std::string& record_dir) {
   FileResult r;
   r.path = path;
   auto scenario = cr::LoadScenario(path);
@@ -75,7 +98,16 @@ FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
     r.read = scenario.status();
     return r;
   }
-  r.run = cr::RunScenario(*scenario, config, options);
+  if (record_dir.empty()) {
+    r.run = cr::RunScenario(*scenario, config, options);
+  } else {
+    cr::RunRecorder recorder(*scenario, record_dir, options.vehicle_type, options.prediction,
+                             options.timing);
+    cr::RunOptions recorded = options;
+    recorder.Attach(&recorded);
+    r.run = cr::RunScenario(*scenario, config, recorded);
+    r.record_status = recorder.status();
+  }
   const cr::VehicleParams vehicle = *cr::VehicleParamsForType(options.vehicle_type);
   cr::Solution solution;
   solution.scenario_id = scenario->benchmark_id;
@@ -195,6 +227,9 @@ int Run(const Args& a) {
     std::filesystem::create_directories(a.solution_dir, ec);
     if (ec) return Fail("--solution-dir " + a.solution_dir + ": " + ec.message());
   }
+  if (!a.record_dir.empty()) {
+    if (Status st = RecordDirWritable(a.record_dir); !st.ok()) return Fail(st.message());
+  }
   const std::string config_path =
       a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
   auto base = cr::LoadBaseConfig(config_path, a.overlay_path);
@@ -211,7 +246,7 @@ int Run(const Args& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (int i = next++; i < n; i = next++) {
-      results[i] = RunFile((*files)[i], *config, options, a.solution_dir);
+      results[i] = RunFile((*files)[i], *config, options, a.solution_dir, a.record_dir);
       for (const cr::ProblemRun& p : results[i].run.problems) {
         ++problems;
         solved += p.verdict.solved;
@@ -305,7 +340,14 @@ int Run(const Args& a) {
                 Percentile(ms, 0.5), Percentile(ms, 0.99), max_ms, cycles);
     std::printf("candidates per cycle: mean %.0f\n", cycles ? cands / cycles : 0.0);
   }
-  return unreadable > 0 ? 1 : 0;
+  // Records do not change the results above: a failure to write one is told on stderr.
+  int record_errors = 0;
+  for (const FileResult& f : results) {
+    if (f.record_status.ok()) continue;
+    ++record_errors;
+    std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_status.message().c_str());
+  }
+  return unreadable > 0 || record_errors > 0 ? 1 : 0;
 }
 
 }  // namespace
@@ -338,6 +380,13 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_option("--solution-dir", args->solution_dir,
                   "Write a CommonRoad solution file per scenario into DIR "
                   "(solution_KS2:WX1:<scenario id>:2020a.xml). Default: none");
+  sub->add_option("--record", args->record_dir,
+                  "Write a record of each planning problem's run into DIR (created if missing): "
+                  "<scenario id>_<problem id>.jsonl.gz, the drive record's format with the "
+                  "road's lane borders, the goal regions, the obstacles with their sizes, the "
+                  "ego, its planned path and up to 40 candidates per cycle; `frenetic report "
+                  "FILE` replays it. The results do not change (the candidates are traced by a "
+                  "replica of the planner, off the planning thread). Default: none");
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
                   "Scenario files planned in parallel (0 = all cores). Results do not depend on "

@@ -31,6 +31,28 @@ std::string DefaultOutput(std::string run) {
   return (has_extension ? run.substr(0, dot) : run) + ".html";
 }
 
+// A CommonRoad run's verdict (its footer's, commonroad/record.h) as "; solved, goal at step 78"
+// or "; NOT solved: goal at step 50"; empty for a drive.
+std::string Verdict(const report::RunData& run) {
+  if (run.header.world != "commonroad" || !run.has_footer) return "";
+  const nlohmann::json f = nlohmann::json::parse(run.footer_json, nullptr, false);
+  if (!f.is_object() || !f.contains("solved") || !f["solved"].is_boolean()) return "";
+  if (f["solved"].get<bool>()) {
+    return "; solved, goal at step " +
+           (f.contains("goal_step") ? f["goal_step"].dump() : std::string("?"));
+  }
+  std::string out = "; NOT solved:";
+  if (f.contains("failures") && f["failures"].is_array()) {
+    for (const nlohmann::json& e : f["failures"]) {
+      if (!e.is_object()) continue;
+      const bool named = e.contains("kind") && e["kind"].is_string();
+      out += " " + (named ? e["kind"].get<std::string>() : std::string("?")) + " at step " +
+             (e.contains("step") ? e["step"].dump() : std::string("?"));
+    }
+  }
+  return out;
+}
+
 int RunReport(const ReportArgs& args) {
   auto run = report::ReadRecordFile(args.run, args.read);
   if (!run.ok()) {
@@ -65,10 +87,10 @@ int RunReport(const ReportArgs& args) {
     std::printf("%s\n", out.dump().c_str());
   } else {
     std::printf("wrote %s (%.1f MB): %d exchanges over %.1f s, %zu cycles with candidates, "
-                "%zu incidents, %d lines skipped%s\n",
+                "%zu incidents, %d lines skipped%s%s\n",
                 output.c_str(), page.size() / 1e6, run->size(), run->t.back() - run->t.front(),
                 run->candidate_cycles.size(), run->incidents.size(), run->skipped_lines,
-                run->has_footer ? "" : ", no footer (run cut short?)");
+                run->has_footer ? "" : ", no footer (run cut short?)", Verdict(*run).c_str());
   }
   return 0;
 }

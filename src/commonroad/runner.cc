@@ -360,6 +360,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     if (!built.ok()) {
       run.road = built.status();
       run.verdict = checker.Check(problem, run.trajectory);
+      if (options.on_problem_end) options.on_problem_end(problem, run);
       out.problems.push_back(std::move(run));
       continue;
     }
@@ -391,6 +392,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     auto planner = plan::MakePlanner("search", problem_config, built->road);
     if (!planner.ok()) {
       run.road = planner.status();
+      if (options.on_problem_end) options.on_problem_end(problem, run);
       out.problems.push_back(std::move(run));
       continue;
     }
@@ -488,9 +490,12 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       const bool tracing = spdlog::should_log(spdlog::level::trace);
       plan::CycleTrace trace;
       if (tracing) (*planner)->set_trace(&trace, 200);
-      if (options.on_cycle) options.on_cycle({problem, k, built->road, problem_config, t});
+      const CycleInput input{problem, k, built->road, problem_config, t};
+      if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
       const plan::PlanResult& res = (*planner)->Plan(t);
+      const auto t_planned = std::chrono::steady_clock::now();
+      if (options.on_plan) options.on_plan(input, res);
       if (tracing) {
         // The best candidate of each lane: its cost by term and what became of it.
         std::vector<bool> seen(16, false);
@@ -508,8 +513,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         }
         (*planner)->set_trace(nullptr, 0);
       }
-      const double ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const double ms = std::chrono::duration<double, std::milli>(t_planned - t0).count();
       RunCycle cyc;
       cyc.step = k;
       cyc.plan_ms = options.timing ? ms : 0.0;
@@ -546,6 +550,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       if (met) run.stop_reason = "goal";
     }
     run.verdict = checker.Check(problem, run.trajectory);
+    if (options.on_problem_end) options.on_problem_end(problem, run);
     out.problems.push_back(std::move(run));
   }
   return out;

@@ -156,11 +156,43 @@ std::string PageDataJson(const RunData& run, std::string_view source) {
   o.Key("car_length").Fixed(h.car_length, 3);
   o.Key("car_width").Fixed(h.car_width, 3);
   o.Key("config").Json(h.config_json);
+  // A CommonRoad run's fields; a drive's page has none of them (and stays as it was).
+  if (!h.world.empty()) {
+    o.Key("world").String(h.world);
+    o.Key("problem").Int(h.problem);
+    o.Key("dt").Fixed(h.dt, 4);
+    o.Key("prediction").String(h.prediction);
+    o.Key("vehicle").String(h.vehicle);
+  }
   o.Close('}');
   o.Key("center").Open('{');
   o.Key("x").Fixeds(h.center_x, 2);
   o.Key("y").Fixeds(h.center_y, 2);
   o.Close('}');
+  if (!h.road_lanes.empty()) {
+    o.Key("road").Open('[');
+    for (const RecordHeader::Lane& l : h.road_lanes) {
+      o.Open('{');
+      o.Key("lx").Fixeds(l.left.x, 2).Key("ly").Fixeds(l.left.y, 2);
+      o.Key("rx").Fixeds(l.right.x, 2).Key("ry").Fixeds(l.right.y, 2);
+      o.Close('}');
+    }
+    o.Close(']');
+  }
+  if (!h.goals.empty()) {
+    o.Key("goals").Open('[');
+    for (const RecordHeader::Goal& g : h.goals) {
+      o.Open('{').Key("x").Fixeds(g.outline.x, 2).Key("y").Fixeds(g.outline.y, 2);
+      o.Key("steps");
+      if (g.step_lo >= 0) {
+        o.Open('[').Int(g.step_lo).Int(g.step_hi).Close(']');
+      } else {
+        o.Json("null");
+      }
+      o.Close('}');
+    }
+    o.Close(']');
+  }
 
   o.Key("n").Int(run.size());
   o.Key("ex").Open('{');
@@ -216,6 +248,12 @@ std::string PageDataJson(const RunData& run, std::string_view source) {
   o.Key("x").Fixeds(run.traffic_x, 1);
   o.Key("y").Fixeds(run.traffic_y, 1);
   o.Key("h").Fixeds(run.traffic_heading_deg, 0);
+  bool sizes = false;
+  for (double v : run.traffic_length) sizes = sizes || std::isfinite(v);
+  if (sizes) {  // cars of their own sizes (CommonRoad); a drive's cars are all the header's
+    o.Key("l").Fixeds(run.traffic_length, 2);
+    o.Key("w").Fixeds(run.traffic_width, 2);
+  }
   o.Close('}');
 
   // Candidates: [lane, end_speed, duration, total_cost, flags (1 checked, 2 winner), reject or
@@ -257,6 +295,11 @@ std::string PageDataJson(const RunData& run, std::string_view source) {
 
 std::string_view PageTemplate() { return internal::PageTemplateText(); }
 
+std::string_view PageTemplateFor(const RunData& run) {
+  return run.header.world == "commonroad" ? internal::CommonRoadPageTemplateText()
+                                          : internal::PageTemplateText();
+}
+
 std::string RenderPage(const RunData& run, std::string_view source) {
   std::string data = PageDataJson(run, source);
   // '<' occurs only inside JSON strings, where \u003c means the same: no "</script>" or "<!--"
@@ -270,7 +313,7 @@ std::string RenderPage(const RunData& run, std::string_view source) {
       escaped += c;
     }
   }
-  const std::string_view page = PageTemplate();
+  const std::string_view page = PageTemplateFor(run);
   const size_t at = page.find(kDataPlaceholder);
   FRENETIC_CHECK(at != std::string_view::npos);  // report.cmake refuses a template without it
   std::string out;

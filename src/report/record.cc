@@ -224,7 +224,49 @@ class Reader {
     if (const json* config = Field(h, "config"); config != nullptr) {
       header.config_json = config->dump();
     }
+    header.world = Str(h, "world");
+    if (header.world.empty()) return Status::Ok();
+    header.problem = Int(h, "problem", -1);
+    header.dt = Num(h, "dt", 0);
+    header.prediction = Str(h, "prediction");
+    header.vehicle = Str(h, "vehicle");
+    if (const json* road = Field(h, "road"); road != nullptr) {
+      if (const json* lanes = Field(*road, "lanes"); lanes != nullptr && lanes->is_array()) {
+        for (const json& l : *lanes) {
+          RecordHeader::Lane lane;
+          lane.left = ReadPolyline(Field(l, "left"));
+          lane.right = ReadPolyline(Field(l, "right"));
+          header.road_lanes.push_back(std::move(lane));
+        }
+      }
+    }
+    if (const json* goals = Field(h, "goals"); goals != nullptr && goals->is_array()) {
+      for (const json& g : *goals) {
+        RecordHeader::Goal goal;
+        goal.outline = ReadPolyline(&g);
+        if (const json* steps = Field(g, "steps");
+            steps != nullptr && steps->is_array() && steps->size() == 2 &&
+            (*steps)[0].is_number_integer() && (*steps)[1].is_number_integer()) {
+          goal.step_lo = (*steps)[0].get<int>();
+          goal.step_hi = (*steps)[1].get<int>();
+        }
+        if (!goal.outline.x.empty()) header.goals.push_back(std::move(goal));
+      }
+    }
     return Status::Ok();
+  }
+
+  // {"x": [...], "y": [...]}: the points where both are finite numbers.
+  static Polyline ReadPolyline(const json* o) {
+    Polyline p;
+    if (o == nullptr) return p;
+    const std::vector<double> x = Numbers(Field(*o, "x")), y = Numbers(Field(*o, "y"));
+    for (size_t i = 0; i < std::min(x.size(), y.size()); ++i) {
+      if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+      p.x.push_back(x[i]);
+      p.y.push_back(y[i]);
+    }
+    return p;
   }
 
   int StatusIndex(const std::string& name) {
@@ -366,9 +408,18 @@ class Reader {
       run_.traffic_x.push_back(cx);
       run_.traffic_y.push_back(cy);
       // A standing car has no heading of its own; the page then draws it along the road.
-      run_.traffic_heading_deg.push_back(std::hypot(vx, vy) > 0.1
-                                             ? std::atan2(vy, vx) * 180.0 / std::numbers::pi
-                                             : kNaN);
+      double heading = std::hypot(vx, vy) > 0.1 ? std::atan2(vy, vx) * 180.0 / std::numbers::pi
+                                                : kNaN;
+      double length = kNaN, width = kNaN;
+      if (car.size() >= 9 && car[7].is_number() && car[8].is_number()) {
+        length = car[7].get<double>();
+        width = car[8].get<double>();
+        if (!(length > 0 && width > 0)) length = width = kNaN;
+      }
+      if (car.size() >= 10 && car[9].is_number()) heading = car[9].get<double>();
+      run_.traffic_heading_deg.push_back(heading);
+      run_.traffic_length.push_back(length);
+      run_.traffic_width.push_back(width);
     }
   }
 

@@ -284,6 +284,61 @@ class RecordWriter::Sink {
   std::string error_;
 };
 
+nlohmann::json PlanJson(plan::PlanStatus status, const plan::PlanSummary& s, double plan_ms,
+                        double time_scale, const std::vector<plan::CandidateTrace>& candidates) {
+  const double k = time_scale;
+  nlohmann::json rejections = nlohmann::json::object();
+  for (int r = 0; r < static_cast<int>(plan::Reject::kCount); ++r) {
+    rejections[plan::ToString(static_cast<plan::Reject>(r))] = s.rejections[r];
+  }
+  nlohmann::json traced = nlohmann::json::array();
+  for (const plan::CandidateTrace& c : candidates) {
+    nlohmann::json reject = nullptr;
+    if (c.reject >= 0 && c.reject < static_cast<int>(plan::Reject::kCount)) {
+      reject = plan::ToString(static_cast<plan::Reject>(c.reject));
+    }
+    traced.push_back({{"lane", c.lane},
+                      {"end_speed", Finite(c.end_speed)},
+                      {"duration", Finite(c.duration)},
+                      {"total_cost", Finite(c.total_cost)},
+                      {"checked", c.checked},
+                      {"winner", c.winner},
+                      {"reject", reject},
+                      {"reject_car", c.reject_car >= 0 ? nlohmann::json(c.reject_car)
+                                                       : nlohmann::json(nullptr)},
+                      {"reject_t", Finite(c.reject_time)},
+                      {"x", Decimeters(c.x)},
+                      {"y", Decimeters(c.y)},
+                      {"costs", Costs(c.costs)}});
+  }
+  return {{"status", StatusName(status)},
+          {"ms_total", k * plan_ms},
+          {"ms_planner", k * s.ms_total},
+          {"ms_stages",
+           {{"prepare", k * s.ms_prepare},
+            {"generate", k * s.ms_generate},
+            {"score", k * s.ms_score},
+            {"check", k * s.ms_check},
+            {"refine", k * s.ms_refine},
+            {"output", k * s.ms_output}}},
+          {"candidates_generated", s.candidates_generated},
+          {"candidates_scored", s.candidates_scored},
+          {"candidates_checked", s.candidates_checked},
+          {"candidates_feasible", s.candidates_feasible},
+          {"rejections", rejections},
+          {"winner_costs", Costs(s.winner_costs)},
+          {"winner_total_cost", Finite(s.winner_total_cost)},
+          {"winner_lane", s.winner_lane},
+          {"winner_end_speed", Finite(s.winner_end_speed)},
+          {"winner_duration", Finite(s.winner_duration)},
+          {"refine_iterations", s.refine_iterations},
+          {"deadline_stage", plan::ToString(s.deadline_stage)},
+          {"refine_cost_before", Finite(s.refine_cost_before)},
+          {"refine_cost_after", Finite(s.refine_cost_after)},
+          {"points_kept", s.points_kept},
+          {"candidates", traced}};
+}
+
 nlohmann::json YamlToJson(const std::string& yaml_text) {
   try {
     return Node(YAML::Load(yaml_text));
@@ -474,57 +529,7 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
       candidates.clear();
       Replay(index, telemetry_json, path_x, path_y, &summary, &candidates);
     }
-    const plan::PlanSummary& s = summary;
-    nlohmann::json rejections = nlohmann::json::object();
-    for (int r = 0; r < static_cast<int>(plan::Reject::kCount); ++r) {
-      rejections[plan::ToString(static_cast<plan::Reject>(r))] = s.rejections[r];
-    }
-    nlohmann::json traced = nlohmann::json::array();
-    for (const plan::CandidateTrace& c : candidates) {
-      nlohmann::json reject = nullptr;
-      if (c.reject >= 0 && c.reject < static_cast<int>(plan::Reject::kCount)) {
-        reject = plan::ToString(static_cast<plan::Reject>(c.reject));
-      }
-      traced.push_back({{"lane", c.lane},
-                        {"end_speed", Finite(c.end_speed)},
-                        {"duration", Finite(c.duration)},
-                        {"total_cost", Finite(c.total_cost)},
-                        {"checked", c.checked},
-                        {"winner", c.winner},
-                        {"reject", reject},
-                        {"reject_car", c.reject_car >= 0 ? nlohmann::json(c.reject_car)
-                                                         : nlohmann::json(nullptr)},
-                        {"reject_t", Finite(c.reject_time)},
-                        {"x", Decimeters(c.x)},
-                        {"y", Decimeters(c.y)},
-                        {"costs", Costs(c.costs)}});
-    }
-    const nlohmann::json plan = {{"status", StatusName(status)},
-                                 {"ms_total", k * plan_ms},
-                                 {"ms_planner", k * s.ms_total},
-                                 {"ms_stages",
-                                  {{"prepare", k * s.ms_prepare},
-                                   {"generate", k * s.ms_generate},
-                                   {"score", k * s.ms_score},
-                                   {"check", k * s.ms_check},
-                                   {"refine", k * s.ms_refine},
-                                   {"output", k * s.ms_output}}},
-                                 {"candidates_generated", s.candidates_generated},
-                                 {"candidates_scored", s.candidates_scored},
-                                 {"candidates_checked", s.candidates_checked},
-                                 {"candidates_feasible", s.candidates_feasible},
-                                 {"rejections", rejections},
-                                 {"winner_costs", Costs(s.winner_costs)},
-                                 {"winner_total_cost", Finite(s.winner_total_cost)},
-                                 {"winner_lane", s.winner_lane},
-                                 {"winner_end_speed", Finite(s.winner_end_speed)},
-                                 {"winner_duration", Finite(s.winner_duration)},
-                                 {"refine_iterations", s.refine_iterations},
-                                 {"deadline_stage", plan::ToString(s.deadline_stage)},
-                                 {"refine_cost_before", Finite(s.refine_cost_before)},
-                                 {"refine_cost_after", Finite(s.refine_cost_after)},
-                                 {"points_kept", s.points_kept},
-                                 {"candidates", traced}};
+    const nlohmann::json plan = PlanJson(status, summary, plan_ms, k, candidates);
     FormatExchange(index, t, telemetry_json, path_x, path_y, plan, metrics, incidents, line);
   });
 }
@@ -543,6 +548,10 @@ void RecordWriter::WriteRemoteExchange(int index, double t, const std::string& t
     const nlohmann::json plan = {{"status", reply}, {"ms_total", ms}};
     FormatExchange(index, t, telemetry_json, path_x, path_y, plan, metrics, incidents, line);
   });
+}
+
+void RecordWriter::WriteLine(std::function<void(std::string* line)> format, bool last) {
+  Queue(std::move(format), last);
 }
 
 void RecordWriter::WriteFooter(const DriveReport& report) {

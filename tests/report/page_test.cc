@@ -3,11 +3,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "report/synthetic_record.h"
 
@@ -64,6 +66,61 @@ TEST(PageDataTest, IsValidJsonWithColumnsOfOneLength) {
   EXPECT_TRUE(c0["c"][0][5].is_string());  // rejected best candidate of cycle 0
   EXPECT_EQ(c0["c"][1][4], 3);             // checked and winner
   EXPECT_EQ(c0["c"][1][8].size(), 9u);     // three terms as (index, weight, value)
+}
+
+// A drive's page stays as it was before CommonRoad records: none of their keys in the data, and
+// the drive's script (without the CommonRoad parts).
+TEST(PageDataTest, ADrivesPageHasNoCommonRoadParts) {
+  testing::SyntheticOptions options;
+  options.exchanges = 20;
+  const RunData run = ReadSynthetic(options);
+  const json data = json::parse(PageDataJson(run, "run.jsonl"));
+  for (const char* key : {"world", "problem", "dt", "prediction", "vehicle"}) {
+    EXPECT_FALSE(data["header"].contains(key)) << key;
+  }
+  EXPECT_FALSE(data.contains("road"));
+  EXPECT_FALSE(data.contains("goals"));
+  EXPECT_FALSE(data["traffic"].contains("l"));
+  EXPECT_FALSE(data["traffic"].contains("w"));
+  EXPECT_EQ(PageTemplateFor(run), PageTemplate());
+  EXPECT_THAT(std::string(PageTemplate()), Not(HasSubstr("//@")));
+}
+
+// A CommonRoad record's header (commonroad/record.h) and rows with sizes and headings.
+TEST(PageDataTest, ACommonRoadRecordHasItsRoadGoalsAndCarSizes) {
+  const std::string text =
+      R"({"type":"header","version":1,"world":"commonroad","scenario":"ZAM_X-1_1_T-1",)"
+      R"("problem":7,"dt":0.1,"prediction":"recorded","vehicle":"KS2","lanes":1,)"
+      R"("lane_width":3.5,"car_length":4.508,"car_width":1.61,)"
+      R"("road":{"lanes":[{"left":{"x":[0,100],"y":[0,0]},)"
+      R"("right":{"x":[0,100],"y":[-3.5,-3.5]}}]},)"
+      R"("goals":[{"x":[90,100,100,90],"y":[0,0,-3.5,-3.5],"steps":[10,20]}]})"
+      "\n"
+      R"({"type":"exchange","i":0,"t":0,"telemetry":{"x":10,"y":-1.75,"yaw":0,"speed":40,"s":10,)"
+      R"("d":1.75,"sensor_fusion":[[3,30,-1.75,0,0,30,1.75,4.8,2.0,90],[4,40,-1.75,5,0,40,1.75]]}})"
+      "\n";
+  std::istringstream in(text);
+  auto run = ReadRecord(in, "cr.jsonl");
+  ASSERT_TRUE(run.ok()) << run.message();
+  const RecordHeader& h = run->header;
+  EXPECT_EQ(h.world, "commonroad");
+  EXPECT_EQ(h.problem, 7);
+  ASSERT_EQ(h.road_lanes.size(), 1u);
+  EXPECT_EQ(h.road_lanes[0].right.y, (std::vector<double>{-3.5, -3.5}));
+  ASSERT_EQ(h.goals.size(), 1u);
+  EXPECT_EQ(h.goals[0].step_lo, 10);
+  EXPECT_EQ(h.goals[0].step_hi, 20);
+  ASSERT_EQ(run->traffic_length.size(), 2u);
+  EXPECT_EQ(run->traffic_length[0], 4.8);
+  EXPECT_EQ(run->traffic_heading_deg[0], 90);       // the row's own, though it stands
+  EXPECT_TRUE(std::isnan(run->traffic_length[1]));  // a drive's row: the header's size
+  const json data = json::parse(PageDataJson(*run, "cr.jsonl"));
+  EXPECT_EQ(data["header"]["world"], "commonroad");
+  EXPECT_EQ(data["road"][0]["ry"], json::array({-3.5, -3.5}));
+  EXPECT_EQ(data["goals"][0]["steps"], json::array({10, 20}));
+  EXPECT_EQ(data["traffic"]["l"], json::array({4.8, nullptr}));
+  EXPECT_NE(PageTemplateFor(*run), PageTemplate());
+  EXPECT_THAT(RenderPage(*run, "cr.jsonl"), HasSubstr("D.traffic.l[j]"));
 }
 
 TEST(PageDataTest, RoundsNumbersAndWritesNullForMissing) {

@@ -43,6 +43,8 @@ StatusOr<PredictionMode> ParsePredictionMode(std::string_view text);
 
 inline constexpr int kMaxSteps = 3000;
 
+struct ProblemRun;
+
 // What the planner is given at one cycle of a run (RunOptions::on_cycle).
 struct CycleInput {
   const PlanningProblem& problem;
@@ -58,6 +60,12 @@ struct RunOptions {
   bool timing = true;    // false: planning times are recorded as 0 (byte-stable output)
   // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
   std::function<void(const CycleInput&)> on_cycle;
+  // Called after each Plan() with its input and result (the ego has not moved yet; the time it
+  // takes is not planning time); may be empty.
+  std::function<void(const CycleInput&, const plan::PlanResult&)> on_plan;
+  // Called once a problem's run is complete (verdict included), also for one that never ran
+  // (no road); may be empty.
+  std::function<void(const PlanningProblem&, const ProblemRun&)> on_problem_end;
   Status Validate() const;
 };
 

@@ -38,6 +38,11 @@ struct ReadOptions {
   Status Validate() const;
 };
 
+// A polyline or outline in the map frame, m.
+struct Polyline {
+  std::vector<double> x, y;
+};
+
 // The header line, the fields the page uses.
 struct RecordHeader {
   int version = 0;
@@ -50,6 +55,22 @@ struct RecordHeader {
   // The road's centre line (d = 0), map frame, m; lanes lie to its right (d > 0).
   std::vector<double> center_x, center_y;
   std::string config_json = "null";  // header.config re-serialised as JSON (object or string)
+
+  // A CommonRoad run's record (`frenetic commonroad --record`, commonroad/record.h): world is
+  // "commonroad" (empty for a drive's record, which has none of the fields below).
+  std::string world;
+  int problem = -1;  // the planning problem's id
+  double dt = 0;     // s per time step
+  std::string prediction, vehicle;
+  struct Lane {
+    Polyline left, right;  // borders
+  };
+  std::vector<Lane> road_lanes;  // left to right
+  struct Goal {
+    Polyline outline;
+    int step_lo = -1, step_hi = -1;  // time window in steps, -1 when none
+  };
+  std::vector<Goal> goals;
 };
 
 // One cost term over the run: the winner's weight and unweighted value per exchange (NaN where
@@ -118,6 +139,9 @@ struct RunData {
   std::vector<int> traffic_offset;  // sensor_fusion within ReadOptions::traffic_range
   std::vector<int> traffic_id;
   std::vector<double> traffic_x, traffic_y, traffic_heading_deg;
+  // Each car's footprint (m) where the record gives it (rows [id, x, y, vx, vy, s, d, length,
+  // width, heading_deg]), else NaN; the heading then comes from the row's too.
+  std::vector<double> traffic_length, traffic_width;
 
   std::vector<CycleCandidates> candidate_cycles;  // sorted by exchange
   std::vector<Incident> incidents;                // in record order

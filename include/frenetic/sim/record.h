@@ -79,6 +79,11 @@ class RecordWriter {
                            std::size_t first_incident, int l_old, int l_new);
   // The last line: the stream is ended after it (later writes are ignored).
   void WriteFooter(const DriveReport& report);
+  // A line of a record of another kind of run (`frenetic commonroad --record`,
+  // commonroad/record.h): `format` appends the line (one JSON object, no newline) on the
+  // writer's thread, so it should hold copies, not references to what the caller changes next.
+  // `last` ends the stream after it, as WriteFooter does.
+  void WriteLine(std::function<void(std::string* line)> format, bool last = false);
   // Waits until everything queued is in the file; Ok unless a write failed (the message names
   // the file and why).
   Status status();
@@ -115,6 +120,13 @@ class RecordWriter {
   int drain_ = 0;                 // status() calls waiting for everything to be written
   std::thread thread_;
 };
+
+// An exchange line's "plan" object as WriteExchange writes it: the status ("ok", "fallback",
+// ...), the counts, rejections by reason and the winner's costs of `summary`, and the traced
+// `candidates` (best first). Every time (plan_ms, the summary's stage times) is multiplied by
+// `time_scale`: 0 with timing off.
+nlohmann::json PlanJson(plan::PlanStatus status, const plan::PlanSummary& summary, double plan_ms,
+                        double time_scale, const std::vector<plan::CandidateTrace>& candidates);
 
 // The planner YAML as JSON (numbers, booleans, strings, maps, lists); the text itself on error.
 nlohmann::json YamlToJson(const std::string& yaml_text);

@@ -52,6 +52,16 @@
     if (i + 1 < N && t - T[i] > T[i + 1] - t) return i + 1;
     return i;
   }
+  //@commonroad
+  // A CommonRoad run (`frenetic commonroad --record`): the verdict's failures are its incidents,
+  // each at the cycle of its time step.
+  for (const f of (D.footer && Array.isArray(D.footer.failures) ? D.footer.failures : [])) {
+    const e = nearestIndexOfTime(f.step * H.dt);
+    D.incidents.push({ e, t: T[e], s: E.s[e], d: E.d[e], lane: E.lane[e], kind: f.kind,
+                       value: num(f.obstacle) ? f.obstacle : null });
+  }
+  D.incidents.sort((a, b) => a.e - b.e);
+  //@end
   const PALETTE = ["#1570ef", "#e04f16", "#12b76a", "#9e77ed", "#f79009", "#0e9384", "#dd2590",
                    "#475467", "#66c61c", "#6172f3"];
 
@@ -77,6 +87,17 @@
         `record ${D.source} \u00b7 map ${H.map || DASH} \u00b7 seed ${H.seed} \u00b7 ` +
         `${H.lanes} lanes of ${H.lane_width} m \u00b7 ${N} exchanges over ` +
         `${fmt(T[N - 1] - T[0], 1)} s \u00b7 ${D.generator}`));
+    //@commonroad
+    const verdict = !D.footer ? "no verdict (run cut short)"
+        : (D.footer.solved ? `solved, goal at step ${D.footer.goal_step}` : "NOT solved") +
+          ` (stopped by ${D.footer.stop_reason})`;
+    root.append(el("div", { class: "sub" },
+        `CommonRoad ${H.scenario}, planning problem ${H.problem} \u00b7 time step ${H.dt} s \u00b7 ` +
+        `${H.prediction} predictions \u00b7 vehicle ${H.vehicle} \u00b7 ${verdict}`));
+    for (const f of (D.footer && Array.isArray(D.footer.failures) ? D.footer.failures : [])) {
+      root.append(el("div", { class: "warn" }, `${f.kind} at step ${f.step}: ${f.detail}`));
+    }
+    //@end
     const f = D.footer || {};
     const tiles = el("div", { class: "tiles", id: "summary-tiles" });
     function tile(key, value, bad) {
@@ -196,6 +217,34 @@
     for (let l = 1; l < H.lanes; ++l) road.lanes.push(linePath(...offsetLine(l * H.lane_width)));
     road.edge = linePath(outer[0], outer[1]);
   }
+  //@commonroad
+  // A CommonRoad road: each lane's borders as recorded (lanes may begin, end, widen and bend
+  // apart); the leftmost lane's left border solid yellow, the rightmost's right border solid
+  // white, every border dashed. Goal regions as outlines.
+  const GOALS = [];
+  if (Array.isArray(D.road) && D.road.length) {
+    road.surface = new Path2D();
+    road.center = new Path2D();
+    road.edge = new Path2D();
+    D.road.forEach((l, i) => {
+      const n = Math.min(l.lx.length, l.ly.length, l.rx.length, l.ry.length);
+      if (n < 2) return;
+      for (let p = 0; p < n; ++p) (p ? road.surface.lineTo : road.surface.moveTo).call(road.surface, l.lx[p], l.ly[p]);
+      for (let p = n - 1; p >= 0; --p) road.surface.lineTo(l.rx[p], l.ry[p]);
+      road.surface.closePath();
+      const left = linePath(l.lx, l.ly), right = linePath(l.rx, l.ry);
+      road.lanes.push(left, right);
+      if (i === 0) road.center.addPath(left);
+      if (i === D.road.length - 1) road.edge.addPath(right);
+    });
+  }
+  for (const g of (Array.isArray(D.goals) ? D.goals : [])) {
+    if (g.x.length < 2) continue;
+    const p = linePath(g.x, g.y);
+    p.closePath();
+    GOALS.push({ path: p, steps: g.steps });
+  }
+  //@end
 
   // ---------- candidates ----------
   const CAND = D.candidates;
@@ -257,6 +306,18 @@
       for (const p of road.lanes) ctx.stroke(p);
       ctx.setLineDash([]);
     }
+    //@commonroad
+    // Goal regions: filled more strongly inside their time window.
+    for (const g of GOALS) {
+      const step = T[k] / H.dt;
+      const open = !g.steps || (step >= g.steps[0] - 1e-6 && step <= g.steps[1] + 1e-6);
+      ctx.fillStyle = open ? "rgba(18,183,106,0.35)" : "rgba(18,183,106,0.12)";
+      ctx.fill(g.path);
+      ctx.strokeStyle = "#12b76a";
+      ctx.lineWidth = 1.5 * px * dpr;
+      ctx.stroke(g.path);
+    }
+    //@end
     const labels = [];
     // Candidates of the cycle (decimated by the writer), the rejected ones faint.
     const cyc = state.showCandidates ? candidateCycleAt(k) : null;
@@ -303,8 +364,15 @@
     const t0 = D.traffic.off[k], t1 = D.traffic.off[k + 1];
     for (let j = t0; j < t1; ++j) {
       const h = D.traffic.h[j];
+      //@commonroad
+      // Each car of its recorded size.
+      box(ctx, D.traffic.x[j], D.traffic.y[j], num(h) ? h * Math.PI / 180 : yaw,
+          D.traffic.l && num(D.traffic.l[j]) ? D.traffic.l[j] : H.car_length,
+          D.traffic.w && num(D.traffic.w[j]) ? D.traffic.w[j] : H.car_width);
+      //@else
       box(ctx, D.traffic.x[j], D.traffic.y[j], num(h) ? h * Math.PI / 180 : yaw,
           H.car_length, H.car_width);
+      //@end
       ctx.fillStyle = "#d0d5dd";
       ctx.fill();
       ctx.lineWidth = 1 * px * dpr;
@@ -353,6 +421,11 @@
       '<span><i class="swatch" style="background:linear-gradient(90deg,hsl(120,85%,50%),hsl(0,85%,50%))"></i>' +
       'candidates, cheap to dear</span>' +
       '<span><i class="swatch" style="background:#ddd"></i>rejected (reason)</span>';
+  //@commonroad
+  $("replay-legend").innerHTML +=
+      '<span><i class="swatch" style="background:rgba(18,183,106,0.35);border:1px solid #12b76a"></i>' +
+      'goal region (strong inside its time window)</span>';
+  //@end
 
   // ---------- plots ----------
   const plots = [];
