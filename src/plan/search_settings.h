@@ -71,6 +71,10 @@ struct Settings {
   double refine_budget_ms;
   double fallback_decel, fallback_jerk, fallback_lat_duration;
   double budget_ms;
+  // strategy.*: the strategic layer (search_strategy.h). Seconds, and metres of progress.
+  bool strategy;
+  double strategy_horizon, strategy_dt, strategy_change_time, strategy_change_cost;
+  double strategy_hold, strategy_window, strategy_terminal_time;
 
   // On the configured uniform road (road.num_lanes x road.lane_width).
   explicit Settings(const PlannerConfig& c);

@@ -45,6 +45,25 @@ nlohmann::json Costs(const std::vector<plan::CostTermValue>& terms) {
   return a;
 }
 
+// The strategic layer's decision: the plans it weighed and the one chosen.
+nlohmann::json Strategy(const plan::StrategySummary& st) {
+  nlohmann::json plans = nlohmann::json::array();
+  for (int i = 0; i < st.num_plans && i < plan::StrategySummary::kMaxPlans; ++i) {
+    const plan::StrategyPlan& p = st.plans[i];
+    nlohmann::json lanes = nlohmann::json::array();
+    for (const int l : p.lanes) {
+      if (l >= 0) lanes.push_back(l);
+    }
+    plans.push_back({{"lanes", lanes},
+                     {"mode", plan::ToString(p.mode)},
+                     {"car", p.car >= 0 ? nlohmann::json(p.car) : nlohmann::json(nullptr)},
+                     {"t_change", p.t_change >= 0 ? Finite(p.t_change) : nlohmann::json(nullptr)},
+                     {"progress", Finite(p.progress)},
+                     {"value", Finite(p.value)}});
+  }
+  return {{"chosen", st.chosen}, {"plans", plans}};
+}
+
 nlohmann::json Node(const YAML::Node& n) {
   switch (n.Type()) {
     case YAML::NodeType::Map: {
@@ -499,32 +518,33 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
                         {"y", Decimeters(c.y)},
                         {"costs", Costs(c.costs)}});
     }
-    const nlohmann::json plan = {{"status", StatusName(status)},
-                                 {"ms_total", k * plan_ms},
-                                 {"ms_planner", k * s.ms_total},
-                                 {"ms_stages",
-                                  {{"prepare", k * s.ms_prepare},
-                                   {"generate", k * s.ms_generate},
-                                   {"score", k * s.ms_score},
-                                   {"check", k * s.ms_check},
-                                   {"refine", k * s.ms_refine},
-                                   {"output", k * s.ms_output}}},
-                                 {"candidates_generated", s.candidates_generated},
-                                 {"candidates_scored", s.candidates_scored},
-                                 {"candidates_checked", s.candidates_checked},
-                                 {"candidates_feasible", s.candidates_feasible},
-                                 {"rejections", rejections},
-                                 {"winner_costs", Costs(s.winner_costs)},
-                                 {"winner_total_cost", Finite(s.winner_total_cost)},
-                                 {"winner_lane", s.winner_lane},
-                                 {"winner_end_speed", Finite(s.winner_end_speed)},
-                                 {"winner_duration", Finite(s.winner_duration)},
-                                 {"refine_iterations", s.refine_iterations},
-                                 {"deadline_stage", plan::ToString(s.deadline_stage)},
-                                 {"refine_cost_before", Finite(s.refine_cost_before)},
-                                 {"refine_cost_after", Finite(s.refine_cost_after)},
-                                 {"points_kept", s.points_kept},
-                                 {"candidates", traced}};
+    nlohmann::json plan = {{"status", StatusName(status)},
+                           {"ms_total", k * plan_ms},
+                           {"ms_planner", k * s.ms_total},
+                           {"ms_stages",
+                            {{"prepare", k * s.ms_prepare},
+                             {"generate", k * s.ms_generate},
+                             {"score", k * s.ms_score},
+                             {"check", k * s.ms_check},
+                             {"refine", k * s.ms_refine},
+                             {"output", k * s.ms_output}}},
+                           {"candidates_generated", s.candidates_generated},
+                           {"candidates_scored", s.candidates_scored},
+                           {"candidates_checked", s.candidates_checked},
+                           {"candidates_feasible", s.candidates_feasible},
+                           {"rejections", rejections},
+                           {"winner_costs", Costs(s.winner_costs)},
+                           {"winner_total_cost", Finite(s.winner_total_cost)},
+                           {"winner_lane", s.winner_lane},
+                           {"winner_end_speed", Finite(s.winner_end_speed)},
+                           {"winner_duration", Finite(s.winner_duration)},
+                           {"refine_iterations", s.refine_iterations},
+                           {"deadline_stage", plan::ToString(s.deadline_stage)},
+                           {"refine_cost_before", Finite(s.refine_cost_before)},
+                           {"refine_cost_after", Finite(s.refine_cost_after)},
+                           {"points_kept", s.points_kept},
+                           {"candidates", traced}};
+    if (s.strategy.num_plans > 0) plan["strategy"] = Strategy(s.strategy);
     FormatExchange(index, t, telemetry_json, path_x, path_y, plan, metrics, incidents, line);
   });
 }
