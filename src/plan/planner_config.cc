@@ -98,6 +98,8 @@ constexpr Default kDefaults[] = {
     {"strategy.hold", 5, 0, 50, false},
     {"strategy.window", 4, 0.5, 30, false},
     {"strategy.terminal_time", 2, 0, 10, false},
+    {"strategy.gap_cars", 2, 0, 2, false},
+    {"strategy.one_sided", 0, 0, 1, false},
     {"refine.enabled", 1, 0, 1, false},
     {"refine.max_iterations", 40, 1, 500, true},
     {"refine.budget_ms", 3, 0.1, 50, true},

@@ -90,6 +90,8 @@ Settings::Settings(const PlannerConfig& c) {
   strategy_hold = c.value("strategy.hold");
   strategy_window = c.value("strategy.window");
   strategy_terminal_time = c.value("strategy.terminal_time");
+  strategy_gap_cars = c.int_value("strategy.gap_cars");
+  strategy_one_sided = c.int_value("strategy.one_sided") != 0;
 }
 
 Settings::Settings(const PlannerConfig& c, const map::Road& road) : Settings(c) {

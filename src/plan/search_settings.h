@@ -75,6 +75,8 @@ struct Settings {
   bool strategy;
   double strategy_horizon, strategy_dt, strategy_change_time, strategy_change_cost;
   double strategy_hold, strategy_window, strategy_terminal_time;
+  int strategy_gap_cars;
+  bool strategy_one_sided;  // no plan's regret above keeping the lane's  // cars of the next lane per side a plan may drop back behind / pass
 
   // On the configured uniform road (road.num_lanes x road.lane_width).
   explicit Settings(const PlannerConfig& c);

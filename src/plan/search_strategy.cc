@@ -32,7 +32,7 @@ constexpr double kHoldBetween = 1.0;
 constexpr double kWaitMin = 1.0;
 // Cars of the next lane a plan may drop back behind (centre from kDropBehind m behind the ego
 // to kDropAhead ahead) or get ahead of (kSpeedBehind behind to kSpeedAhead ahead), m; the
-// nearest kGapCars of each.
+// nearest strategy.gap_cars (at most kGapCars) of each.
 constexpr double kDropBehind = 35.0, kDropAhead = 25.0, kSpeedBehind = 25.0, kSpeedAhead = 10.0;
 constexpr int kGapCars = 2;
 // The rolled-out traffic follows the predictor this long (s; its braking and lane changes),
@@ -391,7 +391,7 @@ void Strategy::Decide(double elapsed, StrategySummary* summary) {
       const double hi = pass == 0 ? kDropAhead : kSpeedAhead;
       int* out = pass == 0 ? drop : speed;
       int& m = pass == 0 ? n_drop : n_speed;
-      for (int taken = 0; taken < kGapCars; ++taken) {
+      for (int taken = 0; taken < std::min(cfg_.strategy_gap_cars, kGapCars); ++taken) {
         int best = -1;
         for (int j = 0; j < count; ++j) {
           const int car = list[j];
@@ -445,8 +445,15 @@ void Strategy::Decide(double elapsed, StrategySummary* summary) {
     if (outcomes_[i].value > outcomes_[best].value) best = i;
   }
   const double top = outcomes_[best].value;
+  // One-sided (strategy.one_sided): no plan is charged more than keeping the lane (policy 0),
+  // so the layer can only pull the ego out of a lane that will be slow, never hold it back
+  // from a change the lattice finds worth it (the rollouts' queues see few gaps in dense
+  // traffic, where every change then looked a loss).
+  const double ceiling = cfg_.strategy_one_sided ? top - outcomes_[0].value : kInf;
   scratch_count_ = 0;
-  for (int i = 0; i < np; ++i) Emit(policies_[i], outcomes_[i], top - outcomes_[i].value);
+  for (int i = 0; i < np; ++i) {
+    Emit(policies_[i], outcomes_[i], std::min(top - outcomes_[i].value, ceiling));
+  }
   // The options, least regret first; one is kept only when no option for the same lane
   // without a window has as little regret (that one serves every candidate as well).
   // (A stable insertion sort: std::stable_sort takes a heap buffer, and the cycle must not

@@ -195,6 +195,49 @@ TEST(SearchStrategyTest, DisabledLeavesNoPlan) {
   EXPECT_EQ(TermValue(st, 2, 20), 0.0) << "no plan: the term charges nothing";
 }
 
+TEST(SearchStrategyTest, WithoutGapCarsOnlyLaneSequences) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig c = WithStrategy(1);
+  ASSERT_TRUE(c.Set("strategy.gap_cars", 0).ok());
+  Stages st(c);
+  Strategy strategy(st.cfg, *st.predictor, st.ws);
+  Prepare(st, 0, 15, {{25, 0, 10}, {0, 1, 15}, {60, 1, 12}});  // boxed in, as above
+  StrategySummary sum;
+  strategy.Decide(0, &sum);
+  ExpectSane(sum, st.ws.strategy_goal);
+  for (int i = 0; i < sum.num_plans; ++i) {
+    EXPECT_EQ(sum.plans[i].mode, StrategyPlan::Mode::kKeep) << i;
+    EXPECT_EQ(sum.plans[i].car, -1) << i;
+  }
+}
+
+// One-sided: no lane is charged more than keeping the current one. On a free road (keeping is
+// best) that charges nothing anywhere; behind a slow leader it still charges staying.
+TEST(SearchStrategyTest, OneSidedNeverChargesMoreThanKeeping) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig c = WithStrategy(1);
+  ASSERT_TRUE(c.Set("strategy.one_sided", 1).ok());
+  Stages st(c);
+  Strategy strategy(st.cfg, *st.predictor, st.ws);
+  Prepare(st, 1, 20, {});
+  StrategySummary sum;
+  strategy.Decide(0, &sum);
+  ExpectSane(sum, st.ws.strategy_goal);
+  for (int i = 0; i < st.ws.strategy_goal.num_options; ++i) {
+    EXPECT_EQ(st.ws.strategy_goal.options[i].regret, 0.0) << i;
+  }
+  for (int l = 0; l < 3; ++l) EXPECT_EQ(TermValue(st, l, 20), 0.0) << l;
+  strategy.Reset();
+  Prepare(st, 1, 20, {{35, 1, 10}, {60, 2, 10}, {80, 2, 10}});
+  strategy.Decide(0, &sum);
+  ExpectSane(sum, st.ws.strategy_goal);
+  const double left = TermValue(st, 0, 20), stay = TermValue(st, 1, 20),
+               right = TermValue(st, 2, 20);
+  EXPECT_EQ(left, 0.0);
+  EXPECT_GT(stay, 0.0);
+  EXPECT_LE(right, stay);
+}
+
 // Random scenes: every value finite, the options sorted, and the same decision from the same
 // scene after a Reset.
 TEST(SearchStrategyTest, RandomScenesAreFiniteAndDeterministic) {
