@@ -25,6 +25,7 @@ constexpr double kGhostMinSpeed = 15.0 / kMphPerMps;  // m/s
 constexpr double kGhostClear = 20.0;                   // m
 constexpr double kGhostLeaderReach = 40.0;  // m: a leader this close ahead is what it brakes for
 constexpr double kGhostOnset = 1.0;         // s: the rule holds this long before the car moves
+constexpr double kGhostEgoLateral = 3.0;    // m: the rule minds an ego this close to the lane
 
 class TrafficPredictor : public Predictor {
  public:
@@ -43,7 +44,7 @@ class TrafficPredictor : public Predictor {
   }
 
   void Observe(std::span<const SensorCar> rows, double ego_s, double now,
-               std::span<const CarFuture> futures) override {
+               std::span<const CarFuture> futures, double ego_d) override {
     cars_.clear();
     slot_.clear();
     if (!std::isfinite(ego_s)) return;
@@ -91,7 +92,9 @@ class TrafficPredictor : public Predictor {
       cars_.push_back(car);
       slot_.push_back(car.recorded ? slot : -1);
     }
-    if (manoeuvres_ && options_.lane_change_ghosts && road_->uniform()) AddLaneChangeGhosts(now);
+    if (manoeuvres_ && options_.lane_change_ghosts && road_->uniform()) {
+      AddLaneChangeGhosts(now, ego_d);
+    }
   }
 
   std::span<const TrackedCar> cars() const override { return cars_; }
@@ -183,18 +186,22 @@ class TrafficPredictor : public Predictor {
   // 15 mph, the target lane clear within 20 m. The rule must hold for more than 50 evaluations
   // (about a second) before the car moves, so the ghost starts its move kGhostOnset after the
   // car was first seen so, or at once when that was long enough ago.
-  void AddLaneChangeGhosts(double now) {
+  void AddLaneChangeGhosts(double now, double ego_d) {
     const double w = options_.lane_width;
     const int n = static_cast<int>(cars_.size());
     ghost_seen_next_.clear();
     for (int i = 0; i < n; ++i) {
       const TrackedCar c = cars_[i];
       if (!(c.a_s < -options_.brake_threshold) || !(c.v_s > kGhostMinSpeed)) continue;
-      if (!(c.s > kGhostClear) || c.d_target != c.d) continue;  // near or behind, or moving
+      if (c.d_target != c.d) continue;  // already moving
       const int lane = static_cast<int>(std::floor(c.d / w));
       const int target = lane == 1 ? 0 : 1;  // the middle lane's cars only ever go left
       if (lane < 0 || lane > 2 || target >= options_.num_lanes) continue;
       const double centre = (target + 0.5) * w;
+      // The rule keeps a car 20 m clear of the ego only when the ego is in (or near) the target
+      // lane; either way a car behind the ego is its follower's business.
+      const bool ego_minded = !(std::abs(ego_d - centre) > kGhostEgoLateral);  // NaN: minded
+      if (!(c.s > (ego_minded ? kGhostClear : -kGhostClear))) continue;
       bool clear = true, blocked = false;
       for (int j = 0; j < n && clear; ++j) {
         if (j == i) continue;

@@ -45,6 +45,25 @@ nlohmann::json Costs(const std::vector<plan::CostTermValue>& terms) {
   return a;
 }
 
+// The strategic layer's decision: the plans it weighed and the one chosen.
+nlohmann::json Strategy(const plan::StrategySummary& st) {
+  nlohmann::json plans = nlohmann::json::array();
+  for (int i = 0; i < st.num_plans && i < plan::StrategySummary::kMaxPlans; ++i) {
+    const plan::StrategyPlan& p = st.plans[i];
+    nlohmann::json lanes = nlohmann::json::array();
+    for (const int l : p.lanes) {
+      if (l >= 0) lanes.push_back(l);
+    }
+    plans.push_back({{"lanes", lanes},
+                     {"mode", plan::ToString(p.mode)},
+                     {"car", p.car >= 0 ? nlohmann::json(p.car) : nlohmann::json(nullptr)},
+                     {"t_change", p.t_change >= 0 ? Finite(p.t_change) : nlohmann::json(nullptr)},
+                     {"progress", Finite(p.progress)},
+                     {"value", Finite(p.value)}});
+  }
+  return {{"chosen", st.chosen}, {"plans", plans}};
+}
+
 nlohmann::json Node(const YAML::Node& n) {
   switch (n.Type()) {
     case YAML::NodeType::Map: {
@@ -529,7 +548,8 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
       candidates.clear();
       Replay(index, telemetry_json, path_x, path_y, &summary, &candidates);
     }
-    const nlohmann::json plan = PlanJson(status, summary, plan_ms, k, candidates);
+    nlohmann::json plan = PlanJson(status, summary, plan_ms, k, candidates);
+    if (summary.strategy.num_plans > 0) plan["strategy"] = Strategy(summary.strategy);
     FormatExchange(index, t, telemetry_json, path_x, path_y, plan, metrics, incidents, line);
   });
 }

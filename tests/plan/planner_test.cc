@@ -441,6 +441,7 @@ TEST(SearchPlannerTest, NoAllocationAfterWarmUp) {
   for (const int refine : {0, 1}) {
     PlannerConfig config = Config();
     ASSERT_TRUE(config.Set("refine.enabled", refine).ok());
+    ASSERT_TRUE(config.Set("strategy.enabled", 1).ok());  // whatever the shipped default
     auto made = MakePlanner("search", config, line);
     ASSERT_TRUE(made.ok());
     auto planner = std::move(made).value();
@@ -721,7 +722,8 @@ TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
   // Ego at s = 200. Cars given at t = 0 as (s, d, v), all braking at 3 m/s^2 since then,
   // observed every 0.1 s from `from` to `to`.
   using Cars = std::vector<std::array<double, 3>>;
-  auto observe = [&](Predictor& pred, const Cars& cars, double from, double to) {
+  auto observe = [&](Predictor& pred, const Cars& cars, double from, double to,
+                     double ego_d = NAN) {
     for (double t = from; t <= to + 1e-9; t += 0.1) {
       std::vector<SensorCar> rows;
       for (size_t i = 0; i < cars.size(); ++i) {
@@ -731,7 +733,7 @@ TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
         rows.push_back({static_cast<int>(i), p.x, p.y, v * std::cos(p.heading),
                         v * std::sin(p.heading), s, d});
       }
-      pred.Observe(rows, 200, t);
+      pred.Observe(rows, 200, t, {}, ego_d);
     }
   };
   auto ghosts = [](const Predictor& pred) {
@@ -779,6 +781,20 @@ TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
   EXPECT_TRUE(none({{240, 6.0, 15.0}}));                                      // no leader
   EXPECT_TRUE(none({{215, 6.0, 15.0}, {230, 6.0, 12.0}}));                    // within 20 m
   EXPECT_TRUE(none({{240, 6.0, 6.0}, {250, 6.0, 4.0}}));                      // under 15 mph
+  // Within 20 m, the rule minds the ego only when it is near the target lane: with the ego in
+  // the right lane (8 m from the left lane's centre) the car may move left right beside it,
+  // and even from just behind it; never from 20 m behind.
+  auto ghosts_with_ego = [&](const Cars& cars, double ego_d) {
+    auto pred = MakeManoeuvrePredictor(line, o);
+    observe(*pred, cars, 0.0, 0.1, ego_d);
+    return ghosts(*pred);
+  };
+  const Cars near = {{215, 6.0, 15.0}, {230, 6.0, 12.0}};
+  EXPECT_EQ(ghosts_with_ego(near, 2.0), 0);   // the ego in the left lane
+  EXPECT_EQ(ghosts_with_ego(near, 4.5), 0);   // moving out of it: still minded
+  EXPECT_EQ(ghosts_with_ego(near, 10.0), 1);  // the right lane
+  EXPECT_EQ(ghosts_with_ego({{195, 6.0, 15.0}, {210, 6.0, 12.0}}, 10.0), 1);
+  EXPECT_EQ(ghosts_with_ego({{175, 6.0, 15.0}, {190, 6.0, 12.0}}, 10.0), 0);
 }
 
 TEST(FeasibilityTest, CurvaturesOfAPathAreEachTriplesBitForBit) {

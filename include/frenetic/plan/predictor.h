@@ -7,6 +7,7 @@
 // the two moves of the simulator's traffic that end in collisions (udacity-sim.md §8.3, §8.5).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <span>
 #include <vector>
@@ -56,7 +57,9 @@ struct PredictorOptions {
   // ego) within 20 m of it in s is in that lane. With this on, every such car faster than
   // 15 mph also appears as a second car (same id) that starts that move now, so a plan never
   // counts on the braking car staying in its lane; none is added within 20 m of the ego, where
-  // the rule would not let the car move (the ego could be in the target lane).
+  // the rule would not let the car move (the ego could be in the target lane), unless Observe's
+  // ego_d is known and more than 3 m from the target lane's centre (the rule then ignores the
+  // ego: a car alongside or just ahead may move in).
   bool lane_change_ghosts = false;
   double ghost_lateral_speed = 1.6;  // m/s across, about a lane in 2.5 s
 };
@@ -70,9 +73,10 @@ class Predictor {
   // dates the readings from which later calls estimate accelerations. A row with a CarFuture
   // in `futures` (same id) is predicted from it (its first kMaxFutureSamples samples) instead.
   // Never fails: invalid rows and future samples are skipped (a future with any non-finite
-  // sample is not used).
+  // sample is not used). `ego_d` is the ego's lateral offset (m; NaN: unknown), which the
+  // traffic's lane-change rule looks at (PredictorOptions::lane_change_ghosts).
   virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now,
-                       std::span<const CarFuture> futures = {}) = 0;
+                       std::span<const CarFuture> futures = {}, double ego_d = NAN) = 0;
   static constexpr int kMaxFutureSamples = 96;
   virtual std::span<const TrackedCar> cars() const = 0;
   // Predicted state of car i, t >= 0 seconds after the observation: s and d (m), speed along
