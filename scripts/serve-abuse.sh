@@ -65,8 +65,9 @@ if [[ $rt -eq 1 ]]; then
   client_pin=(chrt -f 1 "${client_pin[@]}")
 fi
 
-# The telemetry of a recorded drive (what a simulator would send), one frame per line.
-"$frenetic" drive --map "$map" --seconds 60 --seed 3 --latency random --no-timing \
+# The telemetry of a recorded drive (what a simulator would send), one frame per line: long
+# enough that a latency run never wraps round to its start (a jump back in time and place).
+"$frenetic" drive --map "$map" --seconds 150 --seed 3 --latency random --no-timing \
   --record "$tmp/drive.jsonl" >/dev/null
 python3 - "$tmp/drive.jsonl" >"$tmp/frames.txt" <<'EOF'
 import json, sys

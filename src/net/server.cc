@@ -112,9 +112,11 @@ constexpr int kRefusalsPerConnection = 4;
 constexpr int kLoggedRefusals = 5;
 // The time constant of a session's planning usage (pool priority), s.
 constexpr double kUsageTau = 1.0;
-// Usage (s of work over ~kUsageTau) beyond which a session's work is heavy: a quarter of a
-// core. A simulator at 50 frames/s of ~1 ms each uses ~0.05.
-constexpr double kHeavyUsage = 0.25;
+// Usage (s of work over ~kUsageTau) beyond which a session's work is heavy: a tenth of a core.
+// A simulator at 50 frames/s of ~1 ms each uses ~0.05. At a quarter, 7 flooding connections
+// sharing the heavy thread (1/7 of a core each) fell back under it and took turns on the light
+// thread, where a simulator's frame waited behind their plans (flood p99 12 ms).
+constexpr double kHeavyUsage = 0.1;
 // A session's first plans, counted as heavy work whatever its usage.
 constexpr int kYoungPlans = 10;
 // The niceness of the threads that run heavy work.
