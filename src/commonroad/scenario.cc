@@ -2,10 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <utility>
 
 #include "commonroad/xml_source.h"
@@ -461,14 +458,9 @@ StatusOr<Scenario> ParseScenario(std::string_view xml, std::string_view source) 
 }
 
 StatusOr<Scenario> LoadScenario(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return Status::Error(path + ": not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return Status::Error(path + ": read error");
-  return ParseScenario(text.str(), path);
+  StatusOr<std::string> text = ReadXmlFile(path);
+  if (!text.ok()) return text.status();
+  return ParseScenario(*text, path);
 }
 
 }  // namespace frenetic::commonroad

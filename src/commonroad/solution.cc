@@ -218,13 +218,9 @@ StatusOr<Solution> ParseSolution(std::string_view xml, std::string_view source) 
 }
 
 StatusOr<Solution> LoadSolution(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return Status::Error(path + ": not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseSolution(text.str(), path);
+  StatusOr<std::string> text = ReadXmlFile(path);
+  if (!text.ok()) return text.status();
+  return ParseSolution(*text, path);
 }
 
 std::string CurrentDate() {

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace frenetic::commonroad {
 
@@ -24,6 +27,17 @@ std::string Quote(std::string_view text) {
 }
 
 }  // namespace
+
+StatusOr<std::string> ReadXmlFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return Status::Error(path + ": not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(path + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Status::Error(path + ": read error");
+  return text.str();
+}
 
 std::optional<double> ParseFiniteDouble(std::string_view text) {
   text = Trim(text);

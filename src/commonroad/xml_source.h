@@ -13,6 +13,10 @@
 
 namespace frenetic::commonroad {
 
+// The whole text of the file at `path`, or an error naming it: not a file, cannot open, read
+// error (the scenario and the solution loaders).
+StatusOr<std::string> ReadXmlFile(const std::string& path);
+
 // The XML text and its name. Every Status it returns is one line:
 //   "<source>:<line>: <path>: <message>"
 // where <path> names the element and its ancestors below the root, with their ids, e.g.

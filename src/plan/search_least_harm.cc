@@ -10,8 +10,8 @@
 
 namespace frenetic::plan::search {
 
-double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr) {
-  return ClearanceAt(cfg, ws, [&](int i) { return tr.At(i * kTickSeconds); });
+double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr) {
+  return ClearanceAt(ws, [&](int i) { return tr.At(i * kTickSeconds); });
 }
 
 LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
@@ -114,7 +114,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       if (first_hit_[c] <= n_steps) return;
       const Checker::Rows rows = checker_.StepRows(c);
       clearance_[c] =
-          ClearanceAbove(cfg_, ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
+          ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
       if (checker_.CandidateBreaksLimits(c)) return;
       scorer_.ExactCost(c);
       best = c;
@@ -122,7 +122,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       return;
     }
     const Checker::Rows rows = checker_.StepRows(c);
-    const double clr = ClearanceAbove(cfg_, ws_, rows.s, rows.d, best_clr);
+    const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
     if (clr < best_clr) return;
     if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
@@ -338,7 +338,7 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
     if (known_[c]) continue;
     const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
     first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
-    clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(cfg_, ws_, steps) : 0.0;
+    clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(ws_, steps) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:
   // std::stable_sort would allocate).

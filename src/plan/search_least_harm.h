@@ -24,10 +24,10 @@ namespace frenetic::plan::search {
 // The smallest separation (m) of the bare boxes of `tr` from any car of ws over the check
 // horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - ws.car_sep_s,
 // |dd| - ws.car_sep_d), < 0 on overlap.
-double Clearance(const Settings& cfg, const Workspace& ws, const traj::FrenetTrajectory& tr);
+double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr);
 // The same from the states at the collision-check steps (state_at(tick), Checker::StepsOf).
 template <typename StateAt>
-double ClearanceAt(const Settings& cfg, const Workspace& ws, StateAt state_at) {
+double ClearanceAt(const Workspace& ws, StateAt state_at) {
   double worst = 1e9;
   for (int j = 1; j <= ws.n_steps; ++j) {
     const traj::FrenetState st = state_at(j * ws.collision_step);
@@ -44,11 +44,11 @@ double ClearanceAt(const Settings& cfg, const Workspace& ws, StateAt state_at) {
 // The same from StepStates' rows, car by car over contiguous steps (the loops vectorise): the
 // minimum of the same separations, and a minimum taken with `<` ignores NaN in any order (no
 // separation is -0), so the same value.
-inline double ClearanceAt(const Settings& cfg, const Workspace& ws, const StepStates& steps) {
+inline double ClearanceAt(const Workspace& ws, const StepStates& steps) {
   constexpr int kMaxSteps = 256;
   const int n_steps = ws.n_steps;
   if (n_steps >= kMaxSteps) {
-    return ClearanceAt(cfg, ws, [&steps](int i) { return steps(i); });
+    return ClearanceAt(ws, [&steps](int i) { return steps(i); });
   }
   double col[kMaxSteps];  // per step, the smallest separation so far
   for (int j = 1; j <= n_steps; ++j) col[j] = 1e9;
@@ -112,12 +112,12 @@ inline double MinOfMax(const double* a, const double* b, int n) {
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
 // `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
 // minimum, car by car: the order does not change a minimum that ignores NaN.
-inline double ClearanceAbove(const Settings& cfg, const Workspace& ws, const double* s,
-                             const double* d, double floor) {
+inline double ClearanceAbove(const Workspace& ws, const double* s, const double* d,
+                             double floor) {
   constexpr int kMaxSteps = 256;
   const int n_steps = ws.n_steps;
   if (n_steps >= kMaxSteps) {
-    return ClearanceAt(cfg, ws, [s, d, &ws](int i) {
+    return ClearanceAt(ws, [s, d, &ws](int i) {
       const int j = i / ws.collision_step;
       return traj::FrenetState{s[j], 0.0, 0.0, d[j], 0.0, 0.0};
     });

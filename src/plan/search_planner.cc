@@ -95,6 +95,7 @@ class SearchPlanner : public Planner {
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
     rows_.reserve(search::kMaxCars + cost::kMaxLanes);
+    for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
     rest_.reserve(ws_.order.capacity());
     popped_.assign(ws_.order.capacity(), 0);
     result_.x.reserve(cfg_.output_points + 1);
@@ -444,12 +445,10 @@ class SearchPlanner : public Planner {
   // returned as they are on a road whose lanes never end.
   std::span<const SensorCar> WithLaneEnds(const std::vector<SensorCar>& rows, double start_s) {
     if (road_->uniform()) return rows;
-    double road_end = -std::numeric_limits<double>::infinity();
-    for (int l = 0; l < road_->num_lanes(); ++l) road_end = std::max(road_end, road_->LaneEnd(l));
     rows_.assign(rows.begin(), rows.begin() + std::min<std::size_t>(rows.size(), search::kMaxCars));
     for (int l = 0; l < road_->num_lanes(); ++l) {
       const double end = road_->LaneEnd(l);
-      if (!(end < road_end - kLaneEndSlack) || end < start_s - kLaneEndSlack ||
+      if (!(end < road_end_ - kLaneEndSlack) || end < start_s - kLaneEndSlack ||
           end > start_s + kLaneEndRange) {
         continue;
       }
@@ -548,6 +547,9 @@ class SearchPlanner : public Planner {
 
   std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
   std::vector<SensorCar> rows_;   // WithLaneEnds' rows
+  // The road's end: the farthest lane end (a lane ending before it, by more than kLaneEndSlack,
+  // ends within the road).
+  double road_end_ = -std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
   std::vector<char> popped_;                  // CheckRest: taken from the heap
   bool none_passed_last_ = false;             // the last search's checks found no candidate passing

@@ -54,10 +54,10 @@ TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
   tr.lon.duration = 5;
   tr.lat.poly.c[0] = 6.0;
   tr.lat.duration = 5;
-  EXPECT_NEAR(Clearance(st.cfg, st.ws, tr), 4.0 - st.cfg.car_width, 1e-6);
+  EXPECT_NEAR(Clearance(st.ws, tr), 4.0 - st.cfg.car_width, 1e-6);
   // 30 m ahead in the same lane: the longitudinal gap minus a car length.
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 30, 6.0, 20}});
-  EXPECT_NEAR(Clearance(st.cfg, st.ws, tr), 30.0 - st.cfg.car_length, 1e-6);
+  EXPECT_NEAR(Clearance(st.ws, tr), 30.0 - st.cfg.car_length, 1e-6);
 }
 
 TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
@@ -124,7 +124,7 @@ int ReferenceChoice(Stages& st) {
   for (const int c : order) {
     const StepStates steps = st.checker.StepsOf(c, 0.0, 1.0);
     hit[c] = st.checker.FirstCollision(steps, 0.0, 1.0, nullptr, false);
-    room[c] = hit[c] > ws.n_steps ? ClearanceAt(st.cfg, ws, steps) : 0.0;
+    room[c] = hit[c] > ws.n_steps ? ClearanceAt(ws, steps) : 0.0;
   }
   std::sort(order.begin(), order.end(), [&](int a, int b) {
     if (hit[a] != hit[b]) return hit[a] > hit[b];

@@ -107,7 +107,9 @@ void ExpectSane(const StrategySummary& sum, const cost::StrategyGoal& goal) {
     EXPECT_GE(o.lane, 0);
     EXPECT_LT(o.lane, 3);
     EXPECT_FALSE(std::isnan(o.s_lo) || std::isnan(o.s_hi)) << i;
-    if (i > 0) EXPECT_GE(o.regret, goal.options[i - 1].regret) << "least regret first";
+    if (i > 0) {
+      EXPECT_GE(o.regret, goal.options[i - 1].regret) << "least regret first";
+    }
     least = std::min(least, o.regret);
   }
   EXPECT_EQ(least, 0.0) << "the chosen plan has no regret";
@@ -177,7 +179,9 @@ TEST(SearchStrategyTest, BoxedInDropsBackForTheLaneBeyond) {
   EXPECT_TRUE(windowed);
   // Better than staying behind the 10 m/s car.
   for (int i = 0; i < sum.num_plans; ++i) {
-    if (sum.plans[i].lanes[0] < 0) EXPECT_GT(p.value, sum.plans[i].value);
+    if (sum.plans[i].lanes[0] < 0) {
+      EXPECT_GT(p.value, sum.plans[i].value);
+    }
   }
 }
 
