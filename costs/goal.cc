@@ -83,7 +83,9 @@ class GoalCost : public CostTerm {
     }
     const int k = std::max(0, static_cast<int>(x));
     const double f = x - k;
-    const At a = Sample(in, k), b = Sample(in, k + 1);
+    return Lerp(Sample(in, k), Sample(in, k + 1), f);
+  }
+  static At Lerp(const At& a, const At& b, double f) {
     return {a.s + f * (b.s - a.s), a.d + f * (b.d - a.d), a.v + f * (b.v - a.v),
             a.h + f * (b.h - a.h)};
   }
@@ -113,9 +115,7 @@ class GoalCost : public CostTerm {
       const double f = (level - qa) / (qb - qa);
       const double t = ta + f * (tb - ta);
       if (!(t >= t0 && t <= t1)) return;
-      const At m{a.s + f * (b.s - a.s), a.d + f * (b.d - a.d), a.v + f * (b.v - a.v),
-                 a.h + f * (b.h - a.h)};
-      best = std::min(best, MissAt(g, m));
+      best = std::min(best, MissAt(g, Lerp(a, b, f)));
     };
     // A term's least value over a piece is 0 where its quantity passes its interval, else the
     // smaller end's: their sum bounds the piece's least miss from below, and a piece whose
@@ -125,8 +125,9 @@ class GoalCost : public CostTerm {
       return std::min(Out(qa, lo, hi), Out(qb, lo, hi)) * inv;
     };
     auto piece = [&](double ta, double tb, const At& a, const At& b) {
+      const double da = Across(g, a), db = Across(g, b);
       const double bound = least(a.s, b.s, g.s_lo, g.s_hi, inv_s_) +
-                           least(Across(g, a), Across(g, b), g.d_lo, g.d_hi, inv_d_) +
+                           least(da, db, g.d_lo, g.d_hi, inv_d_) +
                            least(a.v, b.v, g.v_lo, g.v_hi, inv_v_) +
                            least(a.h, b.h, g.h_lo, g.h_hi, inv_h_);
       if (!(bound < best)) return;
@@ -135,7 +136,6 @@ class GoalCost : public CostTerm {
         cross(ta, tb, a, b, a.s, b.s, g.s_hi);
       }
       if (has_d) {
-        const double da = Across(g, a), db = Across(g, b);
         cross(ta, tb, a, b, da, db, g.d_lo);
         cross(ta, tb, a, b, da, db, g.d_hi);
       }

@@ -266,10 +266,7 @@ class TrafficPredictor : public Predictor {
     const int base = slot * kMaxFutureSamples;
     for (int k = 0; k < n; ++k) {
       const int q = std::min(k * stride, given - 1);
-      const double x = fut->x[q], y = fut->y[q], v = fut->v[q], h = fut->heading[q];
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(v) || !std::isfinite(h)) {
-        return false;
-      }
+      const double x = fut->x[q], y = fut->y[q], v = fut->v[q], h = fut->heading[q];  // finite
       const map::FrenetPoint f = line_->ToFrenet(x, y, hint);
       const double rel = line_->At(f.s).heading - h;  // the car's heading against the line's
       hint = f.s;
