@@ -121,7 +121,9 @@ def main():
         goal = st[steps]
         gx, gy = position(goal)
         heading = value(goal, "orientation") or 0.0
-        v_goal = value(goal, "velocity") or v0
+        v_goal = value(goal, "velocity")
+        if v_goal is None:  # (a recorded 0.0 is a speed: the vehicle stopped there)
+            v_goal = v0
         width = float(obstacle.find("shape/rectangle/width").text) + 1.5
 
         new_root = copy.deepcopy(root)
