@@ -35,6 +35,14 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
 }
 
 bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
+  if (cfg_.clear_enough > 0) {
+    const int c = CheapestClearEnough(over_budget);
+    if (c >= 0) {
+      ws_.TakeWinner(c);
+      return true;
+    }
+    if (*over_budget) return false;
+  }
   bool all_known = false;
   int best = BestClear(over_budget, &all_known, none_passed_before);
   if (best < 0 && all_known && !*over_budget) best = LatestContact(over_budget);
@@ -43,6 +51,26 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
     return true;
   }
   return !*over_budget && ChooseByRanking(over_budget, all_known);
+}
+
+int LeastHarm::CheapestClearEnough(bool* over_budget) {
+  const int n = static_cast<int>(ws_.order.size());
+  for (int r = 0; r < n; ++r) {
+    if (((r & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) || !scorer_.SortUpTo(r)) {
+      *over_budget = true;
+      return -1;
+    }
+    const int c = ws_.order[r];
+    if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+        ws_.n_steps) {
+      continue;
+    }
+    const Checker::Rows rows = checker_.StepRows(c);
+    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.clear_enough) >= cfg_.clear_enough)) continue;
+    if (checker_.CandidateBreaksLimits(c)) continue;
+    return c;
+  }
+  return -1;
 }
 
 // In harm order the collision-free candidates come first, by clearance, then cost: when one

@@ -155,9 +155,18 @@ class LeastHarm {
   // short: then *over_budget is set.
   // none_passed_before: the last cycle's search found no candidate passing either (its Choose
   // was the last call), a hint that changes no choice, only the work.
+  // With check.clear_enough > 0 the cheapest feasible candidate whose bare boxes keep that far
+  // from every car comes first (CheapestClearEnough); the harm ranking only when none does.
   bool Choose(bool* over_budget, bool none_passed_before = false);
 
  private:
+  // The first candidate in cost order that collides with no car on bare boxes (the room behind
+  // kept, the predictor's ghosts left out, as BestClear tests), keeps at least
+  // cfg.clear_enough from every car (Clearance) and breaks no limit; -1 when none does (or the
+  // deadline cut it short: then *over_budget is set). Where the predictions are the traffic's
+  // own future (recorded traffic), more room than enough buys nothing, and the clearest
+  // candidate is mostly the one braking hardest, away from the goal.
+  int CheapestClearEnough(bool* over_budget);
   // The first feasible collision-free candidate in harm order, -1 when there is none (or the
   // deadline cut it short: then *over_budget is set). *all_known: none is, and every
   // candidate's clearance is in clearance_ and its contact in first_hit_ (known_ 1), or for

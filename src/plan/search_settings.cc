@@ -72,6 +72,7 @@ Settings::Settings(const PlannerConfig& c) {
   margin_d = c.value("check.margin_d");
   margin_behind = c.value("check.margin_behind");
   headway_min = c.value("check.headway_min");
+  clear_enough = c.value("check.clear_enough");
   behind_time = c.value("check.behind_time");
   followers_react = c.int_value("prediction.followers_react") != 0;
   refine = c.int_value("refine.enabled") != 0;

@@ -65,6 +65,7 @@ struct Settings {
   double score_dt, score_horizon;
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
   double headway_min, behind_time;
+  double clear_enough;  // m (check.clear_enough; 0: off)
   bool followers_react;  // a car right behind brakes for the ego (prediction.followers_react)
   bool refine;
   int refine_iterations;

@@ -81,6 +81,28 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   EXPECT_EQ(st.ws.sorted, 0) << "a feasible colliding one is found without the whole ranking";
 }
 
+// check.clear_enough: the cheapest candidate keeping that much room wins over the roomiest.
+TEST(SearchLeastHarmTest, ClearEnoughTakesTheCheapestWithThatMuchRoom) {
+  REQUIRE_UDACITY_MAP();
+  auto with = [](double enough) {
+    PlannerConfig c = testing::DefaultConfig();
+    EXPECT_TRUE(c.Overlay("check:\n  clear_enough: " + std::to_string(enough) + "\n", "test").ok());
+    return c;
+  };
+  // The scene of PrefersMoreClearanceOverLowerCost: ~5 m of room for the second, ~10 m for the
+  // third, the first collides.
+  const std::vector<Option> options = {{20, 3.0, 1.0}, {10, 4.0, 2.0}, {10, 3.0, 3.0}};
+  for (const auto& [enough, winner] : {std::pair{3.0, 1}, std::pair{8.0, 2}, std::pair{19.0, 2}}) {
+    Stages st(with(enough));
+    Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
+    SetCandidates(st, options);
+    bool over_budget = false;
+    ASSERT_TRUE(st.least_harm.Choose(&over_budget)) << enough;
+    EXPECT_FALSE(over_budget);
+    EXPECT_EQ(st.ws.winner_index, winner) << "clear_enough " << enough;
+  }
+}
+
 TEST(SearchLeastHarmTest, EqualClearanceGoesToTheLowerCost) {
   REQUIRE_UDACITY_MAP();
   Stages st;
