@@ -239,15 +239,9 @@ double Curvature(double x1, double y1, double x2, double y2, double x3, double y
   return den > 1e-12 ? 2.0 * (ax * by - ay * bx) / den : 0.0;
 }
 
-// The ego after one step toward the planned path (x, y: 0.02 s points from the step's start,
-// the first one 0.02 s in): a constant KS input for the step. Feed-forward from the path at the
-// step's end (the steering angle of its curvature, the rear axle's speed, the slip angle between
-// the centre's path and the axis), corrected as a Stanley controller does (Hoffmann et al.,
-// "Autonomous Automobile Trajectory Tracking for Off-Road Driving", ACC 2007): the heading error
-// and atan(k e / v) of the cross-track error e, both of the state the feed-forward input would
-// reach; the speed corrected by the along-track error. A one-step fit of the position instead
-// steers back and forth at speed (the position answers the steering rate only within the step).
-KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
+}  // namespace
+
+KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
                double dt, const VehicleParams& vp) {
   constexpr double kHeadingGain = 0.5;  // of the heading error
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
@@ -300,12 +294,13 @@ KsState Follow(const KsState& ego, const std::vector<double>& x, const std::vect
   const double delta_cmd = std::clamp(delta_ff + kHeadingGain * heading_err -
                                           std::atan(kCrossGain * cross / std::max(ego.velocity, 1.0)),
                                       -max_steer, max_steer);
-  const double v_cmd = v_ff + kAlongGain * along;
+  // Never backwards: the planner's paths do not reverse, and a vehicle that rolls back at a
+  // stop (ahead of a path point that barely moves) turns the other way as it steers.
+  const double v_cmd = std::max(0.0, v_ff + kAlongGain * along);
   const KsInput u = clip({(delta_cmd - ego.steering_angle) / dt, (v_cmd - ego.velocity) / dt});
   return SimulateKs(ego, u, dt, vp);
 }
 
-}  // namespace
 
 const char* ToString(PredictionMode mode) {
   return mode == PredictionMode::kRecorded ? "recorded" : "constant-velocity";
@@ -522,7 +517,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       cyc.status = res.status;
       // The ego drives dt along the plan.
       const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
-      ego = Follow(ego, res.x, res.y, dt, vp);
+      ego = FollowPath(ego, res.x, res.y, dt, vp);
       ego.time_step = k + 1;
       const size_t j = std::min<size_t>(ticks - 1, res.x.empty() ? 0 : res.x.size() - 1);
       if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);

@@ -15,10 +15,9 @@ constexpr double kMaxLaneLookahead = 60.0;
 // whose half diagonal this is).
 constexpr double kReachS = 8.0, kReachD = 5.0;
 constexpr double kUdacityHalfDiagonal = 2.6832815729997477;
-// s after the last goal window's end that the collision check still sees the traffic (a plan
-// replanned each step should not run into a car just after the end), and m ahead where a
-// car is put after that (beyond every reach).
-constexpr double kGoalEndSlack = 1.0;
+// s after the last goal window's end that the collision check still sees the traffic (a time
+// step of the scenarios), and m ahead where a car is put after that (beyond every reach).
+constexpr double kGoalEndSlack = 0.1;
 constexpr double kGone = 1e6;
 
 // The lanes' centres for this cycle: the nominal ones, moved just enough that the simulator,

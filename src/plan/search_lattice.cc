@@ -21,6 +21,8 @@ constexpr double kAccelMinGain = 1.0;
 // m along s: the road is free for a constant-acceleration run when no car is from this far
 // behind to this far ahead of the ego (a run from a standstill to the limit takes ~60 m).
 constexpr double kAccelFreeBehind = 20.0, kAccelFreeAhead = 100.0;
+// m/s: below it a car laterally at rest off its lane's centre may also hold its d.
+constexpr double kCrawlSpeed = 2.0;
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -43,9 +45,10 @@ void Lattice::AddLon(const LonTraj& l) {
 void Lattice::AddLat(const LatTraj& l) {
   if (!l.traj.poly.IsFinite()) return;
   const int i = static_cast<int>(ws_.lat.size());
+  const int n = ws_.n_samples;
+  if ((i + 1) * n > static_cast<int>(ws_.lat_d.size())) return;  // the workspace is full
   ws_.lat.push_back(l);
   ws_.lat.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
-  const int n = ws_.n_samples;
   const double dt = cfg_.score_dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
                 &ws_.lat_ddd[i * n]);
@@ -315,6 +318,12 @@ void Lattice::Generate() {
         const double off = (oi - cfg_.lat_offsets / 2) * cfg_.lat_offset_step;
         AddLat(MakeLat(l, off, T));
       }
+    }
+    // At a crawl, laterally at rest off the lane's centre: holding d too. A move across there
+    // turns the car far off the lane's heading for the little way it drives (a queue), which
+    // a goal's orientation and the lanelets' borders mind.
+    if (own && at_rest && !centred && start.s_d < kCrawlSpeed) {
+      AddLat(MakeLat(l, start.d - ws_.lane_center[l], cfg_.lat_max_duration));
     }
     if (!own && at_rest) {
       const double T = Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, 3, 1);

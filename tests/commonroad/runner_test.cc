@@ -2,6 +2,7 @@
 // and every shared example, judged by the verdict.
 #include "frenetic/commonroad/runner.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -131,6 +132,45 @@ TEST(RunnerTest, StartsFromRestToASpeedWindow) {
       {GoalRectangleXml({60, -1.75}, 10, 3.5, 0, 0, 100, IntervalXml("velocity", 8, 15))});
   const ProblemRun p = RunOne(xml);
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+}
+
+TEST(RunnerTest, WaitsInAQueueWithoutRollingBackOrTurning) {
+  // A line of stopped cars from 60 m on; the goal: standing behind them, heading along the
+  // lane, in a window 6 to 8 s in. The ego stops well before it and waits.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300)
+      .StaticObstacle(9, 4.8, 2.0, {60, -1.75}, 0)
+      .StaticObstacle(10, 4.8, 2.0, {67, -1.75}, 0)
+      .Problem(1, {10, -1.75}, 0, 8,
+               {GoalRectangleXml({50, -1.75}, 8, 3.5, 0, 60, 80,
+                                 IntervalXml("velocity", 0, 1) +
+                                     IntervalXml("orientation", -0.05, 0.05))});
+  const ProblemRun p = RunOne(xml);
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  for (const KsState& s : p.trajectory) {
+    EXPECT_GE(s.velocity, 0.0) << "step " << s.time_step;
+    EXPECT_LT(std::abs(s.orientation), 0.05) << "step " << s.time_step;
+  }
+}
+
+TEST(RunnerTest, FollowingAPathNeverRollsBack) {
+  // At rest just ahead of a path that stays where it is (a plan to stand, the ego a few cm
+  // past it): the along-track error asks for a step back; the follower stays put instead.
+  const VehicleParams vp;
+  const KsState ego{0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  const std::vector<double> x(60, -0.05), y(60, 0.0);
+  const KsState next = FollowPath(ego, x, y, 0.1, vp);
+  EXPECT_GE(next.velocity, 0.0);
+  EXPECT_LE(next.x, 1e-9);
+  // Moving at 1 m/s along a path 1 m/s behind: it slows down, still forwards.
+  std::vector<double> px, py;
+  for (int i = 1; i <= 60; ++i) {
+    px.push_back(-0.3 + 1.0 * 0.02 * i);
+    py.push_back(0.0);
+  }
+  const KsState slowed = FollowPath({0, 0.0, 0.0, 0.0, 1.0, 0.0}, px, py, 0.1, vp);
+  EXPECT_GE(slowed.velocity, 0.0);
+  EXPECT_LT(slowed.velocity, 1.0);
 }
 
 TEST(RunnerTest, AnUnreachableGoalFailsWithItsReason) {

@@ -241,17 +241,16 @@ TEST(SearchChecksTest, TrafficPastTheLastGoalWindowConstrainsNothing) {
   const int hit = st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0);
   ASSERT_LT(hit, none);
   ASSERT_GT(hit * step_s, 3.0);
-  // A goal window that closes at 1 s: the problem is over before then (the check keeps the
-  // traffic for one more second).
+  // A goal window that closes at 1 s: the problem is over long before then.
   st.ws.num_goals = 1;
   st.ws.goals[0] = cost::GoalRegion{};
   st.ws.goals[0].t_hi = 1.0;
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), none);
-  // The latest window counts: one open until 3 s keeps the car.
+  // The latest window counts: one open past the hit keeps the car.
   st.ws.num_goals = 2;
   st.ws.goals[1] = cost::GoalRegion{};
-  st.ws.goals[1].t_hi = 3.0;
+  st.ws.goals[1].t_hi = hit * step_s;
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), hit);
   // A window without an end: neither.

@@ -92,6 +92,22 @@ TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabl
   EXPECT_EQ(no_stop.ws.lon.size(), 84u);
 }
 
+TEST(SearchLatticeTest, AtACrawlOffTheCentreItMayAlsoHoldItsD) {
+  REQUIRE_UDACITY_MAP();
+  for (const double speed : {1.0, 10.0}) {
+    Stages st;
+    PrepareCentred(st, speed);
+    const double d = st.ws.lane_center[1] + 0.4;
+    st.Prepare({kS, speed, 0, d, 0, 0});
+    st.lattice.Generate();
+    int holds = 0;
+    for (const LatTraj& l : st.ws.lat) {
+      holds += l.lane == 1 && std::abs(l.traj.At(l.traj.end_time()).p - d) < 1e-9;
+    }
+    EXPECT_EQ(holds, speed < 2.0 ? 1 : 0) << speed << " m/s";
+  }
+}
+
 TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
   REQUIRE_UDACITY_MAP();
   Stages st;

@@ -106,6 +106,18 @@ inline constexpr const char* kCommonRoadConfig = "config/commonroad.yaml";  // i
 StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const VehicleParams& vehicle,
                                                PredictionMode prediction);
 
+// The ego after one step of dt s toward a planned path (x, y: 0.02 s points from the step's
+// start, the first one 0.02 s in): a constant KS input for the step, never backwards.
+// Feed-forward from the path at the step's end (the steering angle of its curvature, the rear
+// axle's speed, the slip angle between the centre's path and the axis), corrected as a Stanley
+// controller does (Hoffmann et al., "Autonomous Automobile Trajectory Tracking for Off-Road
+// Driving", ACC 2007): the heading error and atan(k e / v) of the cross-track error e, both of
+// the state the feed-forward input would reach; the speed corrected by the along-track error. A
+// one-step fit of the position instead steers back and forth at speed (the position answers
+// the steering rate only within the step).
+KsState FollowPath(const KsState& ego, const std::vector<double>& x,
+                   const std::vector<double>& y, double dt, const VehicleParams& vp);
+
 // Runs every planning problem of the scenario. `config` is used as given (see CommonRoadConfig).
 // Never fails: a problem whose road cannot be built reports it in ProblemRun::road.
 ScenarioRun RunScenario(const Scenario& scenario, const plan::PlannerConfig& config,
