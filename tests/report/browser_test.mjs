@@ -185,6 +185,18 @@ try {
     check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
     await page.close();
   }
+  // --- a CommonRoad run: the planner's speed cap, no simulator acceleration or jerk ---
+  {
+    const { page, errors } = await open("commonroad.html");
+    const plotIds = await page.$$eval("#plots canvas", (cs) => cs.map((c) => c.id));
+    check(plotIds.includes("plot-speed") && !plotIds.includes("plot-acc") && !plotIds.includes("plot-jerk"),
+          `CommonRoad plots: ${plotIds.join(", ")}`);
+    const allTiles = await page.$$eval(".tile", (ts) => ts.map((t) => t.textContent));
+    check(!allTiles.some((t) => t.startsWith("max acc") || t.startsWith("max jerk")),
+          "no simulator acceleration or jerk tiles on a CommonRoad page");
+    check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
+    await page.close();
+  }
   // The same marks must not appear without an incident (the check above can fail).
   {
     const { page } = await open("run.html");

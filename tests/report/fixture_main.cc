@@ -2,7 +2,8 @@
 //   frenetic_report_fixture OUT_DIR [--large N]
 // OUT_DIR/run.{jsonl,html} (a short drive), OUT_DIR/incident.{jsonl,html} (with a collision and
 // the footer in the simulator's shape),
-// and with --large N also OUT_DIR/large.{jsonl,html} (N exchanges) to time the page's opening.
+// OUT_DIR/commonroad.{jsonl,html} (a CommonRoad run's header), and with --large N also
+// OUT_DIR/large.{jsonl,html} (N exchanges) to time the page's opening.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -48,6 +49,11 @@ int main(int argc, char** argv) {
   options.incident = true;
   options.simulator_footer = true;
   if (Write(dir, "incident", options) != 0) return 1;
+  {
+    frenetic::report::testing::SyntheticOptions cr;
+    cr.commonroad = true;
+    if (Write(dir, "commonroad", cr) != 0) return 1;
+  }
   if (argc == 4) {
     options.exchanges = std::atoi(argv[3]);
     options.incident_at = options.exchanges / 2;

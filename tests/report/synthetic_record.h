@@ -24,6 +24,8 @@ struct SyntheticOptions {
   // plan_ms {p50, p99, max}, miles) instead of the names of the record's spec.
   bool simulator_footer = false;
   int candidates = 6;           // per cycle
+  // A CommonRoad run's header (world, problem, the planner's speed cap in its config).
+  bool commonroad = false;
   std::uint64_t seed = 7;
 };
 
@@ -59,6 +61,14 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
                  {"config", {{"weights", {{"efficiency", 2.0}, {"comfort", 1.0},
                                           {"lane_change", 3.0}}}}},
                  {"centerline", center}, {"car_length", 4.6}, {"car_width", 2.4}};
+  if (options.commonroad) {
+    header["world"] = "commonroad";
+    header["problem"] = 1;
+    header["dt"] = kSyntheticDt;
+    header["prediction"] = "recorded";
+    header["vehicle"] = "KS2";
+    header["config"]["limits"] = {{"max_speed_mph", 80.5}};
+  }
   out += header.dump() + "\n";
 
   const std::vector<std::string> terms = {"efficiency", "comfort", "lane_change"};

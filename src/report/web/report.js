@@ -10,6 +10,9 @@
   const T = E.t;
   const DASH = "\u2013";
   const MPH = 0.44704;
+  //@commonroad
+  const CAP = ((H.config || {}).limits || {}).max_speed_mph;  // mph: the planner's speed cap
+  //@end
 
   // ---------- small helpers ----------
   function $(id) { return document.getElementById(id); }
@@ -134,9 +137,14 @@
       }
     }
     tile("miles to 1st incident", fmt(f.miles_to_first_incident, 2));
+    //@commonroad
+    // No simulator limits: the planner's speed cap, and no acceleration or jerk measures.
+    tile("max speed", `${fmt(f.max_speed_mph, 1)} mph`, num(CAP) && f.max_speed_mph > CAP);
+    //@else
     tile("max speed", `${fmt(f.max_speed_mph, 1)} mph`, f.max_speed_mph > 50);
     tile("max acc", `${fmt(f.max_acc, 2)} m/s\u00b2`, f.max_acc > 10);
     tile("max jerk", `${fmt(f.max_jerk, 2)} m/s\u00b3`, f.max_jerk > 10);
+    //@end
     tile("lane changes", fmt(f.lane_changes, 0));
     tile("min gap", `${fmt(f.min_gap_m, 1)} m`);
     tile("min headway", `${fmt(f.min_headway_s, 2)} s`);
@@ -446,12 +454,18 @@
   }
   function buildPlots() {
     const specs = [
+      //@commonroad
+      // The planner's speed cap; no simulator acceleration or jerk measures to plot.
+      { id: "speed", title: "speed", unit: "mph", series: [series("speed", E.speed, "#1570ef")],
+        limits: num(CAP) ? [[CAP, `${fmt(CAP, 1)} mph (planner's cap)`]] : [], lo: 0 },
+      //@else
       { id: "speed", title: "speed", unit: "mph", series: [series("speed", E.speed, "#1570ef")],
         limits: [[50, "50 mph"]], lo: 0 },
       { id: "acc", title: "total acceleration (simulator)", unit: "m/s\u00b2",
         series: [series("acc", E.acc, "#e04f16")], limits: [[10, "10"]], lo: 0 },
       { id: "jerk", title: "jerk (simulator)", unit: "m/s\u00b3",
         series: [series("jerk", E.jerk, "#9e77ed")], limits: [[10, "10"]], lo: 0 },
+      //@end
       { id: "lane", title: "lane (0 = left)", unit: "",
         series: [series("lane", E.lane.map((v) => v >= 0 ? v : null), "#0e9384", true),
                  series("winner's target", E.winner_lane.map((v) => v >= 0 ? v : null), "#f79009", true)],
