@@ -21,7 +21,7 @@ constexpr double kAccelMinGain = 1.0;
 // m along s: the road is free for a constant-acceleration run when no car is from this far
 // behind to this far ahead of the ego (a run from a standstill to the limit takes ~60 m).
 constexpr double kAccelFreeBehind = 20.0, kAccelFreeAhead = 100.0;
-// m/s: below it a car laterally at rest off its lane's centre may also hold its d.
+// m/s: below it a car laterally at rest off its lane's centre holds its d (Lattice::Generate).
 constexpr double kCrawlSpeed = 2.0;
 
 double Linspace(double lo, double hi, int count, int i) {
@@ -311,7 +311,8 @@ void Lattice::Generate() {
     if (!reachable[l]) continue;
     const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.lane_width;
     const bool centred = own && at_rest && std::abs(ws_.lane_center[l] - start.d) < 0.1;
-    for (int ti = 0; ti < (centred ? 1 : cfg_.lat_durations); ++ti) {
+    const bool crawl_hold = own && at_rest && !centred && start.s_d < kCrawlSpeed;
+    for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat_durations); ++ti) {
       const double T =
           Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, cfg_.lat_durations, ti);
       for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
@@ -319,10 +320,10 @@ void Lattice::Generate() {
         AddLat(MakeLat(l, off, T));
       }
     }
-    // At a crawl, laterally at rest off the lane's centre: holding d too. A move across there
-    // turns the car far off the lane's heading for the little way it drives (a queue), which
-    // a goal's orientation and the lanelets' borders mind.
-    if (own && at_rest && !centred && start.s_d < kCrawlSpeed) {
+    // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
+    // move across there turns the car far off the lane's heading for the little way it drives
+    // (a queue), which a goal's orientation and the lanelets' borders mind.
+    if (crawl_hold) {
       AddLat(MakeLat(l, start.d - ws_.lane_center[l], cfg_.lat_max_duration));
     }
     if (!own && at_rest) {

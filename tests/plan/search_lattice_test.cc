@@ -92,7 +92,9 @@ TEST(SearchLatticeTest, NoBrakingFamilyBelowOneMetrePerSecondAndNoStopWhenDisabl
   EXPECT_EQ(no_stop.ws.lon.size(), 84u);
 }
 
-TEST(SearchLatticeTest, AtACrawlOffTheCentreItMayAlsoHoldItsD) {
+// At a crawl (a queue) the own lane's only lateral move holds d: a move to the centre there turns
+// the car far off the lane's heading for the little way it drives. At speed, every duration.
+TEST(SearchLatticeTest, AtACrawlOffTheCentreItHoldsItsD) {
   REQUIRE_UDACITY_MAP();
   for (const double speed : {1.0, 10.0}) {
     Stages st;
@@ -100,11 +102,14 @@ TEST(SearchLatticeTest, AtACrawlOffTheCentreItMayAlsoHoldItsD) {
     const double d = st.ws.lane_center[1] + 0.4;
     st.Prepare({kS, speed, 0, d, 0, 0});
     st.lattice.Generate();
-    int holds = 0;
+    int own = 0, holds = 0;
     for (const LatTraj& l : st.ws.lat) {
-      holds += l.lane == 1 && std::abs(l.traj.At(l.traj.end_time()).p - d) < 1e-9;
+      if (l.lane != 1) continue;
+      ++own;
+      holds += std::abs(l.traj.At(l.traj.end_time()).p - d) < 1e-9;
     }
     EXPECT_EQ(holds, speed < 2.0 ? 1 : 0) << speed << " m/s";
+    EXPECT_EQ(own, speed < 2.0 ? 1 : st.cfg.lat_durations * st.cfg.lat_offsets) << speed << " m/s";
   }
 }
 
