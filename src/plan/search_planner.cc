@@ -365,7 +365,9 @@ class SearchPlanner : public Planner {
 
   // The cheapest candidate of ranks [r0, n) that passes every check, -1 when none does (or the
   // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
-  // (a heap: only the ones taken are ordered), and tested for collision; one that does not
+  // (a heap: only the ones taken are ordered; a coarse bound that comes up is completed and
+  // queued again, so they come up in the order of complete bounds, Scorer::SortUpTo's
+  // argument), and tested for collision; one that does not
   // collide gets its exact cost, and the hard limits when it is cheaper than the cheapest that
   // passed so far. The test ends once no bound is left below that one's cost (no candidate
   // left can be cheaper). After kRestHeapTests the rest are taken in any order, each skipped
@@ -378,7 +380,7 @@ class SearchPlanner : public Planner {
     rest_.clear();
     for (int k = r0; k < n; ++k) {
       const int c = ws_.order[k];
-      rest_.push_back({scorer_.Bound(c), c});
+      rest_.push_back({scorer_.KnownBound(c), c});
       popped_[c] = 0;
     }
     const auto later = std::greater<std::pair<double, int>>();  // a min-heap by bound, index
@@ -413,17 +415,23 @@ class SearchPlanner : public Planner {
     // Popped in bound order to the end, unless the last search found none passing either.
     const int heap_tests = none_passed_last_ ? kRestHeapTests : n;
     int k = 0;
-    for (; !rest_.empty() && k < heap_tests; ++k) {
+    while (!rest_.empty() && k < heap_tests) {
       if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return -1;
       }
       const auto [bc, c] = rest_.front();
-      if (beaten(bc, c)) return best;
+      if (beaten(bc, c)) return best;  // a coarse bound beaten: its complete one is too
       std::pop_heap(rest_.begin(), rest_.end(), later);
+      if (!scorer_.BoundComplete(c)) {
+        rest_.back().first = scorer_.Bound(c);
+        std::push_heap(rest_.begin(), rest_.end(), later);
+        continue;
+      }
       rest_.pop_back();
       popped_[c] = 1;
       test(c);
+      ++k;
     }
     // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
     // rest in rank order then (popping each costs more than the order saves; the candidates of
@@ -434,7 +442,8 @@ class SearchPlanner : public Planner {
         return -1;
       }
       const int c = ws_.order[e];
-      if (!popped_[c] && !beaten(scorer_.Bound(c), c)) test(c);
+      if (popped_[c] || beaten(scorer_.KnownBound(c), c) || beaten(scorer_.Bound(c), c)) continue;
+      test(c);
     }
     return best;
   }
