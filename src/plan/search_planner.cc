@@ -425,12 +425,12 @@ class SearchPlanner : public Planner {
       }
       if (rest_.empty()) return -1;  // every candidate collides or breaks a limit
       const int c = rest_.front().second;
-      std::pop_heap(rest_.begin(), rest_.end(), later);
       if (!scorer_.BoundComplete(c)) {
-        rest_.back().first = scorer_.Bound(c);
-        std::push_heap(rest_.begin(), rest_.end(), later);
+        rest_.front().first = scorer_.Bound(c);
+        search::SiftDownTop(rest_.begin(), rest_.end(), later);
         continue;
       }
+      std::pop_heap(rest_.begin(), rest_.end(), later);
       rest_.pop_back();
       popped_[c] = 1;
       ++k;

@@ -153,9 +153,8 @@ bool Scorer::SortUpTo(int rank) {
       }
     }
     if (!complete_[p]) {
-      std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
       Tighten(p);
-      std::push_heap(pending_.begin(), pending_.end(), ByBound{this});
+      SiftDownTop(pending_.begin(), pending_.end(), ByBound{this});
       continue;
     }
     if ((++resolved & 63) == 0 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;

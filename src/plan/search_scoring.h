@@ -3,6 +3,7 @@
 // of every candidate in generation order, and the lazy sort into cost order (ties by index).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -31,6 +32,26 @@ inline void SetNear(const Workspace& ws, cost::CostInput& in, const std::uint64_
   in.near_lat[1] = lat + ws.n_samples;
   in.near_lon[0] = lon;
   in.near_lon[1] = lon + ws.n_samples;
+}
+
+// Restores the heap [first, last) (std::make_heap's, by `less`) after its top's key moved
+// down the order (a bound completed: never smaller): one sift down, where std::pop_heap and
+// std::push_heap take two passes. The keys of the planner's heaps are total orders (ties
+// break by index), so the order they come off in is the same either way.
+template <typename It, typename Less>
+void SiftDownTop(It first, It last, Less less) {
+  const std::ptrdiff_t n = last - first;
+  std::ptrdiff_t i = 0;
+  auto v = std::move(first[0]);
+  for (;;) {
+    std::ptrdiff_t child = 2 * i + 1;
+    if (child >= n) break;
+    if (child + 1 < n && less(first[child], first[child + 1])) ++child;
+    if (!less(v, first[child])) break;
+    first[i] = std::move(first[child]);
+    i = child;
+  }
+  first[i] = std::move(v);
 }
 
 // Cost order, ties by index: a strict total order on candidates.
