@@ -19,6 +19,8 @@ class AccelerationCost : public CostTerm {
     return sum / n / (scale_ * scale_);
   }
 
+  bool Sampled() const override { return true; }
+
  private:
   double scale_ = 2.0;
 };

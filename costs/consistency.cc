@@ -26,6 +26,8 @@ class ConsistencyCost : public CostTerm {
     return std::min(sum / n, 1e6);
   }
 
+  bool Sampled() const override { return true; }
+
  private:
   double s_scale_ = 10.0;
 };

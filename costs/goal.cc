@@ -61,6 +61,8 @@ class GoalCost : public CostTerm {
     return best > 0 ? std::clamp(miss_ + best, 0.0, cap_) : 0.0;
   }
 
+  bool Sampled() const override { return true; }
+
  private:
   // The candidate at time t (s after the start): sampled, then straight on. h is its heading's
   // tangent against the line's, d' / s' (s' floored at 0.1 m/s): monotone in the heading, and

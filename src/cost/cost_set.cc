@@ -44,6 +44,7 @@ StatusOr<std::shared_ptr<const CostSet>> CostSet::Build(
     set->weights_.push_back(tc.weight);
     set->expensive_.push_back(term->Expensive());
     set->lane_only_.push_back(term->LaneOnly());
+    set->coarse_skip_.push_back(term->Expensive() || term->Sampled());
     set->terms_.push_back(std::move(term));
   }
   return std::shared_ptr<const CostSet>(std::move(set));
@@ -62,14 +63,24 @@ double CostSet::Evaluate(const CostContext& ctx, const CostInput& in, double* pe
 
 double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
                            LaneMemo* memo) const {
-  // Evaluate's sum, term for term, with 0 in place of the expensive terms' values.
+  return BoundSkipping(expensive_, ctx, in, cheap, memo);
+}
+
+double CostSet::CoarseLowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
+                                 LaneMemo* memo) const {
+  return BoundSkipping(coarse_skip_, ctx, in, cheap, memo);
+}
+
+double CostSet::BoundSkipping(const std::vector<char>& skip, const CostContext& ctx,
+                              const CostInput& in, double* cheap, LaneMemo* memo) const {
+  // Evaluate's sum, term for term, with 0 in place of the skipped terms' values.
   double total = 0;
   const int n = size();
   const int lane = in.target_lane;
   const bool memo_lane = memo != nullptr && lane >= 0 && lane < kMaxLanes;
   for (int i = 0; i < n; ++i) {
     double v = 0.0;
-    if (expensive_[i]) {
+    if (skip[i]) {
       v = 0.0;
     } else if (memo_lane && i < LaneMemo::kMaxTerms && lane_only_[i]) {
       if (!memo->known_[i][lane]) {
@@ -82,6 +93,19 @@ double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* 
     }
     if (cheap != nullptr) cheap[i] = v;
     total += weights_[i] * v;
+  }
+  return total;
+}
+
+double CostSet::CompleteLowerBound(const CostContext& ctx, const CostInput& in,
+                                   double* cheap) const {
+  // LowerBound's sum from the values: the coarse bound's, the Sampled() terms' now, and 0 for
+  // the Expensive() ones (as CoarseLowerBound left them).
+  double total = 0;
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    if (coarse_skip_[i] && !expensive_[i]) cheap[i] = terms_[i]->Evaluate(ctx, in);
+    total += weights_[i] * cheap[i];
   }
   return total;
 }

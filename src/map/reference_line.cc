@@ -271,13 +271,20 @@ FrenetPoint ReferenceLine::ToFrenet(double x, double y) const {
   return impl_->Project(x, y, impl_->NearestGlobal(x, y));
 }
 
-FrenetPoint ReferenceLine::ToFrenet(double x, double y, double s_hint) const {
-  if (!std::isfinite(x) || !std::isfinite(y)) return FrenetPoint{0, 0};
-  if (!std::isfinite(s_hint)) return ToFrenet(x, y);
+int ReferenceLine::HintSample(double s_hint) const {
+  if (!std::isfinite(s_hint)) return -1;
   const Impl& m = *impl_;
   const double sigma_hint = std::clamp(WrapS(s_hint) * m.inv_step, 0.0, static_cast<double>(m.n));
   int start = static_cast<int>(sigma_hint);
   if (start >= m.n && m.closed) start = m.n - 1;
+  return start;
+}
+
+FrenetPoint ReferenceLine::ToFrenet(double x, double y, double s_hint) const {
+  if (!std::isfinite(x) || !std::isfinite(y)) return FrenetPoint{0, 0};
+  const int start = HintSample(s_hint);
+  if (start < 0) return ToFrenet(x, y);
+  const Impl& m = *impl_;
   bool ok = false;
   const int nearest = m.NearestLocal(x, y, start, &ok);
   if (!ok) return ToFrenet(x, y);

@@ -1,8 +1,11 @@
 #include "frenetic/plan/predictor.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <utility>
 
 namespace frenetic::plan {
@@ -27,11 +30,131 @@ constexpr double kGhostLeaderReach = 40.0;  // m: a leader this close ahead is w
 constexpr double kGhostOnset = 1.0;         // s: the rule holds this long before the car moves
 constexpr double kGhostEgoLateral = 3.0;    // m: the rule minds an ego this close to the lane
 
+// The projections of recorded future samples from the last two Observe calls, per car: a
+// recording moves on by a step per cycle, so most samples of a car's future this cycle were
+// projected one cycle ago (a stride of one step) or two (a stride of two), and from the same
+// hint sample. A projection depends on nothing else (ReferenceLine::HintSample): a kept one is
+// the value a fresh projection gives, bit for bit. Sized once; Find and Add do not allocate.
+class ProjectionMemo {
+ public:
+  // One projected sample: its key (x, y, the hint sample), the projection, the line's heading
+  // there and, for the sample's heading h, the cosine and sine of the line's heading less h.
+  struct Entry {
+    double x, y;
+    int hint;
+    double s, d, line_heading;
+    double h, cos_rel, sin_rel;
+  };
+
+  ProjectionMemo(int max_cars, int per_car) : max_cars_(max_cars), per_car_(per_car) {
+    for (Generation& g : gens_) {
+      g.runs.reserve(max_cars);
+      // Not written until used (the Udacity simulator's cars have no futures).
+      g.entries =
+          std::make_unique_for_overwrite<Entry[]>(static_cast<std::size_t>(max_cars) * per_car);
+    }
+  }
+
+  // A new cycle: the oldest generation's runs are dropped, this cycle's are added from now on.
+  void NextCycle() {
+    cur_ = (cur_ + 1) % kGenerations;
+    gens_[cur_].runs.clear();
+    run_ = nullptr;
+  }
+  void Clear() {
+    for (Generation& g : gens_) g.runs.clear();
+    run_ = nullptr;
+  }
+
+  // Starts car `id`'s run of this cycle (with no room left, Find finds nothing and Add keeps
+  // nothing): the car's runs of the earlier cycles are where Find looks.
+  void BeginCar(int id) {
+    run_ = nullptr;
+    Generation& g = gens_[cur_];
+    if (static_cast<int>(g.runs.size()) >= max_cars_) return;
+    g.runs.push_back({id, static_cast<int>(g.runs.size()) * per_car_, 0});
+    run_ = &g.runs.back();
+    for (int b = 1; b < kGenerations; ++b) {
+      Look& look = looks_[b - 1];
+      look = {};
+      const Generation& old = gens_[(cur_ + kGenerations - b) % kGenerations];
+      for (const Run& r : old.runs) {
+        if (r.id == id) look.run = &r;
+      }
+      look.gen = &old;
+    }
+  }
+
+  // The kept projection of (x, y) from hint sample `hint`, or null. The samples of a car are
+  // looked up in order, so each earlier run is searched once (for the first sample it holds)
+  // and then followed entry by entry; a run that stops matching is not searched again.
+  const Entry* Find(double x, double y, int hint) {
+    if (run_ == nullptr) return nullptr;
+    for (Look& look : looks_) {
+      if (look.run == nullptr) continue;
+      const Entry* e = look.gen->entries.get() + look.run->offset;
+      const int n = look.run->count;
+      if (look.next < 0) {  // not found in this run yet: search it (once)
+        for (int k = 0; k < n && look.next < 0; ++k) {
+          if (Same(e[k], x, y)) look.next = k;
+        }
+        if (look.next < 0) {
+          look.run = nullptr;
+          continue;
+        }
+      } else if (look.next >= n || !Same(e[look.next], x, y)) {
+        look.run = nullptr;
+        continue;
+      }
+      const Entry& hit = e[look.next++];
+      if (hit.hint == hint) return &hit;
+    }
+    return nullptr;
+  }
+
+  // Keeps a projection in the current car's run.
+  void Add(const Entry& e) {
+    if (run_ == nullptr || run_->count >= per_car_) return;
+    gens_[cur_].entries[run_->offset + run_->count++] = e;
+  }
+
+ private:
+  static constexpr int kGenerations = 3;  // this cycle's and the two before
+  struct Run {
+    int id, offset, count;
+  };
+  struct Generation {
+    std::vector<Run> runs;
+    std::unique_ptr<Entry[]> entries;  // per_car_ per run, the run's first `count` used
+  };
+  // A car's run of an earlier generation as Find follows it: the entry expected next (-1: not
+  // searched yet).
+  struct Look {
+    const Generation* gen = nullptr;
+    const Run* run = nullptr;
+    int next = -1;
+  };
+  static bool Same(const Entry& e, double x, double y) {
+    return std::bit_cast<std::uint64_t>(e.x) == std::bit_cast<std::uint64_t>(x) &&
+           std::bit_cast<std::uint64_t>(e.y) == std::bit_cast<std::uint64_t>(y);
+  }
+
+  int max_cars_, per_car_;
+  Generation gens_[kGenerations];
+  int cur_ = 0;
+  Run* run_ = nullptr;
+  Look looks_[kGenerations - 1];
+};
+
 class TrafficPredictor : public Predictor {
  public:
   TrafficPredictor(std::shared_ptr<const map::Road> road, const PredictorOptions& options,
                    bool manoeuvres)
-      : road_(std::move(road)), line_(road_->line_ptr()), options_(options), manoeuvres_(manoeuvres) {
+      : road_(std::move(road)),
+        line_(road_->line_ptr()),
+        options_(options),
+        manoeuvres_(manoeuvres),
+        memo_(options_.max_cars, kMaxFutureSamples) {
     cars_.reserve(2 * options_.max_cars);  // room for a ghost per car
     slot_.reserve(2 * options_.max_cars);
     ghost_seen_.reserve(options_.max_cars);
@@ -47,6 +170,7 @@ class TrafficPredictor : public Predictor {
                std::span<const CarFuture> futures, double ego_d) override {
     cars_.clear();
     slot_.clear();
+    memo_.NextCycle();
     if (!std::isfinite(ego_s)) return;
     for (const SensorCar& row : rows) {
       if (static_cast<int>(cars_.size()) >= options_.max_cars) break;
@@ -133,6 +257,7 @@ class TrafficPredictor : public Predictor {
     slot_.clear();
     memory_.clear();
     ghost_seen_.clear();
+    memo_.Clear();
   }
 
  private:
@@ -264,16 +389,31 @@ class TrafficPredictor : public Predictor {
     const double ego_w = line_->WrapS(ego_s);
     double hint = line_s;
     const int base = slot * kMaxFutureSamples;
+    memo_.BeginCar(id);
     for (int k = 0; k < n; ++k) {
       const int q = std::min(k * stride, given - 1);
       const double x = fut->x[q], y = fut->y[q], v = fut->v[q], h = fut->heading[q];  // finite
-      const map::FrenetPoint f = line_->ToFrenet(x, y, hint);
-      const double rel = line_->At(f.s).heading - h;  // the car's heading against the line's
-      hint = f.s;
-      fut_s_[base + k] = line_->DiffS(f.s, ego_w);
-      fut_d_[base + k] = f.d;
-      fut_v_[base + k] = v * std::cos(rel);
-      fut_vd_[base + k] = v * std::sin(rel);  // d is to the right: a heading right of the line
+      // The projection from the hint, or the same one kept from an earlier cycle.
+      const int hint_sample = line_->HintSample(hint);
+      ProjectionMemo::Entry e;
+      if (const ProjectionMemo::Entry* kept = memo_.Find(x, y, hint_sample); kept != nullptr) {
+        e = *kept;
+      } else {
+        const map::FrenetPoint f = line_->ToFrenet(x, y, hint);
+        e = {x, y, hint_sample, f.s, f.d, line_->At(f.s).heading, NAN, 0, 0};
+      }
+      if (std::bit_cast<std::uint64_t>(e.h) != std::bit_cast<std::uint64_t>(h)) {
+        const double rel = e.line_heading - h;  // the car's heading against the line's
+        e.h = h;
+        e.cos_rel = std::cos(rel);
+        e.sin_rel = std::sin(rel);
+      }
+      memo_.Add(e);
+      hint = e.s;
+      fut_s_[base + k] = line_->DiffS(e.s, ego_w);
+      fut_d_[base + k] = e.d;
+      fut_v_[base + k] = v * e.cos_rel;
+      fut_vd_[base + k] = v * e.sin_rel;  // d is to the right: a heading right of the line
     }
     // The last sample kept may be one the stride overshot (the recording's end): its time.
     fut_n_[slot] = n;
@@ -345,6 +485,7 @@ class TrafficPredictor : public Predictor {
   std::vector<Memory> memory_;
   // Cars that gave a ghost last time, with the time they were first seen so (NaN: unknown).
   std::vector<std::pair<int, double>> ghost_seen_, ghost_seen_next_;
+  ProjectionMemo memo_;  // LoadFuture's projections, kept for the next two cycles
 };
 
 }  // namespace

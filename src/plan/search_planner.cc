@@ -36,8 +36,8 @@ using search::Finite;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
 
-// CheckLazily walks this many ranks in cost order (more when traced), then tests the rest by
-// their cost bound.
+// Traced, CheckLazily walks this many ranks in cost order (more when more are traced), then
+// tests the rest by their cost bound; untraced, it tests them all by bound.
 constexpr int kCheckRestMin = 4;
 // CheckRest takes this many candidates cheapest bound first, then the rest in any order, when
 // none passed in the last search either.
@@ -97,6 +97,7 @@ class SearchPlanner : public Planner {
     rows_.reserve(search::kMaxCars + cost::kMaxLanes);
     for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
     rest_.reserve(ws_.order.capacity());
+    clear_.reserve(ws_.order.capacity());
     popped_.assign(ws_.order.capacity(), 0);
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
@@ -300,15 +301,16 @@ class SearchPlanner : public Planner {
     s.ms_total = 0;
   }
 
-  // Checks the scored candidates in cost order, sorting lazily, until one passes: the
-  // Frenet-only collision test first, then the hard limits. False when none passed or the
-  // deadline (85% of budget_ms) cut it short (then *over_budget is set).
-  // Past the first few ranks (and the traced ones) the rest are tested by their cost bound
-  // instead (CheckRest), which needs no exact cost for a candidate that collides.
+  // Finds the cheapest candidate that passes every check: the Frenet-only collision test
+  // first, then the hard limits. False when none passed or the deadline (85% of budget_ms) cut
+  // it short (then *over_budget is set). Traced, the traced ranks are checked in cost order,
+  // sorting lazily (the trace shows why each was rejected); the rest, and untraced every
+  // candidate, are tested by their cost bound instead (CheckRest), which needs no exact cost
+  // for a candidate that collides: the same winner.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
-    const int rest_at = std::max(kCheckRestMin, trace_ != nullptr ? trace_max_ : 0);
+    const int rest_at = trace_ != nullptr ? std::max(kCheckRestMin, trace_max_) : 0;
     for (int r = 0; r < n; ++r) {
       if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *over_budget = true;
@@ -365,76 +367,106 @@ class SearchPlanner : public Planner {
 
   // The cheapest candidate of ranks [r0, n) that passes every check, -1 when none does (or the
   // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
-  // (a heap: only the ones taken are ordered), and tested for collision; one that does not
-  // collide gets its exact cost, and the hard limits when it is cheaper than the cheapest that
-  // passed so far. The test ends once no bound is left below that one's cost (no candidate
-  // left can be cheaper). After kRestHeapTests the rest are taken in any order, each skipped
-  // when its bound is not below that cost: the same cheapest one. Every one tested counts as
-  // checked, and as rejected when it collides or breaks a limit (one outranked by a passing
-  // one is neither).
+  // (a heap: only the ones taken are ordered; a coarse bound that comes up is completed and
+  // queued again, so they come up in the order of complete bounds, Scorer::SortUpTo's
+  // argument), and tested for collision; one that does not collide gets its exact cost and
+  // waits in a second heap, by cost. The cheapest waiting one is the cheapest candidate that
+  // does not collide once no bound left ranks before its cost: it is tested for the hard
+  // limits then, and is the answer when it passes (every cheaper one collides or breaks a
+  // limit). So no candidate that collides is costed in full, and only the cheapest clear
+  // ones are converted to XY. After kRestHeapTests the rest are taken in any order, each
+  // skipped when its bound is not below the cost of the cheapest that passed: the same
+  // cheapest one. Every one tested counts as checked, and as rejected when it collides or
+  // breaks a limit (one outranked by a passing one is neither).
   int CheckRest(int r0, bool* cut) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());
     rest_.clear();
+    clear_.clear();
     for (int k = r0; k < n; ++k) {
       const int c = ws_.order[k];
-      rest_.push_back({scorer_.Bound(c), c});
+      rest_.push_back({scorer_.KnownBound(c), c});
       popped_[c] = 0;
     }
-    const auto later = std::greater<std::pair<double, int>>();  // a min-heap by bound, index
+    // Min-heaps by (bound, index) and (cost, index): Cheaper's order on exact costs.
+    const auto later = std::greater<std::pair<double, int>>();
     std::make_heap(rest_.begin(), rest_.end(), later);
-    int best = -1;  // the cheapest candidate that passed
-    // Tests c: whether it passes and is the cheapest so far.
-    const auto test = [&](int c) {
-      ++sum.candidates_checked;
-      if (checker_.CandidateCollides(c)) {
-        ++sum.rejections[static_cast<int>(Reject::kCollision)];
-        return;
-      }
-      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
-        scorer_.ExactCost(c);
-        if (!search::Cheaper(ws_, c, best)) return;
-      }
+    // Whether c passes the hard limits (counted as feasible or rejected).
+    const auto within_limits = [&](int c) {
       Reject why = Reject::kCount;
       if (checker_.CandidateViolation(c, &why) > 0) {
         ++sum.rejections[static_cast<int>(why)];
-        return;
+        return false;
       }
-      scorer_.ExactCost(c);
       ++sum.candidates_feasible;
-      best = c;
+      return true;
     };
-    // Whether no candidate left in the heap can be cheaper than the best one.
+    // Whether c collides (counted as checked, and as rejected when it does).
+    const auto collides = [&](int c) {
+      ++sum.candidates_checked;
+      if (!checker_.CandidateCollides(c)) return false;
+      ++sum.rejections[static_cast<int>(Reject::kCollision)];
+      return true;
+    };
+    // Popped in bound order to the end, unless the last search found none passing either.
+    const int heap_tests = none_passed_last_ ? kRestHeapTests : n;
+    int k = 0;
+    while (k < heap_tests) {
+      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
+        *cut = true;
+        return -1;
+      }
+      if (!clear_.empty() && (rest_.empty() || clear_.front() < rest_.front())) {
+        std::pop_heap(clear_.begin(), clear_.end(), later);
+        const int c = clear_.back().second;
+        clear_.pop_back();
+        if (within_limits(c)) return c;
+        continue;
+      }
+      if (rest_.empty()) return -1;  // every candidate collides or breaks a limit
+      const int c = rest_.front().second;
+      if (!scorer_.BoundComplete(c)) {
+        rest_.front().first = scorer_.Bound(c);
+        search::SiftDownTop(rest_.begin(), rest_.end(), later);
+        continue;
+      }
+      std::pop_heap(rest_.begin(), rest_.end(), later);
+      rest_.pop_back();
+      popped_[c] = 1;
+      ++k;
+      if (collides(c)) continue;
+      clear_.push_back({scorer_.ExactCost(c), c});
+      std::push_heap(clear_.begin(), clear_.end(), later);
+    }
+    // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
+    // clear ones taken so far in cost order until one passes, then the rest in rank order
+    // (popping each costs more than the order saves; the candidates of a bundle are neighbours
+    // there), each skipped when its bound cannot beat the cheapest that passed.
+    int best = -1;
+    std::sort_heap(clear_.begin(), clear_.end(), later);  // descending: the cheapest last
+    for (; !clear_.empty() && best < 0; clear_.pop_back()) {
+      if (within_limits(clear_.back().second)) best = clear_.back().second;
+    }
     const auto beaten = [&](double bc, int c) {
       if (best < 0) return false;
       const double cost = ws_.cand_cost[best];
       return bc > cost || (bc == cost && c > best);
     };
-    // Popped in bound order to the end, unless the last search found none passing either.
-    const int heap_tests = none_passed_last_ ? kRestHeapTests : n;
-    int k = 0;
-    for (; !rest_.empty() && k < heap_tests; ++k) {
-      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
-        *cut = true;
-        return -1;
-      }
-      const auto [bc, c] = rest_.front();
-      if (beaten(bc, c)) return best;
-      std::pop_heap(rest_.begin(), rest_.end(), later);
-      rest_.pop_back();
-      popped_[c] = 1;
-      test(c);
-    }
-    // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
-    // rest in rank order then (popping each costs more than the order saves; the candidates of
-    // a bundle are neighbours there), each skipped when its bound cannot beat the best one.
     for (int e = r0; !rest_.empty() && e < n; ++e, ++k) {
       if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
         *cut = true;
         return -1;
       }
       const int c = ws_.order[e];
-      if (!popped_[c] && !beaten(scorer_.Bound(c), c)) test(c);
+      if (popped_[c] || beaten(scorer_.KnownBound(c), c) || beaten(scorer_.Bound(c), c)) continue;
+      if (collides(c)) continue;
+      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
+        scorer_.ExactCost(c);
+        if (!search::Cheaper(ws_, c, best)) continue;
+      }
+      if (!within_limits(c)) continue;
+      scorer_.ExactCost(c);
+      best = c;
     }
     return best;
   }
@@ -550,8 +582,9 @@ class SearchPlanner : public Planner {
   // The road's end: the farthest lane end (a lane ending before it, by more than kLaneEndSlack,
   // ends within the road).
   double road_end_ = -std::numeric_limits<double>::infinity();
-  std::vector<std::pair<double, int>> rest_;  // CheckRest's candidates: a heap by bound
-  std::vector<char> popped_;                  // CheckRest: taken from the heap
+  std::vector<std::pair<double, int>> rest_;   // CheckRest's candidates: a heap by bound
+  std::vector<std::pair<double, int>> clear_;  // CheckRest's collision-free ones: a heap by cost
+  std::vector<char> popped_;                   // CheckRest: taken from the heap
   bool none_passed_last_ = false;             // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;

@@ -24,6 +24,7 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   pending_.reserve(cap);
   ready_.reserve(cap);
   resolved_.assign(cap, 1);
+  complete_.assign(cap, 1);
   cheap_.assign(cap * costs_.size(), 0.0);
 }
 
@@ -65,10 +66,12 @@ bool Scorer::Score() {
   bound_.resize(n);
   pos_.resize(n);
   if (resolved_.size() < static_cast<std::size_t>(n)) resolved_.resize(n);
+  if (complete_.size() < static_cast<std::size_t>(n)) complete_.resize(n);
   if (cheap_.size() < static_cast<std::size_t>(n) * costs_.size()) {
     cheap_.resize(static_cast<std::size_t>(n) * costs_.size());
   }
   std::fill(resolved_.begin(), resolved_.begin() + n, 0);
+  std::fill(complete_.begin(), complete_.begin() + n, 0);
   ws_.sorted = 0;
   pending_.clear();
   ready_.clear();
@@ -81,8 +84,8 @@ bool Scorer::Score() {
     }
     // Resolve() makes the cost 1e300 when it is not finite: never below this bound.
     const double b =
-        costs_.LowerBound(ws_.ctx, BoundInputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
-                          &cheap_[static_cast<std::size_t>(c) * costs_.size()], &lane_memo_);
+        costs_.CoarseLowerBound(ws_.ctx, BoundInputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+                                &cheap_[static_cast<std::size_t>(c) * costs_.size()], &lane_memo_);
     bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
     ws_.order[c] = c;
     pos_[c] = c;
@@ -98,9 +101,19 @@ double Scorer::ExactCost(int c) {
   return ws_.cand_cost[c];
 }
 
+void Scorer::Tighten(int c) {
+  if (complete_[c]) return;
+  complete_[c] = 1;
+  const double b =
+      costs_.CompleteLowerBound(ws_.ctx, BoundInputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
+                                &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
+  bound_[c] = Finite(b) ? std::min(b, 1e300) : 1e300;
+}
+
 void Scorer::Resolve(int c) {
   if (resolved_[c]) return;
   resolved_[c] = 1;
+  Tighten(c);
   const double v = costs_.EvaluateWithCheap(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
                                             &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
@@ -117,8 +130,11 @@ void Scorer::Emit(int c) {
 // The lazy check mostly looks at the first few candidates, so a full sort would be wasted.
 // While some costs are unknown: the best known cost is final once it ranks before the smallest
 // bound of the unknown ones (an exact cost is never below its bound, and ties break by index
-// either way); else the candidate with that bound is costed. Once every cost is known, a
-// partial sort, each call at least doubling the sorted prefix.
+// either way); else the candidate with that bound is costed. A coarse bound there is completed
+// first and the candidate queued again: the candidates costed, and the order they are costed
+// and ranked in, are those of complete bounds throughout (a coarse bound is never above its
+// complete one, so the smallest complete bound comes up before any larger one). Once every cost
+// is known, a partial sort, each call at least doubling the sorted prefix.
 bool Scorer::SortUpTo(int rank) {
   const int n = static_cast<int>(ws_.order.size());
   if (rank < ws_.sorted || ws_.sorted >= n) return true;
@@ -135,6 +151,11 @@ bool Scorer::SortUpTo(int rank) {
         Emit(r);
         continue;
       }
+    }
+    if (!complete_[p]) {
+      Tighten(p);
+      SiftDownTop(pending_.begin(), pending_.end(), ByBound{this});
+      continue;
     }
     if ((++resolved & 63) == 0 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;
     std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});

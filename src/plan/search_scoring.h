@@ -3,6 +3,7 @@
 // of every candidate in generation order, and the lazy sort into cost order (ties by index).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +34,26 @@ inline void SetNear(const Workspace& ws, cost::CostInput& in, const std::uint64_
   in.near_lon[1] = lon + ws.n_samples;
 }
 
+// Restores the heap [first, last) (std::make_heap's, by `less`) after its top's key moved
+// down the order (a bound completed: never smaller): one sift down, where std::pop_heap and
+// std::push_heap take two passes. The keys of the planner's heaps are total orders (ties
+// break by index), so the order they come off in is the same either way.
+template <typename It, typename Less>
+void SiftDownTop(It first, It last, Less less) {
+  const std::ptrdiff_t n = last - first;
+  std::ptrdiff_t i = 0;
+  auto v = std::move(first[0]);
+  for (;;) {
+    std::ptrdiff_t child = 2 * i + 1;
+    if (child >= n) break;
+    if (child + 1 < n && less(first[child], first[child + 1])) ++child;
+    if (!less(v, first[child])) break;
+    first[i] = std::move(first[child]);
+    i = child;
+  }
+  first[i] = std::move(v);
+}
+
 // Cost order, ties by index: a strict total order on candidates.
 inline bool Cheaper(const Workspace& ws, int a, int b) {
   return ws.cand_cost[a] < ws.cand_cost[b] || (ws.cand_cost[a] == ws.cand_cost[b] && a < b);
@@ -45,10 +66,11 @@ class Scorer {
 
   // Scores every candidate and sets ws.order to the candidates, unsorted. False when the
   // deadline (half of budget_ms) stopped it early: the candidates scored so far, in generation
-  // order, are the cycle's candidates then. Lazy: only a lower bound of each cost (the cheap
-  // terms, CostSet::LowerBound) is computed here; ws.cand_cost[c] (the cost set's value, a
-  // non-finite cost counting as 1e300) is exact for the ranks SortUpTo has sorted, and for
-  // every candidate after ResolveAll.
+  // order, are the cycle's candidates then. Lazy: only a coarse lower bound of each cost (the
+  // terms that are neither Expensive() nor Sampled(), CostSet::CoarseLowerBound) is computed
+  // here, made the cheap terms' bound (CostSet::LowerBound, Bound) only for the candidates that
+  // need it; ws.cand_cost[c] (the cost set's value, a non-finite cost counting as 1e300) is
+  // exact for the ranks SortUpTo has sorted, and for every candidate after ResolveAll.
   bool Score();
   // Sorts ws.order lazily: ranks up to `rank` are in cost order afterwards. Evaluates the
   // expensive terms of just the candidates whose lower bound could rank them that early, in
@@ -62,8 +84,16 @@ class Scorer {
   // Candidate c's exact cost (ws.cand_cost[c]), evaluated now if Score() left only its bound;
   // the lazy sort's result is unchanged. Costs set without Score() are taken as exact.
   double ExactCost(int c);
-  // Candidate c's lower bound from Score(): its exact cost is never below it.
-  double Bound(int c) const { return bound_[c]; }
+  // Candidate c's lower bound, the cheap terms' (CostSet::LowerBound; completed now if Score()
+  // left it coarse): its exact cost is never below it.
+  double Bound(int c) {
+    Tighten(c);
+    return bound_[c];
+  }
+  // Candidate c's lower bound as far as it is known: Bound(c) when that is complete
+  // (BoundComplete), else the coarse one, never above it.
+  double KnownBound(int c) const { return bound_[c]; }
+  bool BoundComplete(int c) const { return complete_[c] != 0; }
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
   cost::CostInput InputFor(int i, int j);
@@ -90,6 +120,8 @@ class Scorer {
       return bb < ba || (bb == ba && b < a);
     }
   };
+  // Completes candidate c's bound (Bound) when Score() left it coarse.
+  void Tighten(int c);
   // The exact cost of candidate c into ws.cand_cost[c].
   void Resolve(int c);
   // Moves candidate c to rank ws.sorted of ws.order.
@@ -102,8 +134,9 @@ class Scorer {
   std::vector<double> bound_;
   std::vector<int> pos_, pending_, ready_;
   std::vector<char> resolved_;  // per candidate: ws.cand_cost is exact
-  // Per candidate, the cheap terms' values Score() computed for its bound ([c * terms + t]):
-  // Resolve() evaluates only the expensive ones.
+  std::vector<char> complete_;  // per candidate: bound_ is the cheap terms' (not the coarse one)
+  // Per candidate, the cheap terms' values computed for its bound ([c * terms + t]; the
+  // Sampled() ones once it is complete): Resolve() evaluates only the expensive ones.
   std::vector<double> cheap_;
   cost::CostSet::LaneMemo lane_memo_;  // Score()'s lane-only terms, per target lane
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;

@@ -324,6 +324,46 @@ TEST(CostSetTest, LaneMemoKeepsTheValues) {
   }
 }
 
+// CostSet::CoarseLowerBound over every registered term: never above LowerBound, and completed
+// (CompleteLowerBound) it is LowerBound, bit for bit, with the same cheap values.
+TEST(CostSetTest, CoarseBoundCompletesToTheLowerBound) {
+  std::vector<CostTermConfig> terms;
+  int sampled = 0;
+  for (const std::string& name : CostRegistry::Global().Names()) {
+    terms.push_back({name, 0.5 + terms.size(), {}});
+    auto made = CostRegistry::Global().Make(name);
+    ASSERT_TRUE(made.ok()) << made.message();
+    sampled += (*made)->Sampled() && !(*made)->Expensive();
+  }
+  EXPECT_GE(sampled, 1);
+  auto set = CostSet::Build(terms);
+  ASSERT_TRUE(set.ok()) << set.message();
+  const int n = (*set)->size();
+  std::mt19937 rng(57);
+  CostSet::LaneMemo memo;
+  for (int i = 0; i < 500; ++i) {
+    const Fixture f = RandomFixture(rng);
+    memo.Clear();
+    std::vector<double> plain(n), coarse(n, -1.0);
+    const double lower = (*set)->LowerBound(f.ctx, f.in, plain.data());
+    const double bound = (*set)->CoarseLowerBound(f.ctx, f.in, coarse.data(), &memo);
+    if (std::isnan(lower)) {
+      EXPECT_TRUE(std::isnan((*set)->CompleteLowerBound(f.ctx, f.in, coarse.data())));
+      continue;
+    }
+    ASSERT_FALSE(std::isnan(bound)) << "case " << i;
+    ASSERT_LE(bound, lower) << "case " << i;
+    for (int t = 0; t < n; ++t) {
+      const CostTerm& term = (*set)->term(t);
+      if (term.Sampled() || term.Expensive()) {
+        ASSERT_EQ(coarse[t], 0.0) << (*set)->name(t);
+      }
+    }
+    ASSERT_EQ((*set)->CompleteLowerBound(f.ctx, f.in, coarse.data()), lower) << "case " << i;
+    for (int t = 0; t < n; ++t) ASSERT_EQ(coarse[t], plain[t]) << (*set)->name(t);
+  }
+}
+
 TEST_P(CostContractTest, NearZeroOnIdealLaneKeeping) {
   auto term = Make();
   Fixture f = IdealLaneKeeping();

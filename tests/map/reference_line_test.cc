@@ -86,6 +86,28 @@ TEST_P(ReferenceLineOnMap, RoundTripWithHintAcrossSeam) {
   }
 }
 
+TEST_P(ReferenceLineOnMap, HintedProjectionReadsOnlyTheHintSample) {
+  // Hints anywhere within one dense sample's stretch (and one loop on) give the same projection,
+  // bit for bit: what a caller keeping projections by HintSample relies on.
+  const double len = line_->length();
+  const double step = len / line_->samples().size();
+  EXPECT_EQ(line_->HintSample(NAN), -1);
+  EXPECT_EQ(line_->HintSample(INFINITY), -1);
+  for (double s = 1.0; s < len; s += 97.3) {
+    const CartesianPose p = line_->ToCartesian(s + 4.0, 6.0);
+    const double lo = std::floor(s / step) * step;  // the stretch of the sample s is in
+    const int sample = line_->HintSample(s);
+    ASSERT_GE(sample, 0);
+    const FrenetPoint f = line_->ToFrenet(p.x, p.y, s);
+    for (const double hint : {lo + 0.01 * step, lo + 0.5 * step, lo + 0.99 * step, s + len}) {
+      if (line_->HintSample(hint) != sample) continue;  // rounding at a stretch's ends
+      const FrenetPoint g = line_->ToFrenet(p.x, p.y, hint);
+      ASSERT_EQ(f.s, g.s) << "s " << s << " hint " << hint;
+      ASSERT_EQ(f.d, g.d) << "s " << s << " hint " << hint;
+    }
+  }
+}
+
 TEST_P(ReferenceLineOnMap, SmoothAllTheWayRoundIncludingSeam) {
   const auto& samples = line_->samples();
   const size_t n = samples.size();

@@ -356,6 +356,38 @@ TEST(SearchPlannerTest, SummaryIsFilled) {
   EXPECT_EQ(winners, 1);
 }
 
+TEST(SearchPlannerTest, TracedAndUntracedChecksPickTheSameWinner) {
+  // Traced, the first ranks are checked in cost order; untraced, every candidate by its cost
+  // bound (collision first, the exact cost only for those clear of traffic): the same
+  // cheapest candidate that passes, so the same path, cycle after cycle, in traffic that
+  // blocks the cheapest candidates.
+  REQUIRE_MAP(line);
+  auto untraced = Make("search", line);
+  auto traced = Make("search", line);
+  auto driver = Make("search", line);
+  Loop loop(line, driver.get(), 1000, 6.0, 20.0, 11);
+  loop.cars.push_back({0, 1030, 2.0, 13.0});
+  loop.cars.push_back({1, 1050, 6.0, 12.0});
+  loop.cars.push_back({2, 1020, 10.0, 16.0});
+  loop.cars.push_back({3, 1070, 10.0, 11.0});
+  loop.cars.push_back({4, 990, 2.0, 21.0});
+  CycleTrace trace;
+  int rejected = 0;
+  for (int k = 0; k < 150; ++k) {
+    const Telemetry t = loop.Make();
+    const PlanResult& a = untraced->Plan(t);
+    const std::vector<double> ax = a.x, ay = a.y;
+    traced->set_trace(&trace, 6);
+    const PlanResult& b = traced->Plan(t);
+    traced->set_trace(nullptr, 0);
+    ASSERT_EQ(ax, b.x) << "cycle " << k;
+    ASSERT_EQ(ay, b.y) << "cycle " << k;
+    for (const CandidateTrace& c : trace.candidates) rejected += c.reject >= 0;
+    loop.Cycle();
+  }
+  EXPECT_GT(rejected, 0) << "the traffic never blocked a cheap candidate";
+}
+
 // The per-cycle deadline, tripped in a chosen stage by a fake clock that advances a fixed step
 // at every reading (deterministic, whatever the machine's speed).
 struct DeadlineRun {

@@ -2,6 +2,7 @@
 // end, trucks longer than the configured car, recorded futures. A small closed loop written
 // here drives the ego exactly along its own path, 5 ticks (0.1 s) per exchange, as the
 // CommonRoad runner does.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -253,6 +254,76 @@ TEST(RoadPlannerTest, RecordedFuturesAreWhatThePredictorPredicts) {
   pred->Observe(rows, 90, 0.0, bad);
   EXPECT_FALSE(pred->cars()[0].recorded);
   EXPECT_NEAR(pred->Predict(0, 1.0).s, 10 + 10.0, 1e-6);
+}
+
+TEST(RoadPlannerTest, RecordedFuturesPredictAsFreshWhenTheRecordingMovesOn) {
+  // A bend (300 m radius), three recorded cars: one changing lanes, one braking, one cruising.
+  // The predictor keeps its projections of the samples from cycle to cycle (each cycle's
+  // recording starts a step later): every prediction must be the one a fresh predictor makes,
+  // bit for bit, with the recording's step a stride of two (0.1 s) or one (0.2 s).
+  std::vector<map::ReferenceLine::Point> pts;
+  for (int i = 0; i <= 60; ++i) {
+    const double a = i * 10.0 / 300.0;
+    pts.push_back({300 * std::sin(a), 300 * (1 - std::cos(a))});
+  }
+  auto line = map::ReferenceLine::FitOpen(pts, map::ReferenceLine::Options(), "bend");
+  ASSERT_TRUE(line.ok()) << line.message();
+  std::vector<map::LaneProfile> profiles;
+  for (int l = 0; l < 3; ++l) {
+    profiles.push_back({{0, 600}, {l * kLane, l * kLane}, {(l + 1) * kLane, (l + 1) * kLane}});
+  }
+  auto road = map::Road::Make(*line, profiles, "bend");
+  ASSERT_TRUE(road.ok()) << road.message();
+  const map::ReferenceLine& ln = (*road)->line();
+  const Car cars[] = {{1, 60, 0.5 * kLane, 20, 4.8, 2.0, 1.2, 1.5 * kLane},
+                      {2, 90, 1.5 * kLane, 18, 4.8, 2.0, 0, 0, -3},
+                      {3, 40, 2.5 * kLane, 25, 12, 2.5}};
+  for (const double dt : {0.1, 0.2}) {
+    SCOPED_TRACE(dt);
+    PredictorOptions o;
+    o.num_lanes = 3;
+    o.lane_width = kLane;
+    auto kept = MakeManoeuvrePredictor(*road, o);
+    for (int step = 0; step < 12; ++step) {
+      std::vector<SensorCar> rows;
+      std::vector<CarFuture> futures;
+      for (const Car& c : cars) {
+        CarFuture f;
+        f.id = c.id;
+        f.dt = dt;
+        for (int q = step; q <= step + 60; ++q) {
+          const double t = q * dt;
+          const double v = std::max(c.v + c.a * t, 0.0);
+          const double tv = c.a < 0 ? std::min(t, c.v / -c.a) : t;
+          const map::CartesianPose p =
+              ln.ToCartesian(c.s + c.v * tv + 0.5 * c.a * tv * tv, c.DAt(t));
+          f.x.push_back(p.x);
+          f.y.push_back(p.y);
+          f.v.push_back(v);
+          f.heading.push_back(p.heading);
+        }
+        rows.push_back({c.id, f.x[0], f.y[0], f.v[0] * std::cos(f.heading[0]),
+                        f.v[0] * std::sin(f.heading[0]), c.s, c.d, c.length, c.width});
+        futures.push_back(f);
+      }
+      const double ego_s = 50 + 20 * step * dt, now = step * dt;
+      kept->Observe(rows, ego_s, now, futures);
+      auto fresh = MakeManoeuvrePredictor(*road, o);
+      fresh->Observe(rows, ego_s, now, futures);
+      ASSERT_EQ(kept->cars().size(), 3u);
+      ASSERT_EQ(fresh->cars().size(), 3u);
+      for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(kept->cars()[i].recorded);
+        for (double t = 0; t <= 9; t += 0.05) {
+          const Predictor::Prediction a = kept->Predict(i, t), b = fresh->Predict(i, t);
+          ASSERT_EQ(a.s, b.s) << "car " << i << " step " << step << " t " << t;
+          ASSERT_EQ(a.d, b.d) << "car " << i << " step " << step << " t " << t;
+          ASSERT_EQ(a.v, b.v) << "car " << i << " step " << step << " t " << t;
+          ASSERT_EQ(a.v_d, b.v_d) << "car " << i << " step " << step << " t " << t;
+        }
+      }
+    }
+  }
 }
 
 TEST(RoadPlannerTest, AvoidsACutInItIsToldAbout) {

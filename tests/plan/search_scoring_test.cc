@@ -88,6 +88,33 @@ TEST(SearchScoringTest, LazyCostingRanksLikeAFullSortByExactCost) {
   }
 }
 
+TEST(SearchScoringTest, CoarseBoundsAreCompletedOnlyWhenNeeded) {
+  // Score() leaves coarse bounds (no Sampled() term); ranking the first candidates completes
+  // a few, Bound completes any: the cheap terms' bound, never above the exact cost.
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  ASSERT_TRUE(st.scorer.Score());
+  Workspace& ws = st.ws;
+  const int n = static_cast<int>(ws.order.size());
+  ASSERT_TRUE(st.scorer.SortUpTo(3));
+  int complete = 0;
+  for (int c = 0; c < n; ++c) complete += st.scorer.BoundComplete(c);
+  EXPECT_GE(complete, 4);
+  EXPECT_LT(complete, n / 2) << "the sort completes only the bounds it needs";
+  for (int c = 0; c < n; ++c) {
+    const cost::CostInput in = st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]);
+    const double known = st.scorer.KnownBound(c);
+    const double lower = st.costs->LowerBound(ws.ctx, in);
+    const double bound = st.scorer.Bound(c);
+    ASSERT_TRUE(st.scorer.BoundComplete(c));
+    EXPECT_EQ(bound, std::isfinite(lower) ? std::min(lower, 1e300) : 1e300) << c;
+    EXPECT_LE(known, bound) << c;
+    const double exact = st.costs->Evaluate(ws.ctx, in);
+    EXPECT_LE(bound, std::isfinite(exact) ? exact : 1e300) << c;
+  }
+}
+
 TEST(SearchScoringTest, DeadlineStopsScoringAtACheckpoint) {
   REQUIRE_UDACITY_MAP();
   PlannerConfig config = testing::DefaultConfig();

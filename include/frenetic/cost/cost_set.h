@@ -60,6 +60,15 @@ class CostSet {
   // is not cleared: the same values.
   double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr,
                     LaneMemo* memo = nullptr) const;
+  // LowerBound's sum with the Sampled() terms taken as 0 too: never more than LowerBound(ctx,
+  // in), by the same argument. cheap (not null) receives the values of the terms it evaluates
+  // and 0 for the others; memo as LowerBound's. Does not allocate.
+  double CoarseLowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
+                          LaneMemo* memo = nullptr) const;
+  // Completes a CoarseLowerBound of the same input: evaluates the Sampled() terms that are not
+  // Expensive() into cheap and returns LowerBound(ctx, in) from cheap's values, the same sum
+  // term for term; cheap then holds what LowerBound would have put there. Does not allocate.
+  double CompleteLowerBound(const CostContext& ctx, const CostInput& in, double* cheap) const;
   // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
   // Expensive() terms are evaluated; the same sum, term for term. Does not allocate.
   double EvaluateWithCheap(const CostContext& ctx, const CostInput& in, const double* cheap) const;
@@ -69,7 +78,11 @@ class CostSet {
   std::vector<std::string> names_;
   std::vector<double> weights_;
   std::vector<std::unique_ptr<CostTerm>> terms_;
+  // LowerBound and CoarseLowerBound: the terms in `skip` are taken as 0.
+  double BoundSkipping(const std::vector<char>& skip, const CostContext& ctx, const CostInput& in,
+                       double* cheap, LaneMemo* memo) const;
   std::vector<char> expensive_, lane_only_;  // each term's Expensive() and LaneOnly()
+  std::vector<char> coarse_skip_;  // Expensive() or Sampled(): what CoarseLowerBound leaves out
 };
 
 }  // namespace frenetic::cost

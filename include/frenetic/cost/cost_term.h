@@ -257,6 +257,12 @@ class CostTerm {
   // the term out of a first, cheap lower bound of the total (CostSet::LowerBound) and evaluate it
   // only for the candidates that bound cannot rule out. Changes no value.
   virtual bool Expensive() const { return false; }
+  // Whether Evaluate reads the input sample by sample (its cost grows with num_samples), where
+  // the others read a few numbers (durations, the end state, the jerk integrals, the target
+  // lane). A planner may then leave such a term out of a coarser first bound too
+  // (CostSet::CoarseLowerBound) and evaluate it only for the candidates that bound cannot rule
+  // out. Changes no value.
+  virtual bool Sampled() const { return false; }
   // Whether Evaluate reads nothing of the input but in.target_lane: within one context, every
   // candidate bound for a lane has the same value, so a caller may keep it per lane
   // (CostSet::LaneMemo). Changes no value.

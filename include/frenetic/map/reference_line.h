@@ -100,6 +100,10 @@ class ReferenceLine {
   // Non-finite x or y gives (0, 0).
   FrenetPoint ToFrenet(double x, double y) const;
   FrenetPoint ToFrenet(double x, double y, double s_hint) const;
+  // The dense sample the hinted ToFrenet walks from (-1 for a non-finite hint: the global
+  // search): ToFrenet(x, y, s_hint) depends on s_hint through this index only, so two hints
+  // with the same one give the same projection of every point (a caller may keep projections).
+  int HintSample(double s_hint) const;
 
   RefSample At(double s) const;  // interpolated centre-line sample at s (wrapped)
   // The dense samples, uniformly spaced (<= sample_step) from s = 0: closed, length() /
