@@ -15,10 +15,6 @@ constexpr double kMaxLaneLookahead = 60.0;
 // whose half diagonal this is).
 constexpr double kReachS = 8.0, kReachD = 5.0;
 constexpr double kUdacityHalfDiagonal = 2.6832815729997477;
-// s after the last goal window's end that the collision check still sees the traffic (a time
-// step of the scenarios), and m ahead where a car is put after that (beyond every reach).
-constexpr double kGoalEndSlack = 0.1;
-constexpr double kGone = 1e6;
 
 // The lanes' centres for this cycle: the nominal ones, moved just enough that the simulator,
 // which measures d from the chords between waypoints (up to ~1.3 m outward mid-segment on
@@ -144,13 +140,6 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   // steps, t_keep after the observation.
   // The predictor's ghosts (they follow every real car) go last, for the hard checks only.
   const auto cars = predictor.cars();
-  // A problem with goals ends when the last goal window closes (frenetic commonroad stops
-  // there, goal met or not): past it (and kGoalEndSlack) the traffic constrains nothing, and
-  // the collision check's steps see no car there (a merge into a goal in a gap that closes
-  // after the end). No goals (the Udacity track): no end.
-  double t_end = ws.num_goals > 0 ? -cost::GoalRegion::kInf : cost::GoalRegion::kInf;
-  for (int g = 0; g < ws.num_goals; ++g) t_end = std::max(t_end, ws.goals[g].t_hi);
-  if (!(t_end == t_end)) t_end = cost::GoalRegion::kInf;  // NaN: no end known
   int nc = 0, real = 0;
   for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
     const TrackedCar& car = cars[i];
@@ -176,9 +165,8 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     }
     const int row = nc * (n_steps + 1);
     for (int j = 1; j <= n_steps; ++j) {
-      const double t = j * ws.collision_step * kTickSeconds;
-      Predictor::Prediction p = predictor.Predict(i, ws.t_keep + t);
-      if (t > t_end + kGoalEndSlack) p = {kGone, 0.0, 0.0, 0.0};
+      const Predictor::Prediction p =
+          predictor.Predict(i, ws.t_keep + j * ws.collision_step * kTickSeconds);
       ws.step_s[row + j] = start.s + p.s;
       ws.step_d[row + j] = p.d;
       ws.step_v[row + j] = p.v;

@@ -227,37 +227,5 @@ TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 1.0, 1.0), none);
 }
 
-TEST(SearchChecksTest, TrafficPastTheLastGoalWindowConstrainsNothing) {
-  REQUIRE_UDACITY_MAP();
-  Stages st;
-  auto steady = [](double s0, double v, double d) {
-    return [=](int tick) { return traj::FrenetState{s0 + v * tick * kTickSeconds, v, 0, d, 0, 0}; };
-  };
-  const int none = st.ws.n_steps + 1;
-  const double step_s = st.ws.collision_step * kTickSeconds;
-  // A car 40 m ahead at half the ego's speed: bare boxes meet after ~3.5 s.
-  const std::vector<testing::SceneCar> slow = {{kS + 40, 6.0, 10}};
-  st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
-  const int hit = st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0);
-  ASSERT_LT(hit, none);
-  ASSERT_GT(hit * step_s, 3.0);
-  // A goal window that closes at 1 s: the problem is over long before then.
-  st.ws.num_goals = 1;
-  st.ws.goals[0] = cost::GoalRegion{};
-  st.ws.goals[0].t_hi = 1.0;
-  st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
-  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), none);
-  // The latest window counts: one open past the hit keeps the car.
-  st.ws.num_goals = 2;
-  st.ws.goals[1] = cost::GoalRegion{};
-  st.ws.goals[1].t_hi = hit * step_s;
-  st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
-  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), hit);
-  // A window without an end: neither.
-  st.ws.goals[1].t_hi = cost::GoalRegion::kInf;
-  st.Prepare({kS, 20, 0, 6.0, 0, 0}, slow);
-  EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0), hit);
-}
-
 }  // namespace
 }  // namespace frenetic::plan::search
