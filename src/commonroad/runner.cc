@@ -242,7 +242,7 @@ double Curvature(double x1, double y1, double x2, double y2, double x3, double y
 }  // namespace
 
 KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
-               double dt, const VehicleParams& vp) {
+                   double dt, const VehicleParams& vp) {
   constexpr double kHeadingGain = 0.5;  // of the heading error
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
   constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
@@ -300,7 +300,6 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
   const KsInput u = clip({(delta_cmd - ego.steering_angle) / dt, (v_cmd - ego.velocity) / dt});
   return SimulateKs(ego, u, dt, vp);
 }
-
 
 const char* ToString(PredictionMode mode) {
   return mode == PredictionMode::kRecorded ? "recorded" : "constant-velocity";

@@ -45,10 +45,9 @@ void Lattice::AddLon(const LonTraj& l) {
 void Lattice::AddLat(const LatTraj& l) {
   if (!l.traj.poly.IsFinite()) return;
   const int i = static_cast<int>(ws_.lat.size());
-  const int n = ws_.n_samples;
-  if ((i + 1) * n > static_cast<int>(ws_.lat_d.size())) return;  // the workspace is full
   ws_.lat.push_back(l);
   ws_.lat.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+  const int n = ws_.n_samples;
   const double dt = cfg_.score_dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
                 &ws_.lat_ddd[i * n]);
