@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace frenetic::plan::search {
 namespace {
@@ -22,6 +23,8 @@ Refiner::Refiner(const Settings& cfg, const std::string& algorithm, Workspace& w
       checker_(checker),
       clock_(clock),
       opt_(nlopt_create(AlgorithmFromName(algorithm), 4)) {
+  // NLopt evaluates at most refine.max_iterations points; one more for the start.
+  evals_seen_.reserve(std::max(cfg_.refine_iterations, 0) + 2);
   if (opt_ != nullptr) {
     nlopt_set_min_objective(opt_, &Refiner::Objective, this);
     constraints_ok_ =
@@ -46,11 +49,31 @@ traj::FrenetTrajectory Refiner::FromParams(const double* x) const {
   return {l.traj, d.traj};
 }
 
+Refiner::Eval* Refiner::Find(const double* x) {
+  for (Eval& e : evals_seen_) {
+    if (std::memcmp(e.x, x, sizeof(e.x)) == 0) return &e;
+  }
+  return nullptr;
+}
+
+Refiner::Eval& Refiner::Entry(const double* x) {
+  if (Eval* e = Find(x)) return *e;
+  // Past the reserved capacity (an algorithm that overruns maxeval), the oldest is reused
+  // rather than allocating.
+  if (evals_seen_.size() == evals_seen_.capacity()) evals_seen_.erase(evals_seen_.begin());
+  Eval& e = evals_seen_.emplace_back();
+  std::memcpy(e.x, x, sizeof(e.x));
+  e.has_f = e.has_g = false;
+  return e;
+}
+
 double Refiner::Objective(unsigned n, const double* x, double* grad, void* data) {
   (void)n;
   (void)grad;  // derivative-free
   auto* self = static_cast<Refiner*>(data);
   ++self->evals_;
+  Eval& seen = self->Entry(x);
+  if (seen.has_f) return seen.f;
   const traj::FrenetTrajectory tr = self->FromParams(x);
   const Workspace& ws = self->ws_;
   double v = self->scorer_.CostOf(tr, ws.lon[ws.winner_lon], ws.lat[ws.winner_lat]);
@@ -59,6 +82,8 @@ double Refiner::Objective(unsigned n, const double* x, double* grad, void* data)
     self->checker_.FillTicks(tr);
     v += 1e3 * std::max(0.0, self->checker_.Violation(nullptr));
   }
+  seen.f = v;
+  seen.has_f = true;
   return v;
 }
 
@@ -66,8 +91,12 @@ double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data
   (void)n;
   (void)grad;
   auto* self = static_cast<Refiner*>(data);
+  Eval& seen = self->Entry(x);
+  if (seen.has_g) return seen.g;
   self->checker_.FillTicks(self->FromParams(x));
-  return self->checker_.Violation(nullptr);
+  seen.g = self->checker_.Violation(nullptr);
+  seen.has_g = true;
+  return seen.g;
 }
 
 void Refiner::Refine(PlanSummary& sum) {
@@ -117,6 +146,19 @@ void Refiner::Refine(PlanSummary& sum) {
   // 0 switches NLopt's clock off: pinned deadlines leave refine.max_iterations as the bound.
   nlopt_set_maxtime(opt_, std::isfinite(maxtime_ms) ? std::max(1e-3, maxtime_ms) * 1e-3 : 0.0);
   evals_ = 0;
+  evals_seen_.clear();
+  // The start is mostly the winner itself (its parameters within the bounds): its cost is
+  // `before` and its limits were measured by the check (CandidateViolation measures the same
+  // ticks as FillTicks and Violation).
+  if (constraints_ok_) {
+    const traj::FrenetTrajectory start = FromParams(x);
+    if (std::memcmp(&start, &ws_.winner, sizeof(start)) == 0) {
+      Eval& e = Entry(x);
+      e.f = before;
+      e.g = checker_.CandidateViolation(ws_.winner_index, nullptr);
+      e.has_f = e.has_g = true;
+    }
+  }
   double best = 0;
   const nlopt_result r = nlopt_optimize(opt_, x, &best);
   sum.refine_iterations = evals_;
@@ -124,9 +166,14 @@ void Refiner::Refine(PlanSummary& sum) {
   // Safety re-check of the refined trajectory; keep the unrefined winner if it fails.
   const traj::FrenetTrajectory refined = FromParams(x);
   checker_.FillTicks(refined);
-  if (checker_.Violation(nullptr) > 0 || checker_.Collides()) return;
+  const Eval* seen = Find(x);  // the result is a point NLopt evaluated
+  const double violation =
+      seen != nullptr && seen->has_g ? seen->g : checker_.Violation(nullptr);
+  if (violation > 0 || checker_.Collides()) return;
   ws_.winner = refined;
-  sum.refine_cost_after = scorer_.CostOf(refined, lb, db);
+  sum.refine_cost_after = seen != nullptr && seen->has_f && constraints_ok_
+                              ? seen->f
+                              : scorer_.CostOf(refined, lb, db);
 }
 
 }  // namespace frenetic::plan::search

@@ -8,6 +8,7 @@
 #include <nlopt.h>
 
 #include <string>
+#include <vector>
 
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/frenet.h"
@@ -45,6 +46,18 @@ class Refiner {
   static double Objective(unsigned n, const double* x, double* grad, void* data);
   static double Constraint(unsigned n, const double* x, double* grad, void* data);
 
+  // The objective and constraint values at the parameters evaluated in this refinement (the
+  // start, when it is the winner itself, and every point NLopt asked for), so that a point asked
+  // for again, the start and the result's re-check reuse them: the same values, the trajectory
+  // being a function of x and the cost and the limits of the trajectory.
+  struct Eval {
+    double x[4];
+    double f, g;
+    bool has_f, has_g;
+  };
+  Eval* Find(const double* x);
+  Eval& Entry(const double* x);
+
   const Settings& cfg_;
   Workspace& ws_;
   const Lattice& lattice_;
@@ -54,6 +67,7 @@ class Refiner {
   nlopt_opt opt_ = nullptr;
   bool constraints_ok_ = false;
   int evals_ = 0;
+  std::vector<Eval> evals_seen_;  // capacity fixed at construction
 };
 
 }  // namespace frenetic::plan::search
