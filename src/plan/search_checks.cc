@@ -1,6 +1,8 @@
 #include "plan/search_checks.h"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -75,6 +77,11 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lat_reach_.assign(w, ws_.reach_d);
   lon_near_key_.assign(n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
+  lat_tight_.assign(n_lat * w, 0);
+  lat_tight_stamp_.assign(n_lat, 0);
+  lon_tight_stamp_.assign(n_lon, 0);
+  lon_tight_ok_.assign(n_lon, 0);
+  car_extent_d_.assign(ws_.step_d.size(), 0.0);
   verdicts_.resize(ws_.order.capacity());
   last_hit_.assign(2 * n_lon, LastHit{});
   lat_last_hit_.assign(n_lat, LastHit{});
@@ -128,6 +135,7 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
     ReachMasks(&lon_s_[i * w], reach_.data(), ws_.step_s.data(), w, ws_.n_steps, num_cars,
                ws_.car_reach_s.data(), &lon_near_[i * w]);
     lk = {ws_.traffic_stamp, margin_scale, behind_scale};
+    lon_tight_stamp_[i] = 0;
   }
   const bool new_lat = SampleSteps(ws_.lat[k].traj, k, lat_key_, lat_have_, lat_d_, lat_dd_);
   if (new_lat || lat_near_stamp_[k] != ws_.traffic_stamp) {
@@ -135,6 +143,7 @@ StepStates Checker::StepsOf(int c, double margin_scale, double behind_scale) {
     ReachMasks(&lat_d_[k * w], lat_reach_.data(), ws_.step_d.data(), w, ws_.n_steps, num_cars,
                ws_.car_reach_d.data(), &lat_near_[k * w]);
     lat_near_stamp_[k] = ws_.traffic_stamp;
+    lat_tight_stamp_[k] = 0;
   }
   return {lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
           lat_dd_.data() + k * w, ws_.collision_step, lon_near_.data() + i * w,
@@ -152,6 +161,70 @@ Checker::Rows Checker::StepRows(int c) {
     lat_near_stamp_[k] = 0;
   }
   return {lon_s_.data() + i * w, lat_d_.data() + k * w};
+}
+
+const std::uint64_t* Checker::TightLatNear(int i, int k) {
+  const int w = ws_.n_steps + 1, n_steps = ws_.n_steps;
+  const std::uint64_t stamp = ws_.traffic_stamp;
+  const int num_cars = std::min(ws_.num_check_cars, 64);
+  if (tight_stamp_ != stamp) {
+    // A cap on the margins that holds for every lon slot of ordinary speeds (the margin grows
+    // with the ego's s' ahead and shrinks with it behind: the ends of the range bound it).
+    const double top = std::max(cfg_.max_speed, ws_.start.s_d) + 5.0;
+    tight_margin_ = std::max(Widest(0.0, 1.0, 1.0), Widest(top, 1.0, 1.0));
+    // The car's extent along d in HitsAt (its box's half length times |heading's d| plus its
+    // half width times heading's s), with the margin at most tight_margin_.
+    for (int car = 0; car < num_cars; ++car) {
+      for (int j = 1; j <= n_steps; ++j) {
+        const int at = car * w + j;
+        car_extent_d_[at] = (ws_.car_hl[car] + tight_margin_) * std::abs(ws_.step_dir_d[at]) +
+                            (ws_.car_hw[car] + cfg_.margin_d) * ws_.step_dir_s[at];
+      }
+    }
+    tight_stamp_ = stamp;
+  }
+  if (!std::isfinite(tight_margin_)) return &lat_near_[k * w];
+  if (lon_tight_stamp_[i] != stamp) {
+    bool ok = true;
+    for (int j = 1; j <= n_steps && ok; ++j) {
+      const double s_d = lon_sd_[i * w + j];
+      ok = std::isfinite(s_d) && Widest(s_d, 1.0, 1.0) <= tight_margin_;
+    }
+    lon_tight_ok_[i] = ok;
+    lon_tight_stamp_[i] = stamp;
+  }
+  if (!lon_tight_ok_[i]) return &lat_near_[k * w];
+  if (lat_tight_stamp_[k] != stamp) {
+    // The ego's extent along d: half length times |heading's d| plus half width times heading's
+    // s, for a unit heading (s', d') with s' >= 0.5 (EgoAt): |heading's d| is at most
+    // |d'| / sqrt(0.25 + d'^2) =: u, and the extent at most hl u + hw sqrt(1 - u^2) while u
+    // is below hl / r, r (the half diagonal) past it. 1e-9 m covers the rounding of both sides;
+    // a d' that is not finite keeps every car.
+    const double hl = 0.5 * cfg_.ego_length, hw = 0.5 * cfg_.ego_width;
+    const double r = std::hypot(hl, hw);
+    for (int j = 1; j <= n_steps; ++j) {
+      const double vd = lat_dd_[k * w + j];
+      double ego = std::numeric_limits<double>::infinity();
+      if (std::isfinite(vd)) {
+        const double u = std::abs(vd) < 1e6 ? std::abs(vd) / std::sqrt(0.25 + vd * vd) : 1.0;
+        ego = u >= hl / r ? r : hl * u + hw * std::sqrt(std::max(0.0, 1.0 - u * u));
+      }
+      const double reach = ego + 1e-3 + 1e-9;
+      const double d = lat_d_[k * w + j];
+      std::uint64_t m = lat_near_[k * w + j];
+      for (std::uint64_t b = m; b != 0; b &= b - 1) {
+        const int car = std::countr_zero(b);
+        const int at = car * w + j;
+        // HitsAt's d-axis separation for every margin up to tight_margin_ (NaN keeps the car).
+        if (std::abs(ws_.step_d[at] - d) - car_extent_d_[at] > reach) {
+          m &= ~(std::uint64_t{1} << car);
+        }
+      }
+      lat_tight_[k * w + j] = m;
+    }
+    lat_tight_stamp_[k] = stamp;
+  }
+  return &lat_tight_[k * w];
 }
 
 bool Checker::CandidateCollides(int c) {
@@ -173,7 +246,11 @@ bool Checker::CandidateCollides(int c) {
   }
   // Every step then, from the first hint's on (a collision mostly lasts a few steps: one near
   // a neighbour's is found sooner); any hit answers.
-  const StepStates steps = StepsOf(c);
+  StepsOf(c);  // the rows and the reach masks
+  // With the narrower lateral test: the cars it leaves out fail HitsAt anyway.
+  const StepStates steps(lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
+                         lat_dd_.data() + k * w, ws_.collision_step, lon_near_.data() + i * w,
+                         TightLatNear(i, k));
   const int n_steps = ws_.n_steps;
   const std::uint64_t cars = CarMask(true);
   const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;

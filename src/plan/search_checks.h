@@ -151,6 +151,8 @@ class Checker {
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
   // away can collide (+inf when the margins cannot be bounded).
   double ReachS(double s_d, double margin_scale, double behind_scale) const;
+  // The largest margin FirstCollision can give a car at such a step (ReachS less the base).
+  double Widest(double s_d, double margin_scale, double behind_scale) const;
 
  private:
   // FirstCollision at one step: the ego there, and whether car c collides with it.
@@ -229,6 +231,22 @@ class Checker {
   std::vector<double> lat_reach_;  // StepsOf: the lat reach (ws.reach_d) at each step
   std::vector<LonNearKey> lon_near_key_;
   std::vector<std::uint64_t> lat_near_stamp_;
+  // CandidateCollides' narrower lateral test (the unscaled margins only): per lat slot and
+  // step, the cars of lat_near_ whose boxes can reach the ego's along d (HitsAt's d-axis
+  // separation with the ego heading bounded by its d' alone and the car's length bounded by
+  // its length plus tight_margin_), and the traffic it was computed for (0: to compute). It
+  // applies with a lon slot whose steps all give margins of at most tight_margin_
+  // (lon_tight_ok_, computed with its lon_near_).
+  std::vector<std::uint64_t> lat_tight_, lat_tight_stamp_, lon_tight_stamp_;
+  std::vector<char> lon_tight_ok_;
+  // Per car and step ([c * (n_steps + 1) + j]), the car's extent along d that the test bounds,
+  // for traffic tight_stamp_; tight_margin_ is set with it.
+  std::vector<double> car_extent_d_;
+  std::uint64_t tight_stamp_ = 0;
+  double tight_margin_ = 0;
+  // The lateral reach masks CandidateCollides uses for lon slot i and lat slot k: lat_tight_'s
+  // row, or lat_near_'s when the narrower test does not apply.
+  const std::uint64_t* TightLatNear(int i, int k);
   int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
   // CandidateViolation's verdicts per candidate index, with what they were measured for: the
   // trajectory, the XY prefix (prefix_stamp_, counted by SetXyPrefix) and the start's
@@ -259,15 +277,18 @@ class Checker {
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=
 // step_v_max; rounded products and sums are monotone), so a car farther along s than
 // ws.reach_s_base + widest fails its reach test anyway. Only with non-negative factors.
-inline double Checker::ReachS(double s_d, double margin_scale, double behind_scale) const {
+inline double Checker::Widest(double s_d, double margin_scale, double behind_scale) const {
   const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
                        cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
   if (!bounded) return std::numeric_limits<double>::infinity();
-  const double widest = std::max(
+  return std::max(
       {margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * std::max(s_d, 0.0)),
        behind_scale * (cfg_.margin_behind + cfg_.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
        margin_scale * cfg_.margin_s});
-  return ws_.reach_s_base + widest;
+}
+
+inline double Checker::ReachS(double s_d, double margin_scale, double behind_scale) const {
+  return ws_.reach_s_base + Widest(s_d, margin_scale, behind_scale);
 }
 
 // FirstCollision's ego at one step.
