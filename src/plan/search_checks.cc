@@ -280,6 +280,12 @@ void Checker::FillTicks(const traj::FrenetTrajectory& tr, double t0) {
   }
 }
 
+void Checker::FillTicksForLimits(const traj::FrenetTrajectory& tr) {
+  const auto time = [](int t) { return 0.0 + t * kTickSeconds; };  // FillTicks' time
+  tr.lon.Sample(1, ws_.n_ticks + 1, time, ws_.tk_s.data(), ws_.tk_sd.data(), nullptr);
+  tr.lat.Sample(1, ws_.n_ticks + 1, time, ws_.tk_d.data(), ws_.tk_dd.data(), nullptr);
+}
+
 void Checker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n,
                           const double* kept_x, const double* kept_y, int kept) {
   int n = 0;

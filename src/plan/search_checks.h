@@ -78,6 +78,9 @@ class Checker {
   // Samples a trajectory at every tick of the check horizon, t0 + i ticks (s), into ws.tk_*
   // [1, n_ticks].
   void FillTicks(const traj::FrenetTrajectory& tr, double t0 = 0);
+  // FillTicks' s, s' and d (and d'), what Violation reads, with the same values; the other
+  // rows are left as they were.
+  void FillTicksForLimits(const traj::FrenetTrajectory& tr);
   // The XY path's part common to every candidate of the cycle, the driven history then the
   // kept points (oldest first), measured once.
   void SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n, const double* kept_x,

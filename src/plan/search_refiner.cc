@@ -93,7 +93,7 @@ double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data
   auto* self = static_cast<Refiner*>(data);
   Eval& seen = self->Entry(x);
   if (seen.has_g) return seen.g;
-  self->checker_.FillTicks(self->FromParams(x));
+  self->checker_.FillTicksForLimits(self->FromParams(x));
   seen.g = self->checker_.Violation(nullptr);
   seen.has_g = true;
   return seen.g;
