@@ -72,8 +72,12 @@ void MengerCurvatures(const double* x, const double* y, int first, int n, double
 }
 
 XyChecker::XyChecker(int capacity, const VehicleLimits& vehicle) : vehicle_(vehicle) {
-  for (auto* v : {&v_, &kappa_, &vsum_, &ksum_, &acc_, &asum_}) v->assign(capacity + 1, 0.0);
-  if (vehicle_.any()) ksigned_sum_.assign(capacity + 1, 0.0);
+  for (auto* v : {&v_, &kappa_, &vsum_, &ksum_, &acc_, &asum_, &vmean_block_}) {
+    v->assign(capacity + 1, 0.0);
+  }
+  if (vehicle_.any()) {
+    for (auto* v : {&ksigned_sum_, &vmean_, &kmean_}) v->assign(capacity + 1, 0.0);
+  }
 }
 
 XyMeasure XyChecker::Measure(const double* x, const double* y, int n, int first) {
@@ -85,15 +89,21 @@ void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
   const VehicleLimits& lim = vehicle_;
   constexpr int b = kVehicleBlock;
   constexpr double bt = b * kDt;
-  // Block means over ticks j-4..j: speed, and the signed curvature of the triples centred there.
-  auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - b]) / b; };
-  auto kmean = [&](int j) { return (ksigned_sum_[j + 1] - ksigned_sum_[j + 1 - b]) / b; };
+  // Block means over ticks j-4..j: speed, and the signed curvature of the triples centred there;
+  // each block's once (the loop reads the block before too).
+  const int j0 = std::max(b, first);
+  for (int j = std::max(b, j0 - b); j <= n - 2; ++j) {
+    vmean_[j] = (vsum_[j + 1] - vsum_[j + 1 - b]) / b;
+    kmean_[j] = (ksigned_sum_[j + 1] - ksigned_sum_[j + 1 - b]) / b;
+  }
+  auto vmean = [&](int j) { return vmean_[j]; };
+  auto kmean = [&](int j) { return kmean_[j]; };
   // The steering angle is atan(wheelbase kappa): its worst size and change are taken on
   // tangents (atan is monotone; atan x - atan y = atan((x - y) / (1 + x y)) for x y > -1), and
   // one atan each at the end.
   double max_tan = 0, max_change = 0;
   // The last point's curvature is not known (0): blocks end at n - 2.
-  for (int j = std::max(b, first); j <= n - 2; ++j) {
+  for (int j = j0; j <= n - 2; ++j) {
     // At a crawl a path's curvature says nothing about the steering (a car turns its wheels at
     // a standstill, and points millimetres apart bend any way): steering is measured from
     // kSteerSpeed on.
@@ -160,12 +170,16 @@ int XyChecker::Compute(const double* x, const double* y, int n, int from) {
       ksigned_sum_[i + 1] = ksigned_sum_[i] + k;
     }
   }
-  auto vmean = [&](int j) { return (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock; };
+  // Block means of speed, each block's once (a block's acceleration reads the block before):
+  // those ending before tick from - 1 are the same path's (its sums up to there are unchanged).
+  for (int j = std::max(kBlock - 1, from - 1); j < n; ++j) {
+    vmean_block_[j] = (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock;
+  }
   // Block ending at tick j holds ticks j-9..j; its triples are centred at j-8..j-1.
   auto kmean = [&](int j) { return (ksum_[j] - ksum_[j - 8]) / 8.0; };
   // acc_[j] valid for j >= 2 * kBlock (needs the previous block, which starts at tick >= 1).
   for (int j = std::max(2 * kBlock, from); j < n; ++j) {
-    const double vm = vmean(j), vp = vmean(j - kBlock);
+    const double vm = vmean_block_[j], vp = vmean_block_[j - kBlock];
     const double at = (vm - vp) / (kBlock * kDt), an = vm * vm * kmean(j);
     acc_[j] = Norm(at, an);
   }

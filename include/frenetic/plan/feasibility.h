@@ -67,7 +67,10 @@ class XyChecker {
   int prefix_ = 0;
   VehicleLimits vehicle_;
   std::vector<double> v_, kappa_, vsum_, ksum_, acc_, asum_;
+  std::vector<double> vmean_block_;  // Compute's 0.2 s block means of speed, by last tick
   std::vector<double> ksigned_sum_;  // prefix sums of the signed curvature (VehicleLimits)
+  // WorstVehicle's block means of speed and signed curvature (scratch).
+  mutable std::vector<double> vmean_, kmean_;
 };
 
 // The simulator's own measure for tests: fixed blocks starting at tick `phase`, with
