@@ -1,7 +1,6 @@
 #include "plan/search_checks.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -51,6 +50,38 @@ void ReachMasks(const double* x, const double* reach, const double* cars, int w,
   }
 }
 
+// m[j] for j in [1, n] loses bit c when |cars[c * w + j] - x[j]| - extra[c * w + j] > reach[j]
+// (NaN keeps it), for cars c < num_cars <= 64: a per-step reach and a per-car-and-step extra.
+// Two steps at a time, car by car, the bits to clear in SSE2 registers.
+void NarrowMasks(const double* x, const double* reach, const double* cars, const double* extra,
+                 int w, int n, int num_cars, std::uint64_t* m) {
+  int j = 1;
+#if defined(__SSE2__)
+  const __m128d sign = _mm_set1_pd(-0.0);
+  for (; j + 1 <= n; j += 2) {
+    const __m128d xa = _mm_loadu_pd(x + j), ra = _mm_loadu_pd(reach + j);
+    __m128i drop = _mm_setzero_si128();
+    for (int car = 0; car < num_cars; ++car) {
+      const __m128i bit = _mm_set1_epi64x(static_cast<long long>(std::uint64_t{1} << car));
+      const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(car) * w + j;
+      const __m128d da = _mm_sub_pd(_mm_andnot_pd(sign, _mm_sub_pd(_mm_loadu_pd(cars + at), xa)),
+                                    _mm_loadu_pd(extra + at));
+      drop = _mm_or_si128(drop, _mm_and_si128(_mm_castpd_si128(_mm_cmpgt_pd(da, ra)), bit));
+    }
+    __m128i* mj = reinterpret_cast<__m128i*>(m + j);
+    _mm_storeu_si128(mj, _mm_andnot_si128(drop, _mm_loadu_si128(mj)));
+  }
+#endif
+  for (; j <= n; ++j) {
+    std::uint64_t drop = 0;
+    for (int car = 0; car < num_cars; ++car) {
+      const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(car) * w + j;
+      if (std::abs(cars[at] - x[j]) - extra[at] > reach[j]) drop |= std::uint64_t{1} << car;
+    }
+    m[j] &= ~drop;
+  }
+}
+
 }  // namespace
 
 Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
@@ -82,6 +113,7 @@ Checker::Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace&
   lon_tight_stamp_.assign(n_lon, 0);
   lon_tight_ok_.assign(n_lon, 0);
   car_extent_d_.assign(ws_.step_d.size(), 0.0);
+  tight_reach_.assign(w, 0.0);
   verdicts_.resize(ws_.order.capacity());
   last_hit_.assign(2 * n_lon, LastHit{});
   lat_last_hit_.assign(n_lat, LastHit{});
@@ -209,19 +241,12 @@ const std::uint64_t* Checker::TightLatNear(int i, int k) {
         const double u = std::abs(vd) < 1e6 ? std::abs(vd) / std::sqrt(0.25 + vd * vd) : 1.0;
         ego = u >= hl / r ? r : hl * u + hw * std::sqrt(std::max(0.0, 1.0 - u * u));
       }
-      const double reach = ego + 1e-3 + 1e-9;
-      const double d = lat_d_[k * w + j];
-      std::uint64_t m = lat_near_[k * w + j];
-      for (std::uint64_t b = m; b != 0; b &= b - 1) {
-        const int car = std::countr_zero(b);
-        const int at = car * w + j;
-        // HitsAt's d-axis separation for every margin up to tight_margin_ (NaN keeps the car).
-        if (std::abs(ws_.step_d[at] - d) - car_extent_d_[at] > reach) {
-          m &= ~(std::uint64_t{1} << car);
-        }
-      }
-      lat_tight_[k * w + j] = m;
+      tight_reach_[j] = ego + 1e-3 + 1e-9;
+      lat_tight_[k * w + j] = lat_near_[k * w + j];
     }
+    // HitsAt's d-axis separation for every margin up to tight_margin_ (NaN keeps the car).
+    NarrowMasks(&lat_d_[k * w], tight_reach_.data(), ws_.step_d.data(), car_extent_d_.data(), w,
+                n_steps, num_cars, &lat_tight_[k * w]);
     lat_tight_stamp_[k] = stamp;
   }
   return &lat_tight_[k * w];

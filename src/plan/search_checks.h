@@ -245,6 +245,7 @@ class Checker {
   // Per car and step ([c * (n_steps + 1) + j]), the car's extent along d that the test bounds,
   // for traffic tight_stamp_; tight_margin_ is set with it.
   std::vector<double> car_extent_d_;
+  std::vector<double> tight_reach_;  // per step, the ego's bound (scratch)
   std::uint64_t tight_stamp_ = 0;
   double tight_margin_ = 0;
   // The lateral reach masks CandidateCollides uses for lon slot i and lat slot k: lat_tight_'s
