@@ -230,8 +230,8 @@ const std::uint64_t* Checker::TightLatNear(int i, int k) {
     // The ego's extent along d: half length times |heading's d| plus half width times heading's
     // s, for a unit heading (s', d') with s' >= 0.5 (EgoAt): |heading's d| is at most
     // |d'| / sqrt(0.25 + d'^2) =: u, and the extent at most hl u + hw sqrt(1 - u^2) while u
-    // is below hl / r, r (the half diagonal) past it. 1e-9 m covers the rounding of both sides;
-    // a d' that is not finite keeps every car.
+    // is below hl / r, r (the half diagonal) past it. Plus HitsAt's 1 mm, and 1e-9 m for the
+    // rounding of both sides; a d' that is not finite keeps every car.
     const double hl = 0.5 * cfg_.ego_length, hw = 0.5 * cfg_.ego_width;
     const double r = std::hypot(hl, hw);
     for (int j = 1; j <= n_steps; ++j) {
@@ -271,11 +271,9 @@ bool Checker::CandidateCollides(int c) {
   }
   // Every step then, from the first hint's on (a collision mostly lasts a few steps: one near
   // a neighbour's is found sooner); any hit answers.
-  StepsOf(c);  // the rows and the reach masks
+  const StepStates reach = StepsOf(c);  // the rows and the reach masks
   // With the narrower lateral test: the cars it leaves out fail HitsAt anyway.
-  const StepStates steps(lon_s_.data() + i * w, lon_sd_.data() + i * w, lat_d_.data() + k * w,
-                         lat_dd_.data() + k * w, ws_.collision_step, lon_near_.data() + i * w,
-                         TightLatNear(i, k));
+  const StepStates steps = reach.WithNearLat(TightLatNear(i, k));
   const int n_steps = ws_.n_steps;
   const std::uint64_t cars = CarMask(true);
   const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;

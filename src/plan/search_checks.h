@@ -59,6 +59,12 @@ class StepStates {
     return {s_[j], sd_[j], 0.0, d_[j], dd_[j], 0.0};
   }
   std::uint64_t Near(int j) const { return near_lon_[j] & near_lat_[j]; }
+  // The same states with other lateral reach masks (a narrower test's).
+  StepStates WithNearLat(const std::uint64_t* near_lat) const {
+    StepStates r = *this;
+    r.near_lat_ = near_lat;
+    return r;
+  }
   // s and d at step j ([0, n_steps]; rows contiguous in j).
   const double* s() const { return s_; }
   const double* d() const { return d_; }

@@ -585,7 +585,7 @@ class SearchPlanner : public Planner {
   std::vector<std::pair<double, int>> rest_;   // CheckRest's candidates: a heap by bound
   std::vector<std::pair<double, int>> clear_;  // CheckRest's collision-free ones: a heap by cost
   std::vector<char> popped_;                   // CheckRest: taken from the heap
-  bool none_passed_last_ = false;             // the last search's checks found no candidate passing
+  bool none_passed_last_ = false;              // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
