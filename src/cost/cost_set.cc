@@ -42,6 +42,7 @@ StatusOr<std::shared_ptr<const CostSet>> CostSet::Build(
     term->Configure(values);
     set->names_.push_back(tc.name);
     set->weights_.push_back(tc.weight);
+    if (term->Expensive()) set->expensive_terms_.push_back(static_cast<int>(set->terms_.size()));
     set->expensive_.push_back(term->Expensive());
     set->lane_only_.push_back(term->LaneOnly());
     set->coarse_skip_.push_back(term->Expensive() || term->Sampled());
@@ -117,6 +118,16 @@ double CostSet::EvaluateWithCheap(const CostContext& ctx, const CostInput& in,
   for (int i = 0; i < n; ++i) {
     const double v = expensive_[i] ? terms_[i]->Evaluate(ctx, in) : cheap[i];
     total += weights_[i] * v;
+  }
+  return total;
+}
+
+double CostSet::SumKnown(const double* values, std::uint64_t known) const {
+  double total = 0;
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    const bool unknown = expensive_[i] && (i >= 64 || ((known >> i) & 1) == 0);
+    total += weights_[i] * (unknown ? 0.0 : values[i]);
   }
   return total;
 }

@@ -369,13 +369,14 @@ class SearchPlanner : public Planner {
   // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
   // (a heap: only the ones taken are ordered; a coarse bound that comes up is completed and
   // queued again, so they come up in the order of complete bounds, Scorer::SortUpTo's
-  // argument), and tested for collision; one that does not collide gets its exact cost and
-  // waits in a second heap, by cost. The cheapest waiting one is the cheapest candidate that
-  // does not collide once no bound left ranks before its cost: it is tested for the hard
-  // limits then, and is the answer when it passes (every cheaper one collides or breaks a
-  // limit). So no candidate that collides is costed in full, and only the cheapest clear
-  // ones are converted to XY. After kRestHeapTests the rest are taken in any order, each
-  // skipped when its bound is not below the cost of the cheapest that passed: the same
+  // argument), and tested for collision; one that does not collide waits in a second heap,
+  // by its bound until it comes up there, then by its exact cost (the same laziness: a clear
+  // one that never comes up is never costed in full). The cheapest waiting one is the
+  // cheapest candidate that does not collide once no bound left ranks before its cost: it is
+  // tested for the hard limits then, and is the answer when it passes (every cheaper one
+  // collides or breaks a limit). So no candidate that collides is costed in full, and only
+  // the cheapest clear ones are converted to XY. After kRestHeapTests the rest are taken in any
+  // order, each skipped when its bound is not below the cost of the cheapest that passed: the same
   // cheapest one. Every one tested counts as checked, and as rejected when it collides or
   // breaks a limit (one outranked by a passing one is neither).
   int CheckRest(int r0, bool* cut) {
@@ -417,6 +418,14 @@ class SearchPlanner : public Planner {
         return -1;
       }
       if (!clear_.empty() && (rest_.empty() || clear_.front() < rest_.front())) {
+        // A bound until the key is the exact cost (a candidate the traced ranks' sort costed
+        // may wait by its bound too).
+        if (const int c = clear_.front().second;
+            !scorer_.Resolved(c) || clear_.front().first != ws_.cand_cost[c]) {
+          clear_.front().first = scorer_.Advance(c);
+          search::SiftDownTop(clear_.begin(), clear_.end(), later);
+          continue;
+        }
         std::pop_heap(clear_.begin(), clear_.end(), later);
         const int c = clear_.back().second;
         clear_.pop_back();
@@ -435,7 +444,7 @@ class SearchPlanner : public Planner {
       popped_[c] = 1;
       ++k;
       if (collides(c)) continue;
-      clear_.push_back({scorer_.ExactCost(c), c});
+      clear_.push_back({scorer_.KnownBound(c), c});  // advanced when it comes up
       std::push_heap(clear_.begin(), clear_.end(), later);
     }
     // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
@@ -443,7 +452,8 @@ class SearchPlanner : public Planner {
     // (popping each costs more than the order saves; the candidates of a bundle are neighbours
     // there), each skipped when its bound cannot beat the cheapest that passed.
     int best = -1;
-    std::sort_heap(clear_.begin(), clear_.end(), later);  // descending: the cheapest last
+    for (auto& e : clear_) e.first = scorer_.ExactCost(e.second);
+    std::sort(clear_.begin(), clear_.end(), later);  // descending: the cheapest last
     for (; !clear_.empty() && best < 0; clear_.pop_back()) {
       if (within_limits(clear_.back().second)) best = clear_.back().second;
     }
@@ -584,6 +594,7 @@ class SearchPlanner : public Planner {
   double road_end_ = -std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, int>> rest_;   // CheckRest's candidates: a heap by bound
   std::vector<std::pair<double, int>> clear_;  // CheckRest's collision-free ones: a heap by cost
+                                               // (by a bound until they come up)
   std::vector<char> popped_;                   // CheckRest: taken from the heap
   bool none_passed_last_ = false;              // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;

@@ -26,6 +26,12 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   resolved_.assign(cap, 1);
   complete_.assign(cap, 1);
   cheap_.assign(cap * costs_.size(), 0.0);
+  stage_.assign(cap, 0);
+  exp_order_ = costs_.expensive_terms();
+  exp_sum_.assign(costs_.size(), 0.0);
+  if (!exp_order_.empty() && (exp_order_.back() >= 64 || exp_order_.size() > 255)) {
+    exp_order_.clear();
+  }
 }
 
 cost::CostInput Scorer::InputFor(int i, int j) {
@@ -72,6 +78,18 @@ bool Scorer::Score() {
   }
   std::fill(resolved_.begin(), resolved_.begin() + n, 0);
   std::fill(complete_.begin(), complete_.begin() + n, 0);
+  if (stage_.size() < static_cast<std::size_t>(n)) stage_.resize(n);
+  std::fill(stage_.begin(), stage_.begin() + n, 0);
+  // The expensive term that added most last cycle first (an insertion sort: stable, ties keep
+  // their order, and no allocation, which std::stable_sort may make).
+  for (std::size_t i = 1; i < exp_order_.size(); ++i) {
+    const int t = exp_order_[i];
+    std::size_t j = i;
+    for (; j > 0 && exp_sum_[exp_order_[j - 1]] < exp_sum_[t]; --j)
+      exp_order_[j] = exp_order_[j - 1];
+    exp_order_[j] = t;
+  }
+  std::fill(exp_sum_.begin(), exp_sum_.end(), 0.0);
   ws_.sorted = 0;
   pending_.clear();
   ready_.clear();
@@ -114,9 +132,41 @@ void Scorer::Resolve(int c) {
   if (resolved_[c]) return;
   resolved_[c] = 1;
   Tighten(c);
-  const double v = costs_.EvaluateWithCheap(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]),
-                                            &cheap_[static_cast<std::size_t>(c) * costs_.size()]);
+  double* values = &cheap_[static_cast<std::size_t>(c) * costs_.size()];
+  const cost::CostInput in = InputFor(ws_.cand_lon[c], ws_.cand_lat[c]);
+  if (exp_order_.empty()) {
+    const double v = costs_.EvaluateWithCheap(ws_.ctx, in, values);
+    ws_.cand_cost[c] = Finite(v) ? v : 1e300;
+    return;
+  }
+  // The expensive terms Advance has not evaluated yet, then EvaluateWithCheap's sum.
+  const int e = static_cast<int>(exp_order_.size());
+  for (; stage_[c] < e; ++stage_[c]) {
+    const int t = exp_order_[stage_[c]];
+    values[t] = costs_.term(t).Evaluate(ws_.ctx, in);
+    exp_sum_[t] += costs_.weight(t) * values[t];
+  }
+  const double v = costs_.SumKnown(values, ~std::uint64_t{0});
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
+}
+
+double Scorer::Advance(int c) {
+  if (resolved_[c]) return ws_.cand_cost[c];
+  Tighten(c);
+  const int e = static_cast<int>(exp_order_.size());
+  if (stage_[c] + 1 >= e) {  // the last one (or none left to stage): exact
+    Resolve(c);
+    return ws_.cand_cost[c];
+  }
+  double* values = &cheap_[static_cast<std::size_t>(c) * costs_.size()];
+  const int t = exp_order_[stage_[c]++];
+  values[t] = costs_.term(t).Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
+  exp_sum_[t] += costs_.weight(t) * values[t];
+  std::uint64_t known = 0;
+  for (int q = 0; q < stage_[c]; ++q) known |= std::uint64_t{1} << exp_order_[q];
+  const double b = costs_.SumKnown(values, known);
+  // Not finite: the exact cost is 1e300 (a term is NaN or infinite); never above it.
+  return Finite(b) ? std::min(b, 1e300) : (Resolve(c), ws_.cand_cost[c]);
 }
 
 void Scorer::Emit(int c) {

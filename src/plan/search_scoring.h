@@ -94,6 +94,17 @@ class Scorer {
   // (BoundComplete), else the coarse one, never above it.
   double KnownBound(int c) const { return bound_[c]; }
   bool BoundComplete(int c) const { return complete_[c] != 0; }
+  // Whether candidate c's ws.cand_cost is exact (ExactCost would evaluate nothing).
+  bool Resolved(int c) const {
+    return c >= static_cast<int>(resolved_.size()) || resolved_[c] != 0;
+  }
+  // Candidate c's cost a step closer to exact: its bound completed (Bound), and one more of the
+  // expensive terms evaluated (those with the largest values in the last cycle first). A lower
+  // bound of its exact cost, never below the last one Advance or Bound gave, and the exact cost
+  // (ExactCost) once every expensive term is in. A caller that ranks candidates by it, advancing
+  // the one that comes first until it is exact, ranks them as by exact cost while evaluating
+  // fewer terms: a term whose candidate falls behind without it is never evaluated.
+  double Advance(int c);
 
   // The cost input of bundle pair (lon i, lat j), reading the bundles' samples and masks.
   cost::CostInput InputFor(int i, int j);
@@ -136,8 +147,16 @@ class Scorer {
   std::vector<char> resolved_;  // per candidate: ws.cand_cost is exact
   std::vector<char> complete_;  // per candidate: bound_ is the cheap terms' (not the coarse one)
   // Per candidate, the cheap terms' values computed for its bound ([c * terms + t]; the
-  // Sampled() ones once it is complete): Resolve() evaluates only the expensive ones.
+  // Sampled() ones once it is complete; the expensive ones as Advance evaluates them):
+  // Resolve() evaluates only the expensive ones still missing.
   std::vector<double> cheap_;
+  // Advance: per candidate, how many of the expensive terms (in exp_order_) are in cheap_; the
+  // order, and the weighted values of each term evaluated this cycle (exp_sum_, by term index),
+  // which order the next cycle's. Off (empty order: Resolve evaluates them all at once) when a
+  // term's index is beyond SumKnown's 64 bits.
+  std::vector<std::uint8_t> stage_;
+  std::vector<int> exp_order_;
+  std::vector<double> exp_sum_;
   cost::CostSet::LaneMemo lane_memo_;  // Score()'s lane-only terms, per target lane
   std::vector<std::uint64_t> ref_near_lat_, ref_near_lon_;
 };

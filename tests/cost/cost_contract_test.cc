@@ -364,6 +364,41 @@ TEST(CostSetTest, CoarseBoundCompletesToTheLowerBound) {
   }
 }
 
+// CostSet::SumKnown over every registered term: with no expensive term known it is LowerBound,
+// with some of them a bound between LowerBound and Evaluate, with all of them Evaluate, each bit
+// for bit where it is equal.
+TEST(CostSetTest, SumKnownClimbsFromTheLowerBoundToTheCost) {
+  std::vector<CostTermConfig> terms;
+  for (const std::string& name : CostRegistry::Global().Names()) {
+    terms.push_back({name, 0.5 + terms.size(), {}});
+  }
+  auto set = CostSet::Build(terms);
+  ASSERT_TRUE(set.ok()) << set.message();
+  const int n = (*set)->size();
+  const std::vector<int>& expensive = (*set)->expensive_terms();
+  ASSERT_GE(expensive.size(), 2u);
+  for (int t = 0; t < n; ++t) {
+    const bool listed = std::find(expensive.begin(), expensive.end(), t) != expensive.end();
+    EXPECT_EQ(listed, (*set)->term(t).Expensive()) << (*set)->name(t);
+  }
+  std::mt19937 rng(91);
+  int between = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Fixture f = RandomFixture(rng);
+    std::vector<double> values(n);
+    const double cost = (*set)->Evaluate(f.ctx, f.in, values.data());
+    const double lower = (*set)->LowerBound(f.ctx, f.in);
+    if (std::isnan(cost)) continue;
+    ASSERT_EQ((*set)->SumKnown(values.data(), 0), lower) << "case " << i;
+    ASSERT_EQ((*set)->SumKnown(values.data(), ~std::uint64_t{0}), cost) << "case " << i;
+    const double one = (*set)->SumKnown(values.data(), std::uint64_t{1} << expensive.back());
+    ASSERT_LE(lower, one) << "case " << i;
+    ASSERT_LE(one, cost) << "case " << i;
+    between += lower < one && one < cost;
+  }
+  EXPECT_GT(between, 0) << "some partial sums lie strictly between";
+}
+
 TEST_P(CostContractTest, NearZeroOnIdealLaneKeeping) {
   auto term = Make();
   Fixture f = IdealLaneKeeping();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "plan/search_stages_testing.h"
@@ -112,6 +113,54 @@ TEST(SearchScoringTest, CoarseBoundsAreCompletedOnlyWhenNeeded) {
     EXPECT_LE(known, bound) << c;
     const double exact = st.costs->Evaluate(ws.ctx, in);
     EXPECT_LE(bound, std::isfinite(exact) ? exact : 1e300) << c;
+  }
+}
+
+// Advance: from the complete bound up to the exact cost, one expensive term at a time, never
+// down, never above the exact cost; in the next cycle the term that added most goes first.
+TEST(SearchScoringTest, AdvanceClimbsTermByTermToTheExactCost) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Scene(st);
+  ASSERT_TRUE(st.scorer.Score());
+  Workspace& ws = st.ws;
+  const int n = static_cast<int>(ws.order.size());
+  const std::vector<int>& expensive = st.costs->expensive_terms();
+  ASSERT_GE(expensive.size(), 2u);
+  std::vector<double> added(st.costs->size(), 0.0);  // weighted, per term, over the cycle
+  int raised = 0;
+  for (int c = 0; c < n; ++c) {
+    const cost::CostInput in = st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]);
+    std::vector<double> values(st.costs->size());
+    const double v = st.costs->Evaluate(ws.ctx, in, values.data());
+    const double exact = std::isfinite(v) ? v : 1e300;
+    for (int t : expensive) added[t] += st.costs->weight(t) * values[t];
+    double last = st.scorer.Bound(c);
+    int steps = 0;
+    while (!st.scorer.Resolved(c)) {
+      const double next = st.scorer.Advance(c);
+      ASSERT_GE(next, last) << c;
+      ASSERT_LE(next, exact) << c;
+      raised += steps == 0 && next > last && next < exact;
+      last = next;
+      ASSERT_LE(++steps, static_cast<int>(expensive.size())) << c;
+    }
+    EXPECT_EQ(last, exact) << c;
+    EXPECT_EQ(ws.cand_cost[c], exact) << c;
+  }
+  EXPECT_GT(raised, 0) << "one term alone lifts some bounds";
+  // The next cycle (the same scene): one Advance evaluates the term that added most.
+  const int first = *std::max_element(expensive.begin(), expensive.end(),
+                                      [&](int a, int b) { return added[a] < added[b]; });
+  ASSERT_TRUE(st.scorer.Score());
+  for (int c = 0; c < n; ++c) {
+    const cost::CostInput in = st.scorer.InputFor(ws.cand_lon[c], ws.cand_lat[c]);
+    std::vector<double> values(st.costs->size());
+    st.costs->Evaluate(ws.ctx, in, values.data());
+    const double want = st.costs->SumKnown(values.data(), std::uint64_t{1} << first);
+    if (!std::isfinite(want)) continue;
+    st.scorer.Bound(c);
+    ASSERT_EQ(st.scorer.Advance(c), std::min(want, 1e300)) << c;
   }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -72,6 +73,13 @@ class CostSet {
   // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
   // Expensive() terms are evaluated; the same sum, term for term. Does not allocate.
   double EvaluateWithCheap(const CostContext& ctx, const CostInput& in, const double* cheap) const;
+  // The Expensive() terms' indices, in config order.
+  const std::vector<int>& expensive_terms() const { return expensive_terms_; }
+  // Evaluate's sum from each term's unweighted value in values[i], with every Expensive() term
+  // whose bit i in `known` is clear (and every one from index 64 on) taken as 0: never more than
+  // Evaluate of the input the values came from (as LowerBound), and equal to it, bit for bit,
+  // when every Expensive() term is known (the same products, added in the same order).
+  double SumKnown(const double* values, std::uint64_t known) const;
 
  private:
   CostSet() = default;
@@ -82,6 +90,7 @@ class CostSet {
   double BoundSkipping(const std::vector<char>& skip, const CostContext& ctx, const CostInput& in,
                        double* cheap, LaneMemo* memo) const;
   std::vector<char> expensive_, lane_only_;  // each term's Expensive() and LaneOnly()
+  std::vector<int> expensive_terms_;         // the indices of the Expensive() ones
   std::vector<char> coarse_skip_;  // Expensive() or Sampled(): what CoarseLowerBound leaves out
 };
 
