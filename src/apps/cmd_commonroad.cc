@@ -62,6 +62,7 @@ struct FileResult {
   std::string solution_file;
   Status solution_status;
   Status record_status;  // the records' (--record)
+  cr::Vec2 origin;       // the scenario's local frame (Scenario::origin)
 };
 
 double Percentile(std::vector<double> v, double q) {
@@ -98,6 +99,7 @@ FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
     r.read = scenario.status();
     return r;
   }
+  r.origin = scenario->origin;
   if (record_dir.empty()) {
     r.run = cr::RunScenario(*scenario, config, options);
   } else {
@@ -132,6 +134,10 @@ FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
       t.vehicle_type = options.vehicle_type;
       t.cost_function = "WX1";
       t.states = p.trajectory;
+      for (cr::KsState& st : t.states) {  // in the file's frame
+        st.x += scenario->origin.x;
+        st.y += scenario->origin.y;
+      }
       solution.trajectories.push_back(std::move(t));
     }
   }
@@ -299,6 +305,8 @@ int Run(const Args& a) {
         fj["error"] = f.read.message();
       } else {
         fj["benchmark_id"] = f.run.benchmark_id;
+        // Read into a local frame (Scenario::origin): positions in failures are relative to it.
+        if (!(f.origin == cr::Vec2{})) fj["frame_origin"] = {f.origin.x, f.origin.y};
         json probs = json::array();
         for (size_t i = 0; i < f.run.problems.size(); ++i) probs.push_back(ProblemJson(f, i));
         fj["problems"] = probs;

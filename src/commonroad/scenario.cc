@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -444,6 +445,57 @@ Status Reader::Resolve(Scenario* out) {
   return Status::Ok();
 }
 
+// Scenario::origin: the lanelets' bounding box (the obstacles' and problems' positions when
+// there are no lanelets), and every position moved by minus its centre, rounded to the
+// kilometre, when the box reaches beyond kLocalFrameBeyond. Shapes of obstacles are in their own
+// frames and stay; goal shapes are in the scenario's and move.
+void ToLocalFrame(Scenario* sc) {
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x;
+  double hi_x = -lo_x, hi_y = -lo_x;
+  auto add = [&](Vec2 p) {
+    lo_x = std::min(lo_x, p.x);
+    hi_x = std::max(hi_x, p.x);
+    lo_y = std::min(lo_y, p.y);
+    hi_y = std::max(hi_y, p.y);
+  };
+  for (const Lanelet& l : sc->lanelets) {
+    for (Vec2 p : l.left) add(p);
+    for (Vec2 p : l.right) add(p);
+  }
+  if (sc->lanelets.empty()) {
+    for (const Obstacle& o : sc->obstacles) add(o.initial.position);
+    for (const PlanningProblem& p : sc->problems) add(p.initial.position);
+  }
+  if (!(hi_x >= lo_x && hi_y >= lo_y)) return;  // nothing placed
+  const double reach =
+      std::max({std::abs(lo_x), std::abs(hi_x), std::abs(lo_y), std::abs(hi_y)});
+  if (!(reach > kLocalFrameBeyond)) return;
+  const Vec2 o{1000.0 * std::round(0.5 * (lo_x + hi_x) / 1000.0),
+               1000.0 * std::round(0.5 * (lo_y + hi_y) / 1000.0)};
+  auto move = [&o](Vec2& p) { p = p - o; };
+  for (Lanelet& l : sc->lanelets) {
+    for (Vec2& p : l.left) move(p);
+    for (Vec2& p : l.right) move(p);
+  }
+  for (TrafficSign& t : sc->signs) {
+    if (t.position) move(*t.position);
+  }
+  for (Obstacle& ob : sc->obstacles) {
+    move(ob.initial.position);
+    for (State& st : ob.trajectory) move(st.position);
+  }
+  for (PlanningProblem& p : sc->problems) {
+    move(p.initial.position);
+    for (GoalState& g : p.goals) {
+      for (Shape& shape : g.shapes) {
+        move(shape.center);
+        for (Vec2& v : shape.points) move(v);
+      }
+    }
+  }
+  sc->origin = o;
+}
+
 }  // namespace
 
 StatusOr<Scenario> ParseScenario(std::string_view xml, std::string_view source) {
@@ -454,6 +506,7 @@ StatusOr<Scenario> ParseScenario(std::string_view xml, std::string_view source) 
   scenario.source = std::string(source);
   Reader reader(src);
   FRENETIC_CR_TRY(reader.Read(doc, &scenario));
+  ToLocalFrame(&scenario);
   return scenario;
 }
 

@@ -194,6 +194,42 @@ TEST_F(CommonRoadCliTest, SolutionDirWritesFilesThatReadBack) {
   }
 }
 
+// A file in map-projection coordinates is planned in a local frame (the JSON gives its origin)
+// and its solution file is in the file's own coordinates: the first state is the problem's
+// initial one as the file gives it.
+TEST_F(CommonRoadCliTest, AFileFarFromItsOriginGetsItsSolutionInItsOwnFrame) {
+  const commonroad::Vec2 far{612345.0, 5432100.0};
+  crt::ScenarioXml xml("ZAM_Utm-1_1_T-1");
+  crt::AddStraightRoadAt(xml, far, 400)
+      .Problem(1, far + commonroad::Vec2{10, -1.75}, 0, 20,
+               {crt::GoalRectangleXml(far + commonroad::Vec2{150, -1.75}, 10, 3, 0, 50, 90)});
+  const fs::path file = dir_ / "utm" / "utm.xml";
+  fs::create_directories(file.parent_path());
+  std::ofstream(file) << xml.Str();
+  const fs::path out = dir_ / "utm_solutions";
+  CommandResult r = RunFrenetic("commonroad " + file.string() +
+                                " --json --no-timing --solution-dir " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = json::parse(r.out);
+  const json& sc = j.at("scenarios")[0];
+  // The lanelets' centre (612545, 5432100) rounded to the kilometre.
+  EXPECT_EQ(sc.at("frame_origin"), json({613000.0, 5432000.0}));
+  EXPECT_TRUE(sc.at("problems")[0].at("solved").get<bool>()) << r.out;
+  auto solution = commonroad::LoadSolution((out / sc.at("solution_file").get<std::string>()).string());
+  ASSERT_TRUE(solution.ok()) << solution.message();
+  ASSERT_EQ(solution->trajectories.size(), 1u);
+  const commonroad::SolutionTrajectory& t = solution->trajectories[0];
+  ASSERT_FALSE(t.states.empty());
+  EXPECT_EQ(t.states.front().x, far.x + 10);
+  EXPECT_EQ(t.states.front().y, far.y - 1.75);
+  EXPECT_GT(t.states.back().x, far.x + 140);  // in the goal, 150 m on
+  // A file near its origin says nothing of a frame.
+  CommandResult home = RunFrenetic("commonroad " + (dir_ / "set" / "a_reach.xml").string() +
+                                   " --json --no-timing");
+  ASSERT_EQ(home.exit_code, 0) << home.out;
+  EXPECT_FALSE(json::parse(home.out).at("scenarios")[0].contains("frame_origin"));
+}
+
 TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {
   const std::string broken = (dir_ / "mixed" / "a_broken.xml").string();
   const int line = crt::LineOf(MalformedXml(), "<point><x>1</x></point>");

@@ -74,6 +74,21 @@ TEST(RunnerTest, ReachesARectangleAheadInTime) {
   EXPECT_EQ(p.trajectory.size(), p.cycles.size() + 1);
 }
 
+TEST(RunnerTest, ReachesARectangleInAFileFarFromItsOrigin) {
+  // ReachesARectangleAheadInTime with every position in map-projection coordinates: read into
+  // a local frame (the planner's input bounds and the reference line's fit would not take
+  // millions of metres), solved the same way.
+  const Vec2 far{612345.0, 5432100.0};
+  ScenarioXml xml;
+  testing::AddStraightRoadAt(xml, far, 400)
+      .Problem(1, far + Vec2{10, -1.75}, 0, 20,
+               {GoalRectangleXml(far + Vec2{150, -1.75}, 10, 3, 0, 50, 90)});
+  const ProblemRun p = RunOne(xml);
+  ASSERT_TRUE(p.road.ok()) << p.road.message();
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  EXPECT_EQ(p.stop_reason, "goal");
+}
+
 TEST(RunnerTest, ChangesLanesPastASlowCarIntoAGoalLanelet) {
   // A slow car 30 m ahead in the ego's lane; the goal is the left lane (lanelet 2).
   ScenarioXml xml;

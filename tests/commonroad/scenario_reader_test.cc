@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -104,6 +105,50 @@ TEST(ScenarioReaderTest, ReadsAHandMadeStraightRoad) {
   EXPECT_DOUBLE_EQ(p->goals[1].orientation->start, -0.2);
   EXPECT_FALSE(p->goals[2].HasPosition());
   EXPECT_FALSE(p->goals[2].velocity.has_value());
+}
+
+// A file in map-projection coordinates (UTM-like: half a million metres east, four million
+// north) is read into a frame centred on its lanelets, rounded to the kilometre: every position
+// moved alike (lanelets, obstacles' states, the problem's start and goal shapes), shapes in an
+// obstacle's own frame and everything else as they are. One near its origin stays put.
+TEST(ScenarioReaderTest, AFileFarFromItsOriginIsReadIntoALocalFrame) {
+  const Vec2 far{500000.25, 4000000.5};
+  ScenarioXml xml;
+  testing::AddStraightRoadAt(xml, far, 300)
+      .DynamicObstacle(5, 4.8, 2, {{0, far + Vec2{40, -1.75}, 0.1, 8},
+                                   {1, far + Vec2{40.8, -1.75}, 0.1, 8}})
+      .Problem(1, far + Vec2{10, -1.75}, 0.2, 20,
+               {GoalRectangleXml(far + Vec2{150, -1.75}, 10, 3, 0.3, 50, 90)});
+  auto sc = ParseScenario(xml.Str(), "far.xml");
+  ASSERT_TRUE(sc.ok()) << sc.message();
+  // The lanelets span x 0..300, y -3.5..3.5 from `far`: their centre rounds to (500000, 4000000).
+  EXPECT_EQ(sc->origin.x, 500000.0);
+  EXPECT_EQ(sc->origin.y, 4000000.0);
+  auto near = [](Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y) < 1e-6; };
+  EXPECT_TRUE(near(sc->lanelets[0].left.front(), Vec2{0.25, 0.5}));
+  EXPECT_TRUE(near(sc->lanelets[0].right.back(), Vec2{300.25, -3.0}));
+  const Obstacle* car = sc->FindObstacle(5);
+  ASSERT_NE(car, nullptr);
+  EXPECT_TRUE(near(car->initial.position, Vec2{40.25, -1.25}));
+  ASSERT_EQ(car->trajectory.size(), 1u);
+  EXPECT_TRUE(near(car->trajectory[0].position, Vec2{41.05, -1.25}));
+  EXPECT_EQ(car->initial.orientation, 0.1);  // orientations and sizes as they are
+  ASSERT_EQ(car->shape.shapes.size(), 1u);
+  EXPECT_TRUE(near(car->shape.shapes[0].center, Vec2{}));  // the obstacle's own frame
+  const PlanningProblem& p = sc->problems[0];
+  EXPECT_TRUE(near(p.initial.position, Vec2{10.25, -1.25}));
+  ASSERT_EQ(p.goals[0].shapes.size(), 1u);
+  EXPECT_TRUE(near(p.goals[0].shapes[0].center, Vec2{150.25, -1.25}));
+  EXPECT_EQ(p.goals[0].shapes[0].orientation, 0.3);
+
+  ScenarioXml home;
+  AddStraightRoad(home, 300).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(0, 40)});
+  auto sc_home = ParseScenario(home.Str(), "home.xml");
+  ASSERT_TRUE(sc_home.ok()) << sc_home.message();
+  EXPECT_EQ(sc_home->origin.x, 0.0);
+  EXPECT_EQ(sc_home->origin.y, 0.0);
+  EXPECT_EQ(sc_home->lanelets[0].right.back().x, 300.0);
+  EXPECT_EQ(sc_home->problems[0].initial.position.y, -1.75);
 }
 
 TEST(ScenarioReaderTest, SpeedLimitComesFromAReferencedMaxSpeedSign) {

@@ -199,6 +199,21 @@ inline ScenarioXml& AddStraightRoad(ScenarioXml& xml, double length = 300) {
   return xml.Lanelet(right).Lanelet(left);
 }
 
+// AddStraightRoad's two lanes moved by `offset` (a file in map-projection coordinates).
+inline ScenarioXml& AddStraightRoadAt(ScenarioXml& xml, Vec2 offset, double length = 300) {
+  auto at = [offset](std::vector<Vec2> line) {
+    for (Vec2& p : line) p = p + offset;
+    return line;
+  };
+  LaneletXml right = Lane(1, at(Line(0, length, 0)), at(Line(0, length, -3.5)));
+  right.adjacent_left = {{2, true}};
+  LaneletXml left = Lane(2, at(Line(0, length, 3.5)), at(Line(0, length, 0)));
+  left.adjacent_right = {{1, true}};
+  left.left_marking = "solid";
+  left.right_marking = "dashed";
+  return xml.Lanelet(right).Lanelet(left);
+}
+
 // One lane of width 4 m along a left-turning arc about (0, radius): the centre line has the
 // given radius, from angle 0 (at the origin, heading +x) through `sweep` rad.
 inline ScenarioXml& AddCurvedRoad(ScenarioXml& xml, double radius, double sweep, int id = 1) {

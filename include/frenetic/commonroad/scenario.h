@@ -37,6 +37,12 @@ struct Scenario {
   std::vector<TrafficSign> signs;
   std::vector<Obstacle> obstacles;  // static first, then dynamic, each in file order
   std::vector<PlanningProblem> problems;
+  // The file's coordinates are these plus `origin`: a file whose lanelets lie farther than
+  // kLocalFrameBeyond from its origin (map projections: UTM northings run to millions of
+  // metres) is read into a frame centred on them (origin rounded to the kilometre), where the
+  // reference-line fit and the planner keep their precision and their input bounds; (0, 0)
+  // otherwise. Solution files add it back.
+  Vec2 origin;
 
   // nullptr when there is none with that id. Linear searches.
   const Lanelet* FindLanelet(int id) const;
@@ -44,6 +50,9 @@ struct Scenario {
   const PlanningProblem* FindProblem(int id) const;
   const TrafficSign* FindSign(int id) const;
 };
+
+// m: see Scenario::origin.
+inline constexpr double kLocalFrameBeyond = 1e4;
 
 // Parses a scenario from XML text. `source` names it in error messages and Scenario::source.
 StatusOr<Scenario> ParseScenario(std::string_view xml, std::string_view source);
