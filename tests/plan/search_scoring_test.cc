@@ -22,6 +22,13 @@ void Scene(Stages& st) {
   st.lattice.Generate();
 }
 
+// Scene(st), scored to the end: the number of candidates.
+int ScoredScene(Stages& st) {
+  Scene(st);
+  EXPECT_TRUE(st.scorer.Score());
+  return static_cast<int>(st.ws.order.size());
+}
+
 TEST(SearchScoringTest, ScoresEveryCandidateWithTheCostSet) {
   REQUIRE_UDACITY_MAP();
   Stages st;
@@ -66,10 +73,8 @@ TEST(SearchScoringTest, SortsLazilyIntoCostOrderTiesByIndex) {
 TEST(SearchScoringTest, LazyCostingRanksLikeAFullSortByExactCost) {
   REQUIRE_UDACITY_MAP();
   Stages st;
-  Scene(st);
-  ASSERT_TRUE(st.scorer.Score());
+  const int n = ScoredScene(st);
   Workspace& ws = st.ws;
-  const int n = static_cast<int>(ws.order.size());
   std::vector<double> exact(n);
   std::vector<int> want(n);
   for (int c = 0; c < n; ++c) {
@@ -121,10 +126,8 @@ TEST(SearchScoringTest, CoarseBoundsAreCompletedOnlyWhenNeeded) {
 TEST(SearchScoringTest, AdvanceClimbsTermByTermToTheExactCost) {
   REQUIRE_UDACITY_MAP();
   Stages st;
-  Scene(st);
-  ASSERT_TRUE(st.scorer.Score());
+  const int n = ScoredScene(st);
   Workspace& ws = st.ws;
-  const int n = static_cast<int>(ws.order.size());
   const std::vector<int>& expensive = st.costs->expensive_terms();
   ASSERT_GE(expensive.size(), 2u);
   std::vector<double> added(st.costs->size(), 0.0);  // weighted, per term, over the cycle
