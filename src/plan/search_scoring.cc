@@ -140,14 +140,16 @@ void Scorer::Resolve(int c) {
     return;
   }
   // The expensive terms Advance has not evaluated yet, then EvaluateWithCheap's sum.
-  const int e = static_cast<int>(exp_order_.size());
-  for (; stage_[c] < e; ++stage_[c]) {
-    const int t = exp_order_[stage_[c]];
-    values[t] = costs_.term(t).Evaluate(ws_.ctx, in);
-    exp_sum_[t] += costs_.weight(t) * values[t];
-  }
+  while (stage_[c] < static_cast<int>(exp_order_.size())) EvaluateNextExpensive(c, in);
   const double v = costs_.SumKnown(values, ~std::uint64_t{0});
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
+}
+
+void Scorer::EvaluateNextExpensive(int c, const cost::CostInput& in) {
+  const int t = exp_order_[stage_[c]++];
+  double& value = cheap_[static_cast<std::size_t>(c) * costs_.size() + t];
+  value = costs_.term(t).Evaluate(ws_.ctx, in);
+  exp_sum_[t] += costs_.weight(t) * value;
 }
 
 double Scorer::Advance(int c) {
@@ -158,13 +160,10 @@ double Scorer::Advance(int c) {
     Resolve(c);
     return ws_.cand_cost[c];
   }
-  double* values = &cheap_[static_cast<std::size_t>(c) * costs_.size()];
-  const int t = exp_order_[stage_[c]++];
-  values[t] = costs_.term(t).Evaluate(ws_.ctx, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
-  exp_sum_[t] += costs_.weight(t) * values[t];
+  EvaluateNextExpensive(c, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
   std::uint64_t known = 0;
   for (int q = 0; q < stage_[c]; ++q) known |= std::uint64_t{1} << exp_order_[q];
-  const double b = costs_.SumKnown(values, known);
+  const double b = costs_.SumKnown(&cheap_[static_cast<std::size_t>(c) * costs_.size()], known);
   // Not finite: the exact cost is 1e300 (a term is NaN or infinite); never above it.
   return Finite(b) ? std::min(b, 1e300) : (Resolve(c), ws_.cand_cost[c]);
 }

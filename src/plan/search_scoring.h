@@ -135,6 +135,9 @@ class Scorer {
   void Tighten(int c);
   // The exact cost of candidate c into ws.cand_cost[c].
   void Resolve(int c);
+  // Evaluates the next expensive term of candidate c (exp_order_[stage_[c]]) of input `in` into
+  // cheap_, and counts its weighted value in exp_sum_.
+  void EvaluateNextExpensive(int c, const cost::CostInput& in);
   // Moves candidate c to rank ws.sorted of ws.order.
   void Emit(int c);
 

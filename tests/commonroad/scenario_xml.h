@@ -187,19 +187,9 @@ inline std::vector<Vec2> Line(double x0, double x1, double y, double step = 10) 
   return out;
 }
 
-// Two lanes along +x from x = 0 to `length`, 3.5 m wide: lanelet 1 (right, y in [-3.5, 0]) and
-// lanelet 2 (left, y in [0, 3.5]), adjacent in the same direction.
-inline ScenarioXml& AddStraightRoad(ScenarioXml& xml, double length = 300) {
-  LaneletXml right = Lane(1, Line(0, length, 0), Line(0, length, -3.5));
-  right.adjacent_left = {{2, true}};
-  LaneletXml left = Lane(2, Line(0, length, 3.5), Line(0, length, 0));
-  left.adjacent_right = {{1, true}};
-  left.left_marking = "solid";
-  left.right_marking = "dashed";
-  return xml.Lanelet(right).Lanelet(left);
-}
-
-// AddStraightRoad's two lanes moved by `offset` (a file in map-projection coordinates).
+// Two lanes along +x from x = 0 to `length`, 3.5 m wide, moved by `offset` (a file in
+// map-projection coordinates): lanelet 1 (right, y in [-3.5, 0]) and lanelet 2 (left, y in
+// [0, 3.5]), adjacent in the same direction.
 inline ScenarioXml& AddStraightRoadAt(ScenarioXml& xml, Vec2 offset, double length = 300) {
   auto at = [offset](std::vector<Vec2> line) {
     for (Vec2& p : line) p = p + offset;
@@ -212,6 +202,11 @@ inline ScenarioXml& AddStraightRoadAt(ScenarioXml& xml, Vec2 offset, double leng
   left.left_marking = "solid";
   left.right_marking = "dashed";
   return xml.Lanelet(right).Lanelet(left);
+}
+
+// The same at the origin.
+inline ScenarioXml& AddStraightRoad(ScenarioXml& xml, double length = 300) {
+  return AddStraightRoadAt(xml, {}, length);
 }
 
 // One lane of width 4 m along a left-turning arc about (0, radius): the centre line has the
