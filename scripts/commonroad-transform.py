@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes a CommonRoad scenario turned by ANGLE (rad, about the origin) and then moved by (DX, DY)
 metres: every point and centre (lanelet bounds, obstacle and problem states, goal shapes) and
-every orientation (states, intervals, rectangles). Speeds, sizes and times stay. A planner that
+every orientation (states, intervals, goal rectangles); an obstacle's shape, in the obstacle's
+own frame, stays. Speeds, sizes and times stay. A planner that
 depends on where the road lies or which way it points solves the transformed file differently:
 run a set both ways and compare (docs/commonroad.md, "Moved, turned, and new problems").
 
@@ -29,10 +30,20 @@ def transform(src, dst, angle, dx, dy):
         x.text = repr(c * px - s * py + dx)
         y.text = repr(s * px + c * py + dy)
 
+    # An obstacle's <shape> is in the obstacle's own frame (its states place and turn it): it
+    # stays as it is. Everything else is in the scenario's frame.
+    local = set()
+    for obstacle in root:
+        if obstacle.tag.endswith("Obstacle"):
+            for shape in obstacle.findall("shape"):
+                local.update(shape.iter())
     for tag in ("point", "center"):
         for node in root.iter(tag):
-            move(node)
+            if node not in local:
+                move(node)
     for node in root.iter("orientation"):
+        if node in local:
+            continue
         children = list(node)
         if not children:  # a rectangle's
             node.text = repr(float(node.text) + angle)
