@@ -32,7 +32,9 @@ class GoalCost : public CostTerm {
             {"v_scale", 5.0, 0.5, 30.0, true},
             {"h_scale", 0.05, 0.005, 1.0, true},
             {"miss", 1.0, 0.0, 10.0, false},
-            {"cap", 10.0, 1.0, 100.0, true}};
+            {"cap", 10.0, 1.0, 100.0, true},
+            {"approach", 1.0, 0.0, 10.0, false},
+            {"approach_width", 1.0, 0.0, 3.0, false}};
   }
   void Configure(std::span<const double> v) override {
     s_scale_ = v[0];
@@ -41,6 +43,8 @@ class GoalCost : public CostTerm {
     h_scale_ = v[3];
     miss_ = v[4];
     cap_ = v[5];
+    approach_ = v[6];
+    approach_width_ = v[7];
     inv_s_ = 1 / s_scale_;
     inv_d_ = 1 / d_scale_;
     inv_v_ = 1 / v_scale_;
@@ -56,6 +60,21 @@ class GoalCost : public CostTerm {
       if (!(goal.t_hi >= 0)) continue;  // its window has passed
       any_open = true;
       best = std::min(best, Miss(ctx, in, goal));
+      // A region crossed turned (its headings leave out the road's) is entered by a swerve from
+      // beside it (the planner's lattice offers them, Lattice::AddSwerves): passing along the
+      // side it is entered from, within approach_width lanes of it, at any heading, misses it
+      // by `approach` plus the rest.
+      const int turned = CrossedTurned(goal);
+      const bool right = turned > 0;
+      if (turned != 0 && approach_width_ > 0 && best > approach_) {
+        GoalRegion side = goal;
+        const double width = approach_width_ * ctx.lane_width;
+        side.d_lo = right ? goal.d_lo - width : goal.d_hi;
+        side.d_hi = right ? goal.d_lo : goal.d_hi + width;
+        side.h_lo = -GoalRegion::kInf;
+        side.h_hi = GoalRegion::kInf;
+        best = std::min(best, approach_ + Miss(ctx, in, side));
+      }
     }
     if (!any_open || !std::isfinite(best)) return 0.0;
     return best > 0 ? std::clamp(miss_ + best, 0.0, cap_) : 0.0;
@@ -167,7 +186,7 @@ class GoalCost : public CostTerm {
   }
 
   double s_scale_ = 10.0, d_scale_ = 1.75, v_scale_ = 5.0, h_scale_ = 0.05, miss_ = 1.0,
-         cap_ = 10.0;
+         cap_ = 10.0, approach_ = 1.0, approach_width_ = 1.0;
   double inv_s_ = 0.1, inv_d_ = 1 / 1.75, inv_v_ = 0.2, inv_h_ = 20;
 };
 

@@ -459,6 +459,29 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   for (size_t k = 0; k < skeleton.size(); ++k) {
     for (const auto& [j, pos] : net.CrossSection(skeleton[k])) place(j, offset[k] + pos);
   }
+  // The opposite lanelet beside a cross-section's leftmost one (a two-way road): a lane driven
+  // the other way, at the next position to the left, its bounds read in the road's direction.
+  std::set<int> oncoming;
+  for (size_t k = 0; k < skeleton.size(); ++k) {
+    int leftmost = skeleton[k], left_pos = 0;
+    for (const auto& [j, pos] : net.CrossSection(skeleton[k])) {
+      if (pos < left_pos) {
+        leftmost = j;
+        left_pos = pos;
+      }
+    }
+    const std::optional<Adjacent>& a = net.at(leftmost).adjacent_left;
+    if (!a.has_value() || a->same_direction) continue;
+    const int o = net.Index(a->id);
+    if (o < 0 || !placed.insert(o).second) continue;
+    Lanelet reversed = net.at(o);
+    reversed.left.assign(net.at(o).right.rbegin(), net.at(o).right.rend());
+    reversed.right.assign(net.at(o).left.rbegin(), net.at(o).left.rend());
+    Stations st = Project(reversed, **line);
+    if (st.s.size() < 2) continue;
+    by_position[offset[k] + left_pos - 1].push_back({o, std::move(st)});
+    oncoming.insert(o);
+  }
   BuiltRoad out;
   std::vector<map::LaneProfile> lanes;
   std::vector<int> lane_pos;  // each lane's lateral position
@@ -473,12 +496,17 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
         // Open ends (a first lanelet without predecessors, a last one without successors) go on
         // kOpenEnd m, as the verdict's road area does: a car may start there with its rear
         // past the end of the map.
-        if (net.at(net.Index(ids.front())).predecessors.empty()) {
+        // An oncoming lane's lanelets run the other way: their ends are where s begins.
+        const bool other_way = oncoming.count(net.Index(ids.front())) > 0;
+        lane.oncoming = other_way;
+        const Lanelet& first_piece = net.at(net.Index(ids.front()));
+        const Lanelet& last_piece = net.at(net.Index(ids.back()));
+        if ((other_way ? first_piece.successors : first_piece.predecessors).empty()) {
           lane.s.insert(lane.s.begin(), lane.s.front() - kOpenEnd);
           lane.left.insert(lane.left.begin(), lane.left.front());
           lane.right.insert(lane.right.begin(), lane.right.front());
         }
-        if (net.at(net.Index(ids.back())).successors.empty()) {
+        if ((other_way ? last_piece.predecessors : last_piece.successors).empty()) {
           lane.s.push_back(lane.s.back() + kOpenEnd);
           lane.left.push_back(lane.left.back());
           lane.right.push_back(lane.right.back());
@@ -539,6 +567,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     }
     map::LaneProfile kept;
     kept.speed_limit = l.speed_limit;
+    kept.oncoming = l.oncoming;
     for (size_t k = best_from; k < best_from + best_len; ++k) {
       kept.s.push_back(l.s[k]);
       kept.left.push_back(l.left[k]);

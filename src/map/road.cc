@@ -107,6 +107,10 @@ double Road::SpeedLimit(int lane) const {
   return lanes_[lane].speed_limit;
 }
 
+bool Road::Oncoming(int lane) const {
+  return lane >= 0 && lane < num_lanes() && lanes_[lane].oncoming;
+}
+
 Road::Span Road::EdgesAt(double s) const {
   Span out{kNaN, kNaN, false};
   for (int l = 0; l < num_lanes(); ++l) {

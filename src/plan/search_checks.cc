@@ -259,9 +259,11 @@ bool Checker::CandidateCollides(int c) {
   // latest (the car passes the same reach tests): the lon bundle's last two, its lat bundle's
   // last one.
   LastHit* const hints[3] = {&last_hit_[2 * i], &last_hit_[2 * i + 1], &lat_last_hit_[k]};
+  // A swerve into its goal region is checked up to its end only.
+  const int n_steps = ws_.CheckSteps(c);
   bool sampled = false;
   for (const LastHit* h : hints) {
-    if (h->stamp != ws_.traffic_stamp) continue;
+    if (h->stamp != ws_.traffic_stamp || h->step > n_steps) continue;
     if (!sampled) StepRows(c);
     sampled = true;
     const int j = h->step;
@@ -274,9 +276,9 @@ bool Checker::CandidateCollides(int c) {
   const StepStates reach = StepsOf(c);  // the rows and the reach masks
   // With the narrower lateral test: the cars it leaves out fail HitsAt anyway.
   const StepStates steps = reach.WithNearLat(TightLatNear(i, k));
-  const int n_steps = ws_.n_steps;
   const std::uint64_t cars = CarMask(true);
-  const int from = hints[0]->stamp == ws_.traffic_stamp ? hints[0]->step : 1;
+  const int from =
+      hints[0]->stamp == ws_.traffic_stamp && hints[0]->step <= n_steps ? hints[0]->step : 1;
   int hit = 0, car = -1;
   for (int q = 0; q < n_steps && hit == 0; ++q) {
     const int j = (from - 1 + q) % n_steps + 1;
@@ -371,9 +373,10 @@ double Checker::CandidateMeasure(int c, Reject* reason, bool any) {
   SampleTicks(tr.lat, k, lat_ticks_);
   const int w = ws_.n_ticks + 1;
   Reject why = Reject::kCount;
-  const double worst =
-      Measure(&why, true,
-              {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], nullptr, i}, any);
+  const double worst = Measure(&why, true,
+                               {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w],
+                                nullptr, i, ws_.CheckTicks(c)},
+                               any);
   // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
   const bool partial = any && worst > 0;
   if (reason != nullptr) *reason = why;
@@ -383,7 +386,8 @@ double Checker::CandidateMeasure(int c, Reject* reason, bool any) {
 
 int Checker::BuildXyPath(const Ticks& ticks) {
   int n = first_new_;
-  for (int i = 1; i <= ws_.n_ticks; ++i, ++n) {
+  const int n_ticks = ticks.n > 0 ? ticks.n : ws_.n_ticks;
+  for (int i = 1; i <= n_ticks; ++i, ++n) {
     // ToCartesian's x and y without its heading and curvature.
     const map::CentrePoint p = ticks.centre != nullptr ? ticks.centre[i] : line_.Centre(ticks.s[i]);
     chk_x_[n] = p.OffsetX(ticks.d[i]);
@@ -397,7 +401,7 @@ double Checker::Violation(Reject* reason, bool lane_line) {
 }
 
 double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any) {
-  const int n_ticks = ws_.n_ticks;
+  const int n_ticks = ticks.n > 0 ? ticks.n : ws_.n_ticks;
   const double* tk_s = ticks.s;
   const double* tk_d = ticks.d;
   double worst = -1e9;
@@ -449,9 +453,9 @@ double Checker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool
   }
   Ticks xy_ticks = ticks;
   if (ticks.lon_slot >= 0) {
-    const int i = ticks.lon_slot, w = n_ticks + 1;
+    const int i = ticks.lon_slot, w = ws_.n_ticks + 1;  // the whole row, for every candidate
     if (!lon_centre_have_[i]) {
-      for (int t = 1; t <= n_ticks; ++t) lon_centre_[i * w + t] = line_.Centre(ticks.s[t]);
+      for (int t = 1; t <= ws_.n_ticks; ++t) lon_centre_[i * w + t] = line_.Centre(ticks.s[t]);
       lon_centre_have_[i] = 1;
     }
     xy_ticks.centre = &lon_centre_[i * w];

@@ -125,10 +125,11 @@ class Checker {
   // in front of it (the simulator's traffic only brakes for a car within 2 m laterally), so
   // moving into its way is never safe. With ghosts false only the real cars count, not the
   // predictor's lane-change hypotheses (Workspace::num_check_cars).
-  // from: the first step tested (the caller knows the earlier ones do not collide).
+  // from: the first step tested (the caller knows the earlier ones do not collide); to: the
+  // last (0: n_steps; a swerve's Workspace::CheckSteps).
   template <typename StateAt>
   int FirstCollision(StateAt state_at, double margin_scale, double behind_scale = 1.0,
-                     int* car_hit = nullptr, bool ghosts = true, int from = 1) const;
+                     int* car_hit = nullptr, bool ghosts = true, int from = 1, int to = 0) const;
   // Whether `steps` collide at step j (1..n_steps) as FirstCollision(steps, margin_scale,
   // behind_scale, nullptr, ghosts) tests it there.
   bool CollidesAt(const StepStates& steps, int j, double margin_scale, double behind_scale,
@@ -202,6 +203,7 @@ class Checker {
     const double *s, *sd, *d;
     const map::CentrePoint* centre;
     int lon_slot = -1;
+    int n = 0;  // the ticks [1, n] are measured (0: all, n_ticks)
   };
   // Appends the ticks to the XY prefix; returns the path length.
   int BuildXyPath(const Ticks& ticks);
@@ -349,8 +351,11 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
   const double sep_d = ws_.car_sep_d[c];  // the two half widths: centres this close touch
   const double inside =
       std::clamp((sep_d - std::abs(cd - ego.cy)) / (sep_d - kFollowerLateral), 0.0, 1.0);
+  // An oncoming car (moving the other way: a two-way road's other lane) is passed, not
+  // followed: no headway.
+  const double headway = ws_.step_v[at] >= 0 ? inside * cfg_.headway_min * e.s_d : 0.0;
   const double margin =
-      cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d)
+      cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, headway)
       : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
                           : margin_scale * cfg_.margin_s;
   if (std::abs(cs - ego.cx) > ws_.reach_s_base + ws_.car_reach_s[c] + margin ||
@@ -384,11 +389,12 @@ int Checker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, dou
 
 template <typename StateAt>
 int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
-                            int* car_hit, bool ghosts, int from) const {
+                            int* car_hit, bool ghosts, int from, int to) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
   const std::uint64_t cars = CarMask(ghosts);
   const int n_steps = ws_.n_steps;
-  for (int j = std::max(from, 1); j <= n_steps; ++j) {
+  const int last = to > 0 ? std::min(to, n_steps) : n_steps;
+  for (int j = std::max(from, 1); j <= last; ++j) {
     // Cars in index order either way: the first one hit is the same.
     int hit = -1;
     if constexpr (requires { state_at.Near(j); }) {

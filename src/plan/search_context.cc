@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "frenetic/plan/planner.h"
 
@@ -93,10 +94,15 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   c.start_s = start.s;
   c.start_d = start.d;
   c.start_speed = start.s_d;
+  c.oncoming_right = -std::numeric_limits<double>::infinity();
   if (cfg.uniform_road) {
     LaneCentres(cfg, line, ws);
   } else {
     RoadLanes(cfg, road, ws);
+    for (int l = 0; l < cfg.num_lanes; ++l) {
+      const map::Road::Span now = road.LaneAt(l, start.s);
+      if (road.Oncoming(l) && now.exists) c.oncoming_right = std::max(c.oncoming_right, now.right);
+    }
   }
   c.current_lane = LaneOf(cfg, ws, start.d);
   c.previous_target_lane = ws.prev_target_lane;

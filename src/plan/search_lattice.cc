@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plan/search_context.h"
 #include "plan/search_scoring.h"
 #include "plan/search_workspace.h"
 
@@ -23,6 +24,17 @@ constexpr double kAccelMinGain = 1.0;
 constexpr double kAccelFreeBehind = 20.0, kAccelFreeAhead = 100.0;
 // m/s: below it a car laterally at rest off its lane's centre holds its d (Lattice::Generate).
 constexpr double kCrawlSpeed = 2.0;
+// Swerves into a goal region crossed turned (Lattice::AddSwerves): the heading's tangent beyond
+// the interval's near end; the durations' step (s); the speed (m/s) their d' is reckoned at, at
+// least; the acceleration (m/s^2) that bounds how far the lon bundle spreads about the start's
+// speed; the end speeds' count and step; and the end lateral accelerations.
+constexpr double kSwerveHeading = 0.03;
+constexpr double kSwerveStep = 0.25;
+constexpr double kSwerveMinSpeed = 2.0;
+constexpr double kSwerveReachAccel = 5.0;
+constexpr int kSwerveSpeeds = 3;
+constexpr double kSwerveSpeedStep = 3.0;  // m/s
+constexpr double kSwerveEndAccels[] = {0.0, 6.0, 9.0};  // m/s^2 across, toward the heading
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -114,6 +126,87 @@ LatTraj Lattice::MakeLat(int lane, double offset, double T, double delay) const 
   l.traj.poly = delay > 0 ? traj::SolveQuintic(s0.d, 0.0, 0.0, target, 0.0, 0.0, T)
                           : traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, target, 0.0, 0.0, T);
   return l;
+}
+
+LatTraj Lattice::MakeSwerve(int goal, double d, double d_d, double T, double d_dd) const {
+  LatTraj l;
+  l.goal = goal;
+  l.traj.duration = T;
+  const traj::FrenetState& s0 = ws_.start;
+  l.traj.poly = traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, d, d_d, d_dd, T);
+  l.lane = LaneOf(cfg_, ws_, d);
+  l.offset = d - ws_.lane_center[l.lane];
+  return l;
+}
+
+// Into a goal region whose headings leave out the road's own (a goal crossed turned: cutting
+// back into a lane after passing, say): quintic moves that end inside it, at its middle and a
+// little in from the side they come from, moving across at a heading kSwerveHeading beyond the
+// interval's near end (at a few end speeds) and still turning into it or not (end lateral
+// accelerations), after each of the durations the window allows; and the previous cycle's
+// swerve, to its end. A lane move never crosses such a region (its d' is 0 at the end). What
+// follows a swerve's end leaves the lane turned: a swerve pairs only with the lon trajectories
+// that put it in its region at its end (Workspace::SwerveEndsInside), whose checks stop there
+// (Workspace::CheckTicks), as the run ends at its goal. At most kMaxSwerves, the shortest first.
+void Lattice::AddSwerves() {
+  const traj::FrenetState& s0 = ws_.start;
+  const double v = std::max(s0.s_d, kSwerveMinSpeed);
+  int added = 0;
+  for (int g = 0; g < ws_.num_goals; ++g) {
+    const cost::GoalRegion& r = ws_.goals[g];
+    const int turned = cost::CrossedTurned(r);
+    const bool right = turned > 0;
+    if (turned == 0 || !std::isfinite(r.d_lo) || !std::isfinite(r.d_hi) || !(r.d_hi > r.d_lo)) {
+      continue;
+    }
+    double h = right ? r.h_lo + kSwerveHeading : r.h_hi - kSwerveHeading;
+    if (!(h >= r.h_lo && h <= r.h_hi)) h = 0.5 * (r.h_lo + r.h_hi);
+    const double sign = turned;
+    const double from_side = right ? 0.25 : 0.75;  // coming from smaller d when moving right
+    for (double T = kSwerveStep; T <= cfg_.score_horizon + 1e-9; T += kSwerveStep) {
+      if (T < r.t_lo || T > r.t_hi) continue;
+      const double s_est = s0.s + s0.s_d * T;
+      const double reach = kSwerveReachAccel * T * T;  // the lon bundle's spread about s_est
+      if (s_est + reach < r.s_lo || s_est - reach > r.s_hi) continue;
+      for (const double f : {0.5, from_side}) {
+        const double d = r.d_lo + f * (r.d_hi - r.d_lo) + r.d_slope * (s_est - r.s_ref);
+        for (int k = 0; k < kSwerveSpeeds; ++k) {
+          for (const double a : kSwerveEndAccels) {
+            if (added >= kMaxSwerves) return;
+            AddLat(MakeSwerve(g, d, h * (v + k * kSwerveSpeedStep), T, sign * a));
+            ++added;
+          }
+        }
+      }
+    }
+  }
+}
+
+// The swerve under way, to its end.
+void Lattice::AddSwerveUnderWay() {
+  if (!ws_.have_prev_traj || ws_.prev_swerve_goal < 0 || ws_.prev_swerve_goal >= ws_.num_goals) {
+    return;
+  }
+  const traj::Trajectory1d& prev = ws_.prev_traj.lat;
+  const double remaining = prev.end_time() - ws_.prev_elapsed;
+  if (remaining >= kTickSeconds) {
+    const traj::State1d e = prev.poly.At(prev.duration);
+    AddLat(MakeSwerve(ws_.prev_swerve_goal, e.p, e.v, remaining, e.a));
+    // ...and its longitudinal trajectory, to the same end state at the same time: the
+    // swerve's region lies where the two meet.
+    const traj::Trajectory1d& lon = ws_.prev_traj.lon;
+    const double lon_left = lon.end_time() - ws_.prev_elapsed;
+    if (lon_left > 0.05) {
+      const traj::State1d le = lon.poly.At(lon.duration);
+      const traj::FrenetState& s0 = ws_.start;
+      LonTraj l;
+      l.kind = cost::LonKind::kVelocityKeeping;
+      l.param = le.v;
+      l.traj.duration = lon_left;
+      l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, le.p, le.v, le.a, lon_left);
+      AddLon(l);
+    }
+  }
 }
 
 // The nearest car ahead in `lane` at the start instant (context index), or -1.
@@ -345,9 +438,12 @@ void Lattice::Generate() {
       }
     }
   }
+  AddSwerves();
+  AddSwerveUnderWay();
   for (int i = 0; i < static_cast<int>(ws_.lon.size()); ++i) {
     for (int j = 0; j < static_cast<int>(ws_.lat.size()); ++j) {
       if (ws_.lon[i].lane >= 0 && ws_.lon[i].lane != ws_.lat[j].lane) continue;
+      if (ws_.lat[j].goal >= 0 && !ws_.SwerveEndsInside(i, j)) continue;
       ws_.cand_lon.push_back(i);
       ws_.cand_lat.push_back(j);
     }

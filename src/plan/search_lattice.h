@@ -26,12 +26,14 @@ struct LonTraj {
   double jerk2 = 0;
 };
 
-// One lateral move of the bundle: to `lane`'s centre plus `offset` (m).
+// One lateral move of the bundle: to `lane`'s centre plus `offset` (m); or a swerve into goal
+// region `goal` (>= 0), crossing it turned at the end of the move (Lattice::AddSwerves).
 struct LatTraj {
   traj::Trajectory1d traj;
   int lane = 0;
   double offset = 0;
   double jerk2 = 0;
+  int goal = -1;
 };
 
 class Lattice {
@@ -49,6 +51,9 @@ class Lattice {
   LonTraj MakeLon(cost::LonKind kind, int lane, double param, double T, int lead = -1) const;
   // A quintic move to lane's centre + offset over T s, after `delay` s holding still.
   LatTraj MakeLat(int lane, double offset, double T, double delay = 0) const;
+  // A quintic move into goal region `goal` over T s, ending at d with d' = d_d and d'' = d_dd
+  // (a swerve).
+  LatTraj MakeSwerve(int goal, double d, double d_d, double T, double d_dd) const;
 
  private:
   void AddLon(const LonTraj& l);
@@ -56,6 +61,8 @@ class Lattice {
   void AddBraking();
   void AddGapTargets(int lane, double T);
   void AddAccelerating(const bool reachable[], double vmax);
+  void AddSwerves();
+  void AddSwerveUnderWay();
   int Leader(int lane) const;
   int Alongside(int lane) const;
 

@@ -232,7 +232,9 @@ class SearchPlanner : public Planner {
         sum.deadline_stage = PlanSummary::Stage::kCheck;
       }
       sum.ms_check = Elapsed() - t_check;
-      if (found && cfg_.refine && refiner_.available()) {
+      // A swerve into a goal region is taken as it is: its checks end at the region
+      // (Workspace::CheckTicks), the refinement's run over the whole horizon.
+      if (found && cfg_.refine && refiner_.available() && ws_.lat[ws_.winner_lat].goal < 0) {
         // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
         // asks for none beyond the cycle's.
         const double refine_ms = std::isfinite(cfg_.refine_budget_ms) ? cfg_.refine_budget_ms : 0;
@@ -335,7 +337,8 @@ class SearchPlanner : public Planner {
       // Past the traced ranks, whether it collides is all the walk needs.
       int hit_car = -1, hit = ws_.n_steps + 1;
       if (trace_ != nullptr && r < trace_max_) {
-        hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car);
+        hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
+                                      ws_.CheckSteps(c));
       } else {
         hit = checker_.CandidateCollides(c) ? 1 : hit;
       }
@@ -555,6 +558,7 @@ class SearchPlanner : public Planner {
     }
     ws_.prev_target_lane = lane;
     ws_.prev_lat_lane = ws_.lat[ws_.winner_lat].lane;
+    ws_.prev_swerve_goal = ws_.lat[ws_.winner_lat].goal;
     ws_.prev_lat_offset =
         ws_.winner.lat.At(ws_.winner.lat.end_time()).p - ws_.lane_center[ws_.prev_lat_lane];
     ws_.prev_traj = ws_.winner;

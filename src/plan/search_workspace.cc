@@ -27,9 +27,10 @@ Workspace::Workspace(const Settings& cfg) {
                       2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
                       cfg.num_lanes * cfg.gap_targets * cfg.durations +
                       cfg.brake_decels * cfg.brake_targets + cost::kMaxGoalRegions * cfg.durations +
-                      cfg.accels * (cfg.num_lanes + 1) + 8;
+                      cfg.accels * (cfg.num_lanes + 1) + 9;
   const int max_lat =
-      cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + 8;
+      cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + kMaxSwerves +
+      9;
   lon.reserve(max_lon);
   lat.reserve(max_lat);
   for (auto* v : {&lon_s, &lon_sd, &lon_sdd}) v->assign(max_lon * n_samples, 0.0);
@@ -60,6 +61,27 @@ Workspace::Workspace(const Settings& cfg) {
   prev_s.assign(n_samples, 0.0);
   prev_d.assign(n_samples, 0.0);
   for (auto* v : {&tk_s, &tk_sd, &tk_sdd, &tk_d, &tk_dd, &tk_ddd}) v->assign(n_ticks + 1, 0.0);
+}
+
+int Workspace::CheckTicks(int c) const {
+  const int j = cand_lat[c];
+  if (lat[j].goal < 0 || lat[j].goal >= num_goals) return n_ticks;
+  const int ticks = static_cast<int>(std::floor(lat[j].traj.end_time() / kTickSeconds + 1e-6));
+  if (ticks < 1 || ticks >= n_ticks || !SwerveEndsInside(cand_lon[c], j)) return n_ticks;
+  return ticks;
+}
+
+bool Workspace::SwerveEndsInside(int i, int j) const {
+  const LatTraj& l = lat[j];
+  if (l.goal < 0 || l.goal >= num_goals) return false;
+  const double T = l.traj.end_time();
+  const cost::GoalRegion& r = goals[l.goal];
+  const traj::State1d lo = lon[i].traj.At(T);
+  const traj::State1d la = l.traj.At(T);
+  const double across = la.p - r.d_slope * (lo.p - r.s_ref);
+  const double h = la.v / std::max(lo.v, 0.1);
+  return T >= r.t_lo && T <= r.t_hi && lo.p >= r.s_lo && lo.p <= r.s_hi && across >= r.d_lo &&
+         across <= r.d_hi && lo.v >= r.v_lo && lo.v <= r.v_hi && h >= r.h_lo && h <= r.h_hi;
 }
 
 }  // namespace frenetic::plan::search

@@ -4,6 +4,7 @@
 // which stage writes what.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -30,8 +31,25 @@ class CycleClock {
   double t0_ = 0;  // ms, now_ms_ at the start of the cycle
 };
 
+// Swerves into goal regions a cycle offers at most (Lattice::AddSwerves), besides the one under
+// way.
+inline constexpr int kMaxSwerves = 216;
+
 struct Workspace {
   explicit Workspace(const Settings& cfg);
+
+  // The ticks [1, CheckTicks(c)] and collision steps [1, CheckSteps(c)] candidate c is checked
+  // over: the whole horizon (n_ticks, n_steps); for a swerve whose candidate is inside its goal
+  // region at the swerve's end (at a tick), up to there: the run ends at its goal, and what
+  // would follow leaves the lane turned.
+  int CheckTicks(int c) const;
+  // Whether lon trajectory i with swerve j (lat[j].goal >= 0) is inside the swerve's goal region
+  // at the swerve's end: time, s, d, speed and heading.
+  bool SwerveEndsInside(int i, int j) const;
+  int CheckSteps(int c) const {
+    const int t = CheckTicks(c);
+    return t == n_ticks ? n_steps : std::max(1, t / collision_step);
+  }
 
   // The candidate c's trajectory (an index into cand_lon / cand_lat).
   traj::FrenetTrajectory Candidate(int c) const {
@@ -138,6 +156,7 @@ struct Workspace {
   int prev_target_lane = -1, lane_before_change = -1;
   int prev_lat_lane = -1;  // lane and end offset (m) of the previous winner's lateral move
   double prev_lat_offset = 0;
+  int prev_swerve_goal = -1;  // the goal region the previous winner swerved into, or -1
   double time_since_change = 1e9;
 };
 

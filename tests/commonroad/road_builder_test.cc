@@ -16,6 +16,7 @@ namespace {
 
 using testing::AddCurvedRoad;
 using testing::AddStraightRoad;
+using testing::AddTwoWayRoad;
 using testing::GoalLaneletXml;
 using testing::GoalRectangleXml;
 using testing::GoalTimeOnlyXml;
@@ -55,6 +56,34 @@ TEST(RoadBuilderTest, TwoLanesOfAStraightRoad) {
   EXPECT_NEAR(right.right, 1.75, 0.01);
   EXPECT_NEAR(b.road->line().length(), 300, 0.5);
   EXPECT_NEAR(b.road->lane_width(), 3.5, 0.01);
+}
+
+TEST(RoadBuilderTest, TheOppositeLaneOfATwoWayRoadIsAnOncomingLaneOnTheLeft) {
+  ScenarioXml xml;
+  AddTwoWayRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(50, 50)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.route, std::vector<int>{1});
+  ASSERT_EQ(b.road->num_lanes(), 2);
+  EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2}, {1}}));
+  EXPECT_TRUE(b.road->Oncoming(0));
+  EXPECT_FALSE(b.road->Oncoming(1));
+  EXPECT_FALSE(b.road->Oncoming(2));
+  // Its bounds read in the road's direction: the shared centre line is its right border.
+  const map::Road::Span oncoming = b.road->LaneAt(0, 100), own = b.road->LaneAt(1, 100);
+  ASSERT_TRUE(oncoming.exists && own.exists);
+  EXPECT_NEAR(oncoming.left, -5.25, 0.01);
+  EXPECT_NEAR(oncoming.right, -1.75, 0.01);
+  EXPECT_NEAR(own.left, -1.75, 0.01);
+  EXPECT_NEAR(own.right, 1.75, 0.01);
+  EXPECT_NEAR(b.road->LaneEnd(0) - b.road->LaneBegin(0), b.road->LaneEnd(1) - b.road->LaneBegin(1),
+              0.01);
+  // A one-way road has none.
+  ScenarioXml one_way;
+  AddStraightRoad(one_way, 300).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(50, 50)});
+  const BuiltRoad o = Build(Parse(one_way));
+  ASSERT_NE(o.road, nullptr);
+  EXPECT_FALSE(o.road->Oncoming(0) || o.road->Oncoming(1));
 }
 
 TEST(RoadBuilderTest, ALaneDropKeepsTheReferenceOnTheLaneThatGoesOn) {

@@ -1,8 +1,9 @@
-// Builds small CommonRoad 2020a scenario files in the tests (straight, curved and lane-drop roads,
+// Builds small CommonRoad 2020a scenario files in the tests (straight, two-way, curved and lane-drop roads,
 // obstacles, planning problems with goals by lanelet, rectangle or time only), one element per
 // line so that a test can name the line an error must point at.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -207,6 +208,23 @@ inline ScenarioXml& AddStraightRoadAt(ScenarioXml& xml, Vec2 offset, double leng
 // The same at the origin.
 inline ScenarioXml& AddStraightRoad(ScenarioXml& xml, double length = 300) {
   return AddStraightRoadAt(xml, {}, length);
+}
+
+// A two-way road along +x from x = 0 to `length`, lanes 3.5 m wide: lanelet 1 driven +x
+// (y in [-3.5, 0]) and lanelet 2 driven -x (y in [0, 3.5], its points from x = length back to
+// 0), each the other's adjacent left in the opposite direction (their left bounds are the centre
+// line).
+inline ScenarioXml& AddTwoWayRoad(ScenarioXml& xml, double length = 300) {
+  LaneletXml ours = Lane(1, Line(0, length, 0), Line(0, length, -3.5));
+  ours.adjacent_left = {{2, false}};
+  ours.left_marking = "dashed";
+  std::vector<Vec2> centre = Line(0, length, 0), edge = Line(0, length, 3.5);
+  std::reverse(centre.begin(), centre.end());
+  std::reverse(edge.begin(), edge.end());
+  LaneletXml theirs = Lane(2, centre, edge);
+  theirs.adjacent_left = {{1, false}};
+  theirs.left_marking = "dashed";
+  return xml.Lanelet(ours).Lanelet(theirs);
 }
 
 // One lane of width 4 m along a left-turning arc about (0, radius): the centre line has the

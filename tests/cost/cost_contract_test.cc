@@ -145,6 +145,10 @@ Fixture RandomFixture(std::mt19937& rng) {
         r.v_lo = 25 * u(rng);
         r.v_hi = r.v_lo + 10 * u(rng);
       }
+      if (u(rng) < 0.4) {  // a heading interval, turned off the road's or not
+        r.h_lo = -0.5 + u(rng);
+        r.h_hi = r.h_lo + 0.4 * u(rng);
+      }
       f.goals.push_back(r);
     }
   }
@@ -164,6 +168,8 @@ Fixture RandomFixture(std::mt19937& rng) {
     f.strategy.push_back(g);
   }
   f.Wire();
+  // A two-way road's oncoming lane on the left half the time.
+  if (u(rng) < 0.5) f.ctx.oncoming_right = -2 + 6 * u(rng);
   return f;
 }
 

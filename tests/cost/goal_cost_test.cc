@@ -1,4 +1,5 @@
 // The goal term: how far a candidate misses a goal region within its time window.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -61,7 +62,7 @@ class GoalCostTest : public ::testing::Test {
     auto made = CostRegistry::Global().Make("goal");
     ASSERT_TRUE(made.ok()) << made.message();
     term_ = std::move(made.value());
-    const std::vector<double> params = {10.0, 1.75, 5.0, 0.05, 1.0, 10.0};
+    const std::vector<double> params = {10.0, 1.75, 5.0, 0.05, 1.0, 10.0, 1.0, 1.0};
     term_->Configure(params);
   }
   double Eval(const Case& c) const { return term_->Evaluate(c.ctx, c.in); }
@@ -124,6 +125,40 @@ TEST_F(GoalCostTest, HeadingOutsideItsIntervalCounts) {
   EXPECT_NEAR(Eval(c), 1 + (1.0 / 20 - std::tan(0.01)) / 0.05, 1e-9);
   c.goals[0].h_hi = std::tan(0.06);
   EXPECT_EQ(Eval(c), 0.0);
+}
+
+TEST_F(GoalCostTest, ARegionCrossedTurnedCreditsPassingAlongTheSideItIsEnteredFrom) {
+  // A strip d in [-1, 1] crossed moving right, turned 0.2 to 0.6 (tangents): entered from the
+  // left (smaller d). The candidate passes it at d = 2 going straight, then at d = -3.
+  GoalRegion g = Box(95, 105, 4, 6);
+  g.d_lo = -1;
+  g.d_hi = 1;
+  g.h_lo = 0.2;
+  g.h_hi = 0.6;
+  Case right(20, {g});
+  // On the far side: 1 m and 0.2 of heading off the region, or 3 m off the side band
+  // [-1 - 4, -1] (one lane width, 4 m by default) plus `approach` (1).
+  EXPECT_NEAR(Eval(right), 1 + std::min(1 / 1.75 + 0.2 / 0.05, 1 + 3 / 1.75), 1e-9);
+  Case left(20, {g});
+  for (double& d : left.d) d = -3;
+  EXPECT_NEAR(Eval(left), 1 + 1, 1e-9) << "in the side band: miss and approach only";
+  // Crossing it: at a tangent of 0.04, a miss; at 0.2, nothing.
+  Case swerve(20, {g});
+  for (int k = 0; k < kN; ++k) {
+    swerve.d[k] = -3 + 0.25 * k * 0.8;
+    swerve.d_d[k] = 0.8;
+  }
+  EXPECT_GT(Eval(swerve), 0.0);
+  for (int k = 0; k < kN; ++k) {
+    swerve.d[k] = -20 + 0.25 * k * 4;  // d = 0 at 5 s (s = 100), tangent 0.2
+    swerve.d_d[k] = 4;
+  }
+  EXPECT_EQ(Eval(swerve), 0.0);
+  // A region turned less than kTurnedHeading is kept in a lane: no side band.
+  g.h_lo = 0.5 * kTurnedHeading;
+  Case slight(20, {g});
+  for (double& d : slight.d) d = -3;
+  EXPECT_NEAR(Eval(slight), 1 + 2 / 1.75 + 0.5 * kTurnedHeading / 0.05, 1e-9);
 }
 
 TEST_F(GoalCostTest, ASlantedRegionFollowsItsSlope) {

@@ -225,6 +225,16 @@ TEST(SearchChecksTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
   // The same car in the ego's own lane at the start is its follower's business.
   st.Prepare({kS, 20, 0, 2.0, 0, 0}, {{kS - 10, 2.0, 20}});
   EXPECT_EQ(st.checker.FirstCollision(steady(kS, 20, 2.0), 1.0, 1.0), none);
+  // A stopped car 60 m ahead is hit headway_min at 20 m/s (10 m, 0.5 s) before bare boxes
+  // touch; a car coming the other way (a two-way road's oncoming lane) is passed, not followed:
+  // margin_s only.
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 60, 6.0, 0}});
+  const int stopped_bare = st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0);
+  EXPECT_GE(stopped_bare - st.checker.FirstCollision(steady(kS, 20, 6.0), 1.0), 4);
+  st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 60, 6.0, -20}});
+  const int oncoming_bare = st.checker.FirstCollision(steady(kS, 20, 6.0), 0.0);
+  ASSERT_LT(oncoming_bare, none);
+  EXPECT_LE(oncoming_bare - st.checker.FirstCollision(steady(kS, 20, 6.0), 1.0), 1);
 }
 
 }  // namespace

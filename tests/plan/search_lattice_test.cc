@@ -313,5 +313,61 @@ TEST(SearchLatticeTest, SlowerLanesOfABendGetTheirOwnLimit) {
   EXPECT_EQ(Count(plain.ws, cost::LonKind::kVelocityKeeping), c.speeds * c.durations);
 }
 
+// A goal region crossed turned: swerves into it, each paired only with the lon trajectories that
+// put it inside at its end, and checked up to there; none for a region kept in a lane.
+TEST(SearchLatticeTest, SwervesIntoARegionCrossedTurnedEndInsideItAndAreCheckedUpToThere) {
+  REQUIRE_UDACITY_MAP();
+  Stages st(GridOnly());
+  PrepareCentred(st, 20);
+  Workspace& ws = st.ws;
+  cost::GoalRegion g;
+  g.s_lo = kS + 50;
+  g.s_hi = kS + 90;
+  g.d_lo = ws.lane_center[1] - 1;
+  g.d_hi = ws.lane_center[1] + 1;
+  g.t_lo = 0;
+  g.t_hi = 5;
+  g.h_lo = 0.2;  // moving right, turned 0.2 to 0.5 (tangents)
+  g.h_hi = 0.5;
+  ws.goals[0] = g;
+  ws.num_goals = 1;
+  st.lattice.Generate();
+  int swerves = 0, paired = 0;
+  for (size_t j = 0; j < ws.lat.size(); ++j) {
+    const LatTraj& l = ws.lat[j];
+    if (l.goal < 0) continue;
+    ++swerves;
+    EXPECT_EQ(l.goal, 0);
+    const traj::State1d end = l.traj.At(l.traj.end_time());
+    EXPECT_GE(end.p, g.d_lo - 1e-9);
+    EXPECT_LE(end.p, g.d_hi + 1e-9);
+    EXPECT_GT(end.v, 0.2 * 20 - 1e-9) << "across at the heading, at the start's speed or more";
+    EXPECT_GE(end.a, -1e-9) << "still turning into the region or not, never out of it";
+  }
+  EXPECT_GT(swerves, 0);
+  for (size_t c = 0; c < ws.cand_lon.size(); ++c) {
+    const LatTraj& l = ws.lat[ws.cand_lat[c]];
+    if (l.goal < 0) {
+      EXPECT_EQ(ws.CheckTicks(static_cast<int>(c)), ws.n_ticks);
+      continue;
+    }
+    ++paired;
+    ASSERT_TRUE(ws.SwerveEndsInside(ws.cand_lon[c], ws.cand_lat[c]));
+    const traj::State1d lon = ws.lon[ws.cand_lon[c]].traj.At(l.traj.end_time());
+    EXPECT_GE(lon.p, g.s_lo);
+    EXPECT_LE(lon.p, g.s_hi);
+    const int ticks = ws.CheckTicks(static_cast<int>(c));
+    EXPECT_LT(ticks, ws.n_ticks);
+    EXPECT_NEAR(ticks * kTickSeconds, l.traj.end_time(), kTickSeconds);
+    EXPECT_LE(ws.CheckSteps(static_cast<int>(c)), ws.n_steps);
+  }
+  EXPECT_GT(paired, 0);
+  EXPECT_LT(paired, swerves * static_cast<int>(ws.lon.size())) << "the others are left out";
+  // Turned less than kTurnedHeading: a region kept in a lane, no swerve.
+  ws.goals[0].h_lo = 0.5 * cost::kTurnedHeading;
+  st.lattice.Generate();
+  for (const LatTraj& l : ws.lat) EXPECT_LT(l.goal, 0);
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search

@@ -17,9 +17,12 @@
 //     (5 m) past an open end of the network (a lanelet without predecessor or successor), as the
 //     verdict's road area does; at the map's own ends (where every lane ends) the lanes run on
 //     straight for 300 m, so that the planner does not stop at the edge of the map (a run ends
-//     at its goal; the verdict holds the ego to the lanelets up to there). Lanelets of the
-//     opposite direction are not part of the road (the verdict still counts them as road
-//     surface).
+//     at its goal; the verdict holds the ego to the lanelets up to there).
+//  5. Oncoming lane: on a two-way road, the opposite-direction lanelet beside the leftmost
+//     lanelet of each skeleton cross-section is one more lane on the left, marked
+//     LaneProfile::oncoming (for passing only: the `oncoming` cost term); lanelets of the
+//     opposite direction farther over are not part of the road (the verdict still counts
+//     every lanelet as road surface).
 #pragma once
 
 #include <memory>

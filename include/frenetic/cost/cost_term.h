@@ -54,6 +54,9 @@ struct CostContext {
   // faster in XY than in s).
   double lane_speed_limit[kMaxLanes] = {};
   double lane_center[kMaxLanes] = {};  // d of each lane's centre, m
+  // A two-way road: the right border (d, m) of the oncoming lane on the left, at the start's s
+  // (-infinity: none, as on the Udacity track and one-way roads).
+  double oncoming_right = -std::numeric_limits<double>::infinity();
   // The start state.
   double start_s = 0, start_d = 0, start_speed = 0;
   int current_lane = 0;  // lane whose centre is nearest start_d

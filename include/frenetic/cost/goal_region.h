@@ -25,4 +25,15 @@ struct GoalRegion {
 
 inline constexpr int kMaxGoalRegions = 8;
 
+// A region crossed turned: its headings leave out the road's own by more than kTurnedHeading (as
+// a tangent, ~6 degrees), to the right (+1: d grows) or the left (-1); 0 otherwise. Reached by a
+// swerve from beside it (the search planner's lattice offers them), not by keeping a lane; a
+// smaller offset is within what keeping a lane near the region's edge gives.
+inline constexpr double kTurnedHeading = 0.1;
+inline int CrossedTurned(const GoalRegion& r) {
+  if (r.h_lo > kTurnedHeading) return 1;
+  if (r.h_hi < -kTurnedHeading) return -1;
+  return 0;
+}
+
 }  // namespace frenetic::cost

@@ -21,6 +21,9 @@ namespace frenetic::map {
 struct LaneProfile {
   std::vector<double> s, left, right;  // m
   double speed_limit = std::numeric_limits<double>::infinity();  // m/s
+  // Driven the other way (a two-way road's opposite lane): only for passing, against oncoming
+  // traffic.
+  bool oncoming = false;
 };
 
 class Road {
@@ -62,6 +65,7 @@ class Road {
   double LaneBegin(int lane) const;
   double LaneEnd(int lane) const;
   double SpeedLimit(int lane) const;  // m/s, +inf when none
+  bool Oncoming(int lane) const;      // LaneProfile::oncoming (false outside the lanes)
   // The road's edges at s: the leftmost existing lane's left border and the rightmost's right
   // border (exists false when no lane exists there).
   Span EdgesAt(double s) const;
