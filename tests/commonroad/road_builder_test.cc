@@ -37,6 +37,16 @@ BuiltRoad Build(const Scenario& sc, int problem = 0) {
   return r.ok() ? *r : BuiltRoad{};
 }
 
+// Two 3.5 m lanes at s = 100 about lanelet 1's centre line (the reference): lane 0 left of it.
+void ExpectLanesBesideLanelet1(const BuiltRoad& b) {
+  const map::Road::Span left = b.road->LaneAt(0, 100), right = b.road->LaneAt(1, 100);
+  ASSERT_TRUE(left.exists && right.exists);
+  EXPECT_NEAR(left.left, -5.25, 0.01);
+  EXPECT_NEAR(left.right, -1.75, 0.01);
+  EXPECT_NEAR(right.left, -1.75, 0.01);
+  EXPECT_NEAR(right.right, 1.75, 0.01);
+}
+
 TEST(RoadBuilderTest, TwoLanesOfAStraightRoad) {
   ScenarioXml xml;
   AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(50, 50)});
@@ -48,12 +58,7 @@ TEST(RoadBuilderTest, TwoLanesOfAStraightRoad) {
   ASSERT_EQ(b.road->num_lanes(), 2);
   EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2}, {1}}));
   // The reference is lanelet 1's centre (y = -1.75): lanelet 2 is left of it.
-  const map::Road::Span left = b.road->LaneAt(0, 100), right = b.road->LaneAt(1, 100);
-  ASSERT_TRUE(left.exists && right.exists);
-  EXPECT_NEAR(left.left, -5.25, 0.01);
-  EXPECT_NEAR(left.right, -1.75, 0.01);
-  EXPECT_NEAR(right.left, -1.75, 0.01);
-  EXPECT_NEAR(right.right, 1.75, 0.01);
+  ExpectLanesBesideLanelet1(b);
   EXPECT_NEAR(b.road->line().length(), 300, 0.5);
   EXPECT_NEAR(b.road->lane_width(), 3.5, 0.01);
 }
@@ -70,12 +75,7 @@ TEST(RoadBuilderTest, TheOppositeLaneOfATwoWayRoadIsAnOncomingLaneOnTheLeft) {
   EXPECT_FALSE(b.road->Oncoming(1));
   EXPECT_FALSE(b.road->Oncoming(2));
   // Its bounds read in the road's direction: the shared centre line is its right border.
-  const map::Road::Span oncoming = b.road->LaneAt(0, 100), own = b.road->LaneAt(1, 100);
-  ASSERT_TRUE(oncoming.exists && own.exists);
-  EXPECT_NEAR(oncoming.left, -5.25, 0.01);
-  EXPECT_NEAR(oncoming.right, -1.75, 0.01);
-  EXPECT_NEAR(own.left, -1.75, 0.01);
-  EXPECT_NEAR(own.right, 1.75, 0.01);
+  ExpectLanesBesideLanelet1(b);
   EXPECT_NEAR(b.road->LaneEnd(0) - b.road->LaneBegin(0), b.road->LaneEnd(1) - b.road->LaneBegin(1),
               0.01);
   // A one-way road has none.
