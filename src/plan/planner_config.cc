@@ -61,6 +61,7 @@ constexpr Default kDefaults[] = {
     {"grid.lane_reach", 2.5, 1, 4, false},
     {"grid.lat_delays", 2, 0, 4, false},
     {"grid.lat_delay_step", 1.5, 0.5, 3, false},
+    {"grid.passes", 1, 0, 1, false},
     {"score.dt", 0.25, 0.1, 0.5, false},
     {"score.horizon", 6, 3, 8, false},
     {"check.horizon", 5, 2, 8, false},

@@ -44,6 +44,7 @@ void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
   for (int l = 0; l < cfg.num_lanes; ++l) {
     const map::Road::Span now = road.LaneAt(l, s0), ahead = road.LaneAt(l, look);
     ws.lane_exists[l] = now.exists;
+    ws.lane_oncoming[l] = road.Oncoming(l);
     if (now.exists) {
       ws.lane_nominal[l] = ahead.exists ? ahead.centre() : now.centre();
     } else {

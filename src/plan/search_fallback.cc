@@ -22,9 +22,10 @@ void BuildFallback(const Settings& cfg, Workspace& ws, const Checker& checker) {
                             std::min(2 * cfg.fallback_decel, 0.75 * cfg.max_accel),
                             0.9 * cfg.max_accel};
   const int lane = LaneOf(cfg, ws, start.d);
-  traj::Trajectory1d lat{traj::SolveQuintic(start.d, start.d_d, start.d_dd, ws.lane_center[lane], 0,
-                                            0, cfg.fallback_lat_duration),
-                         cfg.fallback_lat_duration};
+  traj::Trajectory1d lat;
+  lat.poly = traj::SolveQuintic(start.d, start.d_d, start.d_dd, ws.lane_center[lane], 0, 0,
+                                cfg.fallback_lat_duration);
+  lat.duration = cfg.fallback_lat_duration;
   for (int level = 0; level < 3; ++level) {
     const double decel = levels[level];
     const double jerk = std::min(cfg.fallback_jerk, 0.8 * cfg.max_jerk);

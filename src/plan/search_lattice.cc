@@ -35,6 +35,14 @@ constexpr double kSwerveReachAccel = 5.0;
 constexpr int kSwerveSpeeds = 3;
 constexpr double kSwerveSpeedStep = 3.0;  // m/s
 constexpr double kSwerveEndAccels[] = {0.0, 6.0, 9.0};  // m/s^2 across, toward the heading
+// Passes on a two-way road (Lattice::AddPasses): the moves out and back and the hold between
+// (s); how much slower than the ego (m/s) the car ahead must be; and the time (s) below which a
+// phase under way counts as done.
+constexpr double kPassOut[] = {1.5, 2.5};
+constexpr double kPassHold[] = {0.0, 1.0, 2.0, 3.0};
+constexpr double kPassBack[] = {1.5, 2.5};
+constexpr double kPassMinGain = 2.0;
+constexpr double kPassResolve = 0.05;
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -55,10 +63,10 @@ void Lattice::AddLon(const LonTraj& l) {
 }
 
 void Lattice::AddLat(const LatTraj& l) {
-  if (!l.traj.poly.IsFinite()) return;
+  if (!l.traj.IsFinite()) return;
   const int i = static_cast<int>(ws_.lat.size());
   ws_.lat.push_back(l);
-  ws_.lat.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
+  ws_.lat.back().jerk2 = l.traj.JerkSquared();
   const int n = ws_.n_samples;
   const double dt = cfg_.score_dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
@@ -205,6 +213,60 @@ void Lattice::AddSwerveUnderWay() {
       l.traj.duration = lon_left;
       l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, le.p, le.v, le.a, lon_left);
       AddLon(l);
+    }
+  }
+}
+
+// On a two-way road, past a slow car ahead in the lane beside the oncoming lane: out into the
+// oncoming lane's centre, a while there, and back to the own lane's centre (kPassOut x kPassHold x
+// kPassBack), each checked over the whole horizon like any move: a lane change into the
+// oncoming lane and staying there meets its traffic within the horizon, a pass need not. The
+// pass under way goes on: its move out to the same end (and the same hold and move back), or,
+// from its hold on, a lane change back that waits out the hold.
+void Lattice::AddPasses() {
+  const traj::FrenetState& s0 = ws_.start;
+  if (ws_.have_prev_traj && ws_.prev_pass) {
+    const traj::Trajectory1d& prev = ws_.prev_traj.lat;
+    const double elapsed = ws_.prev_elapsed;
+    const int own = ws_.prev_lat_lane;
+    if (elapsed < prev.duration - kPassResolve) {
+      LatTraj l;
+      l.lane = own;
+      l.pass = true;
+      l.traj = prev;
+      l.traj.duration = prev.duration - elapsed;
+      const traj::State1d out = prev.poly.At(prev.duration);
+      l.traj.poly = traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, out.p, 0.0, 0.0, l.traj.duration);
+      AddLat(l);
+    } else if (elapsed < prev.duration + prev.hold - kPassResolve) {
+      AddLat(MakeLat(own, 0.0, prev.back_duration, prev.duration + prev.hold - elapsed));
+    } else if (prev.end_time() - elapsed > kPassResolve) {
+      AddLat(MakeLat(own, 0.0, prev.end_time() - elapsed));
+    }
+  }
+  if (!cfg_.passes || !(ws_.ctx.oncoming_right > -1e300)) return;
+  const int own = LaneOf(cfg_, ws_, s0.d);
+  const int oncoming = own - 1;
+  if (oncoming < 0 || !ws_.lane_oncoming[oncoming] || !ws_.lane_exists[oncoming] ||
+      ws_.lane_oncoming[own]) {
+    return;
+  }
+  const int lead = Leader(own);
+  if (lead < 0 || !(ws_.car_v[lead * ws_.n_samples] < s0.s_d - kPassMinGain)) return;
+  for (const double out : kPassOut) {
+    for (const double hold : kPassHold) {
+      for (const double back : kPassBack) {
+        LatTraj l;
+        l.lane = own;
+        l.pass = true;
+        const double d_out = ws_.lane_center[oncoming], d_own = ws_.lane_center[own];
+        l.traj.duration = out;
+        l.traj.poly = traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, d_out, 0.0, 0.0, out);
+        l.traj.hold = hold;
+        l.traj.back_duration = back;
+        l.traj.back = traj::SolveQuintic(d_out, 0.0, 0.0, d_own, 0.0, 0.0, back);
+        AddLat(l);
+      }
     }
   }
 }
@@ -427,7 +489,7 @@ void Lattice::Generate() {
     // The lateral move under way, to its planned end time: replanning with full durations
     // every cycle would stretch a lane change indefinitely (more time astride the line), and
     // a waiting one would never start.
-    if (ws_.have_prev_traj && l == ws_.prev_lat_lane) {
+    if (ws_.have_prev_traj && l == ws_.prev_lat_lane && !ws_.prev_pass) {
       const traj::Trajectory1d& prev = ws_.prev_traj.lat;
       const double wait = prev.delay - ws_.prev_elapsed;
       const double remaining = prev.end_time() - ws_.prev_elapsed;
@@ -440,6 +502,7 @@ void Lattice::Generate() {
   }
   AddSwerves();
   AddSwerveUnderWay();
+  AddPasses();
   for (int i = 0; i < static_cast<int>(ws_.lon.size()); ++i) {
     for (int j = 0; j < static_cast<int>(ws_.lat.size()); ++j) {
       if (ws_.lon[i].lane >= 0 && ws_.lon[i].lane != ws_.lat[j].lane) continue;

@@ -26,14 +26,16 @@ struct LonTraj {
   double jerk2 = 0;
 };
 
-// One lateral move of the bundle: to `lane`'s centre plus `offset` (m); or a swerve into goal
-// region `goal` (>= 0), crossing it turned at the end of the move (Lattice::AddSwerves).
+// One lateral move of the bundle: to `lane`'s centre plus `offset` (m); a swerve into goal
+// region `goal` (>= 0), crossing it turned at the end of the move (Lattice::AddSwerves); or a
+// pass, out into the oncoming lane and back to `lane` (Lattice::AddPasses).
 struct LatTraj {
   traj::Trajectory1d traj;
   int lane = 0;
   double offset = 0;
   double jerk2 = 0;
   int goal = -1;
+  bool pass = false;  // out into the oncoming lane and back (Lattice::AddPasses)
 };
 
 class Lattice {
@@ -63,6 +65,7 @@ class Lattice {
   void AddAccelerating(const bool reachable[], double vmax);
   void AddSwerves();
   void AddSwerveUnderWay();
+  void AddPasses();
   int Leader(int lane) const;
   int Alongside(int lane) const;
 

@@ -259,7 +259,7 @@ cost::CostInput Scorer::SampleForCost(const traj::FrenetTrajectory& tr, const Lo
   in.lon_duration = tr.lon.duration;
   in.lat_duration = tr.lat.duration;
   in.lon_jerk_squared = tr.lon.poly.JerkSquaredIntegral(tr.lon.duration);
-  in.lat_jerk_squared = tr.lat.poly.JerkSquaredIntegral(tr.lat.duration);
+  in.lat_jerk_squared = tr.lat.JerkSquared();
   in.end_speed = tr.lon.poly.V(tr.lon.duration);
   in.end_d = ref_d_[ws_.n_samples - 1];
   in.target_lane = dbase.lane;

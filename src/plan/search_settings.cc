@@ -61,6 +61,7 @@ Settings::Settings(const PlannerConfig& c) {
   lat_offset_step = c.value("grid.lat_offset_step");
   lane_reach = c.value("grid.lane_reach");
   lat_delays = c.int_value("grid.lat_delays");
+  passes = c.int_value("grid.passes") != 0;
   lat_delay_step = c.value("grid.lat_delay_step");
   score_dt = c.value("score.dt");
   score_horizon = c.value("score.horizon");

@@ -61,6 +61,7 @@ struct Settings {
   double lat_offset_step;
   double lane_reach;          // lane widths: lanes whose centre is this near are targets
   int lat_delays;
+  bool passes;  // passes on a two-way road's oncoming lane (Lattice::AddPasses)
   double lat_delay_step;
   double score_dt, score_horizon;
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;

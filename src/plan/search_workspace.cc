@@ -30,7 +30,7 @@ Workspace::Workspace(const Settings& cfg) {
                       cfg.accels * (cfg.num_lanes + 1) + 9;
   const int max_lat =
       cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + kMaxSwerves +
-      9;
+      kMaxPasses + 9;
   lon.reserve(max_lon);
   lat.reserve(max_lat);
   for (auto* v : {&lon_s, &lon_sd, &lon_sdd}) v->assign(max_lon * n_samples, 0.0);

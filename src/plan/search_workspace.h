@@ -34,6 +34,8 @@ class CycleClock {
 // Swerves into goal regions a cycle offers at most (Lattice::AddSwerves), besides the one under
 // way.
 inline constexpr int kMaxSwerves = 216;
+// Passes a cycle offers at most (Lattice::AddPasses), the one under way included.
+inline constexpr int kMaxPasses = 17;
 
 struct Workspace {
   explicit Workspace(const Settings& cfg);
@@ -82,6 +84,7 @@ struct Workspace {
   double lane_nominal[cost::kMaxLanes] = {};  // the road's lane centres (uniform: fixed), m
   double lane_center[cost::kMaxLanes] = {};   // this cycle's (moved off the lane lines), m
   bool lane_exists[cost::kMaxLanes] = {};     // the lane is there at the start's s
+  bool lane_oncoming[cost::kMaxLanes] = {};   // a two-way road's oncoming lane (Road::Oncoming)
   // The road's edges at the start (the lateral moves' range), m, and for the off-road check on
   // a road that is not uniform, its edges over the stretch ahead: edge_lo / edge_hi[b] are the
   // largest left and the smallest right edge over s in edge_s0 + [b, b + 1] * kEdgeBin (NaN
@@ -157,6 +160,7 @@ struct Workspace {
   int prev_lat_lane = -1;  // lane and end offset (m) of the previous winner's lateral move
   double prev_lat_offset = 0;
   int prev_swerve_goal = -1;  // the goal region the previous winner swerved into, or -1
+  bool prev_pass = false;     // the previous winner's lateral move was a pass
   double time_since_change = 1e9;
 };
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -40,7 +41,8 @@ plan::PlannerConfig Config(PredictionMode mode = PredictionMode::kRecorded) {
   return *c;
 }
 
-ProblemRun RunOne(const ScenarioXml& xml, PredictionMode mode = PredictionMode::kRecorded) {
+ProblemRun RunOne(const ScenarioXml& xml, PredictionMode mode = PredictionMode::kRecorded,
+                  const plan::PlannerConfig* config = nullptr) {
   if (const char* dump = std::getenv("FRENETIC_TEST_DUMP"); dump != nullptr) {
     std::ofstream(dump) << xml.Str();
   }
@@ -49,7 +51,7 @@ ProblemRun RunOne(const ScenarioXml& xml, PredictionMode mode = PredictionMode::
   RunOptions o;
   o.prediction = mode;
   o.timing = false;
-  const ScenarioRun run = RunScenario(*sc, Config(mode), o);
+  const ScenarioRun run = RunScenario(*sc, config != nullptr ? *config : Config(mode), o);
   EXPECT_EQ(run.problems.size(), 1u);
   return run.problems.empty() ? ProblemRun{} : run.problems[0];
 }
@@ -139,6 +141,36 @@ TEST(RunnerTest, PassesABlockedLaneOnTheOncomingLaneAndCutsBackInTurned) {
   EXPECT_FALSE(blocked.verdict.solved);
   ASSERT_NE(blocked.verdict.Find(FailureKind::kGoal), nullptr) << blocked.verdict.Summary();
   EXPECT_EQ(blocked.verdict.failures.size(), 1u) << blocked.verdict.Summary();
+}
+
+TEST(RunnerTest, PassesAParkedTruckBeforeTheOncomingCarComes) {
+  // A two-way road; a truck parked across the ego's lane 140 m ahead; a car coming the other
+  // way meets the ego near the truck some seconds after it gets there. A lane change into the
+  // oncoming lane that stays there meets that car within the horizon; out and back (a pass)
+  // does not. The goal, in the ego's lane past the truck, closes at 15 s: waiting for the car
+  // to go by first is too late.
+  auto xml = [] {
+    ScenarioXml x;
+    AddTwoWayRoad(x, 600)
+        .StaticObstacle(9, 6.0, 3.0, {150, -1.75}, 0)
+        .DynamicObstacle(7, 4.8, 2.0, [] {
+          std::vector<StateXml> s;  // from x = 350 at 15 m/s the other way
+          for (int k = 0; k <= 150; ++k) {
+            s.push_back({k, {350 - 15 * 0.1 * k, 1.75}, std::numbers::pi, 15});
+          }
+          return s;
+        }())
+        .Problem(1, {10, -1.75}, 0, 15, {GoalRectangleXml({210, -1.75}, 40, 3.0, 0, 0, 150)});
+    return x;
+  }();
+  const ProblemRun p = RunOne(xml);
+  ASSERT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  // Without passes the ego waits behind the truck for the car.
+  plan::PlannerConfig no_passes = Config();
+  ASSERT_TRUE(no_passes.Set("grid.passes", 0).ok());
+  const ProblemRun waited = RunOne(xml, PredictionMode::kRecorded, &no_passes);
+  EXPECT_FALSE(waited.verdict.solved);
+  EXPECT_EQ(waited.verdict.Find(FailureKind::kCollision), nullptr) << waited.verdict.Summary();
 }
 
 TEST(RunnerTest, LeavesAnEndingLaneForTheGoal) {

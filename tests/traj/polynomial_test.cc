@@ -86,17 +86,35 @@ TEST(PolynomialTest, DegenerateDurationKeepsStartState) {
   EXPECT_DOUBLE_EQ(p.V(0), 4);
 }
 
+// A one-move trajectory: `poly` over `duration` after `delay`.
+Trajectory1d Move(const Polynomial5& poly, double duration, double delay = 0) {
+  Trajectory1d t;
+  t.poly = poly;
+  t.duration = duration;
+  t.delay = delay;
+  return t;
+}
+
+// Out from 0 to -3.5 in 2 s, 1 s there, back to 0 in 1.5 s: a pass.
+Trajectory1d Pass() {
+  Trajectory1d t = Move(SolveQuintic(0, 0, 0, -3.5, 0, 0, 2.0), 2.0);
+  t.hold = 1.0;
+  t.back = SolveQuintic(-3.5, 0, 0, 0, 0, 0, 1.5);
+  t.back_duration = 1.5;
+  return t;
+}
+
 TEST(TrajectoryTest, ContinuesAtConstantVelocityAfterItsEnd) {
-  Trajectory1d t{SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0};
+  Trajectory1d t = Move(SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0);
   const State1d end = t.At(3.0), later = t.At(5.0);
   EXPECT_NEAR(later.v, 20, 1e-9);
   EXPECT_NEAR(later.p, end.p + 2 * 20, 1e-9);
   EXPECT_EQ(later.a, 0);
-  FrenetTrajectory ft{t, Trajectory1d{SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0}};
+  FrenetTrajectory ft{t, Move(SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0)};
   EXPECT_NEAR(ft.At(2.5).d, 2, 1e-9);
   EXPECT_TRUE(ft.At(1.0).IsFinite());
   // A delayed lane change holds its start for the delay, then follows the quintic, shifted.
-  Trajectory1d wait{SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5};
+  Trajectory1d wait = Move(SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5);
   EXPECT_EQ(wait.end_time(), 3.5);
   EXPECT_EQ(wait.At(0.0).p, 6);
   EXPECT_EQ(wait.At(1.4).p, 6);
@@ -106,11 +124,32 @@ TEST(TrajectoryTest, ContinuesAtConstantVelocityAfterItsEnd) {
   EXPECT_NEAR(wait.At(10).p, 2, 1e-9);
 }
 
+TEST(TrajectoryTest, APassGoesOutHoldsThereAndComesBack) {
+  const Trajectory1d pass = Pass();
+  EXPECT_EQ(pass.end_time(), 4.5);
+  EXPECT_NEAR(pass.At(1.0).p, -1.75, 1e-9);  // halfway out
+  EXPECT_NEAR(pass.At(2.5).p, -3.5, 1e-9);   // held
+  EXPECT_NEAR(pass.At(2.5).v, 0.0, 1e-9);
+  EXPECT_NEAR(pass.At(3.0 + 0.75).p, -1.75, 1e-9);  // halfway back
+  EXPECT_NEAR(pass.At(9.0).p, 0.0, 1e-9);
+  EXPECT_EQ(pass.At(9.0).v, 0.0);
+  EXPECT_TRUE(pass.IsFinite());
+  EXPECT_NEAR(pass.JerkSquared(), pass.poly.JerkSquaredIntegral(2.0) +
+                                      pass.back.JerkSquaredIntegral(1.5), 1e-9);
+  // Without the move back it is the move out, continued.
+  Trajectory1d out = pass;
+  out.back_duration = 0;
+  EXPECT_EQ(out.end_time(), 2.0);
+  EXPECT_NEAR(out.At(9.0).p, -3.5, 1e-9);
+  EXPECT_EQ(out.JerkSquared(), out.poly.JerkSquaredIntegral(2.0));
+}
+
 TEST(TrajectoryTest, SampleGivesAtsValuesExactly) {
-  // Before the delay, on the polynomial, past its end; and NaN times: bit for bit At's values.
-  const Trajectory1d trs[] = {{SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0},
-                              {SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5},
-                              {SolveQuintic(0, 20, 1, 90, 15, 0, 4.7), 4.7, 0.3}};
+  // Before the delay, on the polynomial, past its end, a pass's hold and move back; and NaN
+  // times: bit for bit At's values.
+  const Trajectory1d trs[] = {Move(SolveQuartic(0, 10, 0, 20, 0, 3.0), 3.0),
+                              Move(SolveQuintic(6, 0, 0, 2, 0, 0, 2.0), 2.0, 1.5),
+                              Move(SolveQuintic(0, 20, 1, 90, 15, 0, 4.7), 4.7, 0.3), Pass()};
   constexpr int kN = 61;
   const auto time = [](int k) { return k == kN - 1 ? NAN : k * 0.1; };
   for (const Trajectory1d& tr : trs) {

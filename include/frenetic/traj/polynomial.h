@@ -39,15 +39,34 @@ Polynomial5 SolveQuartic(double x0, double v0, double a0, double v1, double a1, 
 // its end: the lattice's trajectories all end with zero acceleration, so the continuation is C1
 // and, for those, C2. With a delay the motion holds still at the polynomial's start for that long
 // and follows it after (a lane change that waits): for polynomials that start at rest, this is C2.
+// With a second move (back_duration > 0: a pass, out into a lane and back), the continuation
+// lasts `hold` s, then `back` (which starts where the continuation is then) runs over
+// back_duration, continued likewise.
 struct Trajectory1d {
   Polynomial5 poly;
   double duration = 0;  // s, of the polynomial
   double delay = 0;     // s before the polynomial starts
-  double end_time() const { return delay + duration; }
+  Polynomial5 back;
+  double hold = 0, back_duration = 0;  // s
+  double end_time() const {
+    return back_duration > 0 ? delay + duration + hold + back_duration : delay + duration;
+  }
+  // The integral of the squared jerk over the moves.
+  double JerkSquared() const {
+    const double j = poly.JerkSquaredIntegral(duration);
+    return back_duration > 0 ? j + back.JerkSquaredIntegral(back_duration) : j;
+  }
+  bool IsFinite() const { return poly.IsFinite() && (back_duration <= 0 || back.IsFinite()); }
   State1d At(double t) const {
     if (t < delay) return {poly.c[0], 0.0, 0.0, 0.0};
     t -= delay;
     if (t <= duration) return poly.At(t);
+    if (back_duration > 0 && t > duration + hold) {
+      const double u = t - duration - hold;
+      if (u <= back_duration) return back.At(u);
+      const State1d b = back.At(back_duration);
+      return {b.p + b.v * (u - back_duration), b.v, 0.0, 0.0};
+    }
     const State1d e = poly.At(duration);
     return {e.p + e.v * (t - duration), e.v, 0.0, 0.0};
   }
@@ -57,6 +76,8 @@ struct Trajectory1d {
   template <typename Time>
   void Sample(int k0, int k1, Time time, double* p, double* v, double* a) const {
     const double end_p = poly.P(duration), end_v = poly.V(duration);
+    const double back_p = back_duration > 0 ? back.P(back_duration) : 0.0;
+    const double back_v = back_duration > 0 ? back.V(back_duration) : 0.0;
     for (int k = k0; k < k1; ++k) {
       double t = time(k);
       if (t < delay) {
@@ -70,6 +91,17 @@ struct Trajectory1d {
         p[k] = poly.P(t);
         v[k] = poly.V(t);
         if (a != nullptr) a[k] = poly.A(t);
+      } else if (back_duration > 0 && t > duration + hold) {
+        const double u = t - duration - hold;
+        if (u <= back_duration) {
+          p[k] = back.P(u);
+          v[k] = back.V(u);
+          if (a != nullptr) a[k] = back.A(u);
+        } else {
+          p[k] = back_p + back_v * (u - back_duration);
+          v[k] = back_v;
+          if (a != nullptr) a[k] = 0.0;
+        }
       } else {
         p[k] = end_p + end_v * (t - duration);
         v[k] = end_v;
