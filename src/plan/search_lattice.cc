@@ -220,9 +220,10 @@ void Lattice::AddSwerveUnderWay() {
 // On a two-way road, past a slow car ahead in the lane beside the oncoming lane: out into the
 // oncoming lane's centre, a while there, and back to the own lane's centre (kPassOut x kPassHold x
 // kPassBack), each checked over the whole horizon like any move: a lane change into the
-// oncoming lane and staying there meets its traffic within the horizon, a pass need not. The
-// pass under way goes on: its move out to the same end (and the same hold and move back), or,
-// from its hold on, a lane change back that waits out the hold.
+// oncoming lane and staying there meets its traffic within the horizon, a pass need not. None
+// toward a goal crossed turned (swerves reach those). The pass under way goes on: its move out
+// to the same end (and the same hold and move back), or, from its hold on, a lane change back
+// that waits out the hold.
 void Lattice::AddPasses() {
   const traj::FrenetState& s0 = ws_.start;
   if (ws_.have_prev_traj && ws_.prev_pass) {
@@ -245,6 +246,10 @@ void Lattice::AddPasses() {
     }
   }
   if (!cfg_.passes || !(ws_.ctx.oncoming_right > -1e300)) return;
+  // A goal crossed turned is reached by a swerve (AddSwerves), which a pass never ends in.
+  for (int g = 0; g < ws_.num_goals; ++g) {
+    if (cost::CrossedTurned(ws_.goals[g]) != 0) return;
+  }
   const int own = LaneOf(cfg_, ws_, s0.d);
   const int oncoming = own - 1;
   if (oncoming < 0 || !ws_.lane_oncoming[oncoming] || !ws_.lane_exists[oncoming] ||
