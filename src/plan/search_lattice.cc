@@ -35,6 +35,9 @@ constexpr double kSwerveReachAccel = 5.0;
 constexpr int kSwerveSpeeds = 3;
 constexpr double kSwerveSpeedStep = 3.0;  // m/s
 constexpr double kSwerveEndAccels[] = {0.0, 6.0, 9.0};  // m/s^2 across, toward the heading
+// A swerve that ended before the goal was met goes on kSwerveLate s at a time (a CommonRoad
+// step), for at most kSwerveOverrun s past its end.
+constexpr double kSwerveLate = 0.1, kSwerveOverrun = 0.3;
 // Passes on a two-way road (Lattice::AddPasses): the moves out and back and the hold between
 // (s); how much slower than the ego (m/s) the car ahead must be; and the time (s) below which a
 // phase under way counts as done.
@@ -214,6 +217,13 @@ void Lattice::AddSwerveUnderWay() {
       l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, le.p, le.v, le.a, lon_left);
       AddLon(l);
     }
+  } else if (remaining > -kSwerveOverrun) {
+    // Ended between two of the problem's steps, the goal not met yet: on as it goes (constant
+    // lateral acceleration) for kSwerveLate s more, a swerve where that is still in the region.
+    const traj::FrenetState& s0 = ws_.start;
+    const double T = kSwerveLate;
+    AddLat(MakeSwerve(ws_.prev_swerve_goal, s0.d + s0.d_d * T + 0.5 * s0.d_dd * T * T,
+                      s0.d_d + s0.d_dd * T, T, s0.d_dd));
   }
 }
 

@@ -369,5 +369,49 @@ TEST(SearchLatticeTest, SwervesIntoARegionCrossedTurnedEndInsideItAndAreCheckedU
   for (const LatTraj& l : ws.lat) EXPECT_LT(l.goal, 0);
 }
 
+// A swerve that ended between two of the problem's steps, its goal not met: it goes on as it
+// goes for one more step (constant lateral acceleration), while that is in the region; not
+// long past its end.
+TEST(SearchLatticeTest, ASwerveThatEndedBeforeItsGoalGoesOnOneStepAtATime) {
+  REQUIRE_UDACITY_MAP();
+  Stages st(GridOnly());
+  PrepareCentred(st, 20, 4.0);  // moving right at 4 m/s
+  Workspace& ws = st.ws;
+  ws.start.d_dd = 2.0;
+  cost::GoalRegion g;
+  g.s_lo = kS - 10;
+  g.s_hi = kS + 30;
+  g.d_lo = ws.start.d - 1;
+  g.d_hi = ws.start.d + 1;
+  g.t_lo = 0;
+  g.t_hi = 5;
+  g.h_lo = 0.15;
+  g.h_hi = 0.5;
+  ws.goals[0] = g;
+  ws.num_goals = 1;
+  ws.have_prev_traj = true;
+  ws.prev_swerve_goal = 0;
+  ws.prev_traj.lat = {};
+  ws.prev_traj.lat.duration = 1.0;
+  ws.prev_elapsed = 1.05;  // 0.05 s past its end
+  st.lattice.Generate();
+  int late = 0;
+  for (const LatTraj& l : ws.lat) {
+    if (l.goal < 0 || std::abs(l.traj.duration - 0.1) > 1e-12) continue;
+    ++late;
+    const traj::State1d end = l.traj.At(0.1);
+    EXPECT_NEAR(end.p, ws.start.d + 4.0 * 0.1 + 0.5 * 2.0 * 0.01, 1e-9);
+    EXPECT_NEAR(end.v, 4.0 + 2.0 * 0.1, 1e-9);
+    EXPECT_NEAR(end.a, 2.0, 1e-9);
+  }
+  EXPECT_EQ(late, 1);
+  // Long past its end: none.
+  ws.prev_elapsed = 2.0;
+  st.lattice.Generate();
+  for (const LatTraj& l : ws.lat) {
+    EXPECT_FALSE(l.goal >= 0 && std::abs(l.traj.duration - 0.1) < 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search
