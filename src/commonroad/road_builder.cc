@@ -456,30 +456,33 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   for (const Section& sec : sections) {
     for (const auto& [j, pos] : sec.lanelets) place(j, pos);
   }
-  for (size_t k = 0; k < skeleton.size(); ++k) {
-    for (const auto& [j, pos] : net.CrossSection(skeleton[k])) place(j, offset[k] + pos);
-  }
-  // The opposite lanelet beside a cross-section's leftmost one (a two-way road): a lane driven
-  // the other way, at the next position to the left, its bounds read in the road's direction.
+  // With each skeleton lanelet's cross-section, the opposite lanelet beside its leftmost one (a
+  // two-way road): a lane driven the other way, at the next position to the left, its bounds
+  // read in the road's direction.
   std::set<int> oncoming;
+  std::vector<std::pair<int, int>> opposite;  // lanelet, lateral position
   for (size_t k = 0; k < skeleton.size(); ++k) {
     int leftmost = skeleton[k], left_pos = 0;
     for (const auto& [j, pos] : net.CrossSection(skeleton[k])) {
+      place(j, offset[k] + pos);
       if (pos < left_pos) {
         leftmost = j;
         left_pos = pos;
       }
     }
     const std::optional<Adjacent>& a = net.at(leftmost).adjacent_left;
-    if (!a.has_value() || a->same_direction) continue;
-    const int o = net.Index(a->id);
+    if (a.has_value() && !a->same_direction) {
+      opposite.push_back({net.Index(a->id), offset[k] + left_pos - 1});
+    }
+  }
+  for (const auto& [o, pos] : opposite) {
     if (o < 0 || !placed.insert(o).second) continue;
     Lanelet reversed = net.at(o);
     reversed.left.assign(net.at(o).right.rbegin(), net.at(o).right.rend());
     reversed.right.assign(net.at(o).left.rbegin(), net.at(o).left.rend());
     Stations st = Project(reversed, **line);
     if (st.s.size() < 2) continue;
-    by_position[offset[k] + left_pos - 1].push_back({o, std::move(st)});
+    by_position[pos].push_back({o, std::move(st)});
     oncoming.insert(o);
   }
   BuiltRoad out;

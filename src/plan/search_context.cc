@@ -37,7 +37,8 @@ void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace&
 // The lanes of a road that is not uniform, this cycle: each lane there at the start's s, its
 // centre where a lateral move would end (lookahead), and the road's edges over the stretch the
 // horizons can reach (the off-road check's table). A lane that is not there keeps a centre
-// beside its neighbour, so that the centres stay in order.
+// beside its neighbour, so that the centres stay in order. Also ctx.oncoming_right: the right
+// border at the start of an oncoming lane there (BuildContext resets it).
 void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
   const double s0 = ws.start.s;
   const double look = s0 + std::clamp(ws.start.s_d * kLaneLookahead, 0.0, kMaxLaneLookahead);
@@ -45,6 +46,9 @@ void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
     const map::Road::Span now = road.LaneAt(l, s0), ahead = road.LaneAt(l, look);
     ws.lane_exists[l] = now.exists;
     ws.lane_oncoming[l] = road.Oncoming(l);
+    if (ws.lane_oncoming[l] && now.exists) {
+      ws.ctx.oncoming_right = std::max(ws.ctx.oncoming_right, now.right);
+    }
     if (now.exists) {
       ws.lane_nominal[l] = ahead.exists ? ahead.centre() : now.centre();
     } else {
@@ -99,11 +103,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   if (cfg.uniform_road) {
     LaneCentres(cfg, line, ws);
   } else {
-    RoadLanes(cfg, road, ws);
-    for (int l = 0; l < cfg.num_lanes; ++l) {
-      const map::Road::Span now = road.LaneAt(l, start.s);
-      if (road.Oncoming(l) && now.exists) c.oncoming_right = std::max(c.oncoming_right, now.right);
-    }
+    RoadLanes(cfg, road, ws);  // and c.oncoming_right
   }
   c.current_lane = LaneOf(cfg, ws, start.d);
   c.previous_target_lane = ws.prev_target_lane;

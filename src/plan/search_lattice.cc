@@ -46,6 +46,8 @@ constexpr double kPassHold[] = {0.0, 1.0, 2.0, 3.0};
 constexpr double kPassBack[] = {1.5, 2.5};
 constexpr double kPassMinGain = 2.0;
 constexpr double kPassResolve = 0.05;
+static_assert(std::size(kPassOut) * std::size(kPassHold) * std::size(kPassBack) + 1 <=
+              kMaxPasses, "the workspace's room for passes (and the one under way)");
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -236,14 +238,14 @@ void Lattice::AddSwerveUnderWay() {
 // that waits out the hold.
 void Lattice::AddPasses() {
   const traj::FrenetState& s0 = ws_.start;
-  if (ws_.have_prev_traj && ws_.prev_pass) {
+  const bool prev_pass = ws_.have_prev_traj && ws_.prev_traj.lat.back_duration > 0;
+  if (prev_pass) {
     const traj::Trajectory1d& prev = ws_.prev_traj.lat;
     const double elapsed = ws_.prev_elapsed;
     const int own = ws_.prev_lat_lane;
     if (elapsed < prev.duration - kPassResolve) {
       LatTraj l;
       l.lane = own;
-      l.pass = true;
       l.traj = prev;
       l.traj.duration = prev.duration - elapsed;
       const traj::State1d out = prev.poly.At(prev.duration);
@@ -255,7 +257,7 @@ void Lattice::AddPasses() {
       AddLat(MakeLat(own, 0.0, prev.end_time() - elapsed));
     }
   }
-  if (!cfg_.passes || !(ws_.ctx.oncoming_right > -1e300)) return;
+  if (!cfg_.passes) return;
   // A goal crossed turned is reached by a swerve (AddSwerves), which a pass never ends in.
   for (int g = 0; g < ws_.num_goals; ++g) {
     if (cost::CrossedTurned(ws_.goals[g]) != 0) return;
@@ -273,7 +275,6 @@ void Lattice::AddPasses() {
       for (const double back : kPassBack) {
         LatTraj l;
         l.lane = own;
-        l.pass = true;
         const double d_out = ws_.lane_center[oncoming], d_own = ws_.lane_center[own];
         l.traj.duration = out;
         l.traj.poly = traj::SolveQuintic(s0.d, s0.d_d, s0.d_dd, d_out, 0.0, 0.0, out);
@@ -504,7 +505,7 @@ void Lattice::Generate() {
     // The lateral move under way, to its planned end time: replanning with full durations
     // every cycle would stretch a lane change indefinitely (more time astride the line), and
     // a waiting one would never start.
-    if (ws_.have_prev_traj && l == ws_.prev_lat_lane && !ws_.prev_pass) {
+    if (ws_.have_prev_traj && l == ws_.prev_lat_lane && ws_.prev_traj.lat.back_duration <= 0) {
       const traj::Trajectory1d& prev = ws_.prev_traj.lat;
       const double wait = prev.delay - ws_.prev_elapsed;
       const double remaining = prev.end_time() - ws_.prev_elapsed;

@@ -35,7 +35,8 @@ struct LatTraj {
   double offset = 0;
   double jerk2 = 0;
   int goal = -1;
-  bool pass = false;  // out into the oncoming lane and back (Lattice::AddPasses)
+  // A pass: out into the oncoming lane and back (the trajectory's second move).
+  bool pass() const { return traj.back_duration > 0; }
 };
 
 class Lattice {

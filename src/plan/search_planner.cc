@@ -236,7 +236,7 @@ class SearchPlanner : public Planner {
       // (Workspace::CheckTicks), the refinement's run over the whole horizon; and a pass, which
       // the refinement's single move cannot express.
       if (found && cfg_.refine && refiner_.available() && ws_.lat[ws_.winner_lat].goal < 0 &&
-          !ws_.lat[ws_.winner_lat].pass) {
+          !ws_.lat[ws_.winner_lat].pass()) {
         // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
         // asks for none beyond the cycle's.
         const double refine_ms = std::isfinite(cfg_.refine_budget_ms) ? cfg_.refine_budget_ms : 0;
@@ -561,7 +561,6 @@ class SearchPlanner : public Planner {
     ws_.prev_target_lane = lane;
     ws_.prev_lat_lane = ws_.lat[ws_.winner_lat].lane;
     ws_.prev_swerve_goal = ws_.lat[ws_.winner_lat].goal;
-    ws_.prev_pass = ws_.lat[ws_.winner_lat].pass;
     ws_.prev_lat_offset =
         ws_.winner.lat.At(ws_.winner.lat.end_time()).p - ws_.lane_center[ws_.prev_lat_lane];
     ws_.prev_traj = ws_.winner;

@@ -67,8 +67,7 @@ int Workspace::CheckTicks(int c) const {
   const int j = cand_lat[c];
   if (lat[j].goal < 0 || lat[j].goal >= num_goals) return n_ticks;
   const int ticks = static_cast<int>(std::floor(lat[j].traj.end_time() / kTickSeconds + 1e-6));
-  if (ticks < 1 || ticks >= n_ticks || !SwerveEndsInside(cand_lon[c], j)) return n_ticks;
-  return ticks;
+  return ticks < 1 || ticks >= n_ticks ? n_ticks : ticks;
 }
 
 bool Workspace::SwerveEndsInside(int i, int j) const {

@@ -41,9 +41,9 @@ struct Workspace {
   explicit Workspace(const Settings& cfg);
 
   // The ticks [1, CheckTicks(c)] and collision steps [1, CheckSteps(c)] candidate c is checked
-  // over: the whole horizon (n_ticks, n_steps); for a swerve whose candidate is inside its goal
-  // region at the swerve's end (at a tick), up to there: the run ends at its goal, and what
-  // would follow leaves the lane turned.
+  // over: the whole horizon (n_ticks, n_steps); for a swerve, up to its end (a swerve is paired
+  // only with the lon trajectories that put it in its goal region there, SwerveEndsInside): the
+  // run ends at its goal, and what would follow leaves the lane turned.
   int CheckTicks(int c) const;
   // Whether lon trajectory i with swerve j (lat[j].goal >= 0) is inside the swerve's goal region
   // at the swerve's end: time, s, d, speed and heading.
@@ -160,7 +160,6 @@ struct Workspace {
   int prev_lat_lane = -1;  // lane and end offset (m) of the previous winner's lateral move
   double prev_lat_offset = 0;
   int prev_swerve_goal = -1;  // the goal region the previous winner swerved into, or -1
-  bool prev_pass = false;     // the previous winner's lateral move was a pass
   double time_since_change = 1e9;
 };
 
