@@ -39,6 +39,7 @@ struct DriveArgs {
   int jobs = 0;
   bool progress = false;
   bool no_judge = false;
+  bool oracle = false;
   int judge_budget = sim::JudgeOptions().budget_blocks;
   bool no_timing = false;
   bool real_time_deadlines = false;
@@ -122,6 +123,7 @@ int Drive(const DriveArgs& a) {
   judge.budget_blocks = a.judge_budget;
   if (!a.connect.empty()) {
     if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
+    if (a.oracle) return Fail("--oracle needs the traffic's history: drive in-process (no --connect)");
     ConnectOptions connect;
     connect.url = a.connect;
     connect.realtime = a.realtime;
@@ -162,6 +164,7 @@ int Drive(const DriveArgs& a) {
     sim::EpisodesOptions options;
     options.timing = !a.no_timing;
     if (!a.no_judge) options.judge = judge;
+    if (a.oracle) options.oracle = sim::OracleOptions();
     std::unique_ptr<ProgressLine> line;
     if (a.progress || tty) {
       line = std::make_unique<ProgressLine>(tty);
@@ -182,6 +185,7 @@ int Drive(const DriveArgs& a) {
   sim::RunOptions options;
   options.timing = !a.no_timing;
   if (!a.no_judge) options.judge = judge;
+  if (a.oracle) options.oracle = sim::OracleOptions();
   if (!a.record_path.empty()) {
     auto writer = sim::RecordWriter::Open(a.record_path);
     if (!writer.ok()) return Fail(writer.message());
@@ -275,6 +279,13 @@ void RegisterDrive(CLI::App& app) {
                 "t = ...\" or \"unavoidable\" (the traffic's) in the report and the JSON. Cost: "
                 "the history kept while driving is not measurable; a search takes ~2.5 us of CPU "
                 "per 0.2 s block tried, a few ms for a typical incident");
+  sub->add_flag("--oracle", args->oracle,
+                "After each episode, search how far any planner could have driven in its time "
+                "against its traffic as it moved: lanes, positions (0.5 m) and speeds (1 m/s, up "
+                "to 22.2 m/s = 49.7 mph along the road) every 0.5 s, +4/-8 m/s^2, a lane change "
+                "astride for 0.5 s, cars behind braking for the ego (src/sim/oracle.h). Reports "
+                "its mph along the road beside the ego's (an optimistic bound on what a lane "
+                "strategy could gain). Cost: ~1-3 s of CPU per lap. Default: off");
   sub->add_option("--judge-budget", args->judge_budget,
                   "Judging: 0.2 s blocks simulated per start before a search gives up (the start "
                   "is then undecided, never unavoidable). Default: " +

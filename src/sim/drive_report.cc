@@ -20,6 +20,41 @@ std::string Maybe(double v, const char* fmt_unit) {
 
 double Share(double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0; }
 
+// The "oracle" line of a report.
+std::string OracleText(double oracle_mph, double driven_mph) {
+  return fmt::format(
+      "oracle          {:.2f} mph along the road at best against this traffic (offline search), "
+      "the ego {:.2f} mph there\n",
+      oracle_mph, driven_mph);
+}
+
+nlohmann::json OracleWindowsJson(const OracleResult& r) {
+  nlohmann::json arr = nlohmann::json::array();
+  for (const OracleWindow& w : r.windows) {
+    arr.push_back({{"t", w.t},
+                   {"driven_m", w.driven_m},
+                   {"best_m", w.best_m},
+                   {"lanes", w.lanes},
+                   {"driven_lanes", w.driven_lanes}});
+  }
+  return arr;
+}
+
+// The windows where the search gained most on the ego, most first.
+std::string OracleWorstText(const OracleResult& r, std::size_t count) {
+  std::vector<const OracleWindow*> w;
+  for (const OracleWindow& x : r.windows) w.push_back(&x);
+  std::stable_sort(w.begin(), w.end(), [](const OracleWindow* a, const OracleWindow* b) {
+    return a->best_m - a->driven_m > b->best_m - b->driven_m;
+  });
+  std::string out;
+  for (std::size_t i = 0; i < std::min(count, w.size()) && w[i]->best_m > w[i]->driven_m; ++i) {
+    out += fmt::format("  from t {:6.1f} s: {:+.1f} m; lanes searched {}, driven {}\n", w[i]->t,
+                       w[i]->best_m - w[i]->driven_m, w[i]->lanes, w[i]->driven_lanes);
+  }
+  return out;
+}
+
 // The "time" and "passes" lines of a report.
 std::string BreakdownText(const LapBreakdown& b) {
   return fmt::format(
@@ -142,6 +177,14 @@ nlohmann::json DriveReport::ToJson() const {
       {"breakdown", BreakdownJson(breakdown, &laps)},
       {"incident_log", log}};
   if (judged) out["judged"] = VerdictsJson(CountVerdicts(*this));
+  if (oracle_run) {
+    out["oracle"] = {{"seconds", oracle.seconds},
+                     {"distance_m", oracle.distance_m},
+                     {"mph", oracle.mph()},
+                     {"driven_m", oracle.driven_m},
+                     {"driven_mph", oracle.driven_mph()},
+                     {"windows", OracleWindowsJson(oracle)}};
+  }
   return out;
 }
 
@@ -177,6 +220,7 @@ std::string DriveReport::ToText() const {
     << Maybe(min_headway_s, "{:.2f} s") << "\n";
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max, plan_fallbacks);
+  if (oracle_run) o << OracleText(oracle.mph(), oracle.driven_mph()) << OracleWorstText(oracle, 3);
   if (judged) o << VerdictsText(CountVerdicts(*this));
   for (std::size_t n = 0; n < incident_log.size(); ++n) {
     const Incident& i = incident_log[n];
@@ -206,6 +250,11 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
     a.plan_ms_p99 = std::max(a.plan_ms_p99, r.plan_ms_p99);
     a.plan_ms_max = std::max(a.plan_ms_max, r.plan_ms_max);
     a.breakdown.Add(r.breakdown);
+    if (r.oracle_run) {
+      a.oracle_run = true;
+      a.oracle_mph += r.oracle.mph();
+      a.driven_mph += r.oracle.driven_mph();
+    }
     if (r.judged) {
       a.judged = true;
       const std::array<int, 4> n = CountVerdicts(r);
@@ -217,6 +266,8 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
   }
   const double n = static_cast<double>(a.episodes.size());
   if (n > 0) {
+    a.oracle_mph /= n;
+    a.driven_mph /= n;
     a.avg_speed_mph = sum_speed / n;
     double var = 0;
     for (const DriveReport& r : a.episodes) {
@@ -258,6 +309,7 @@ nlohmann::json AggregateReport::ToJson() const {
       {"breakdown", BreakdownJson(breakdown, nullptr)},
       {"per_episode", eps}};
   if (judged) out["judged"] = VerdictsJson(verdicts);
+  if (oracle_run) out["oracle"] = {{"mph", oracle_mph}, {"driven_mph", driven_mph}};
   return out;
 }
 
@@ -275,9 +327,12 @@ std::string AggregateReport::ToText() const {
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms (worst episode)\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max);
   o << BreakdownText(breakdown);
+  if (oracle_run) o << OracleText(oracle_mph, driven_mph);
   for (const DriveReport& r : episodes) {
-    o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi\n",
+    o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi",
                      r.seed, r.miles(), r.avg_speed_mph, r.incidents, r.miles_to_first_incident);
+    if (r.oracle_run) o << fmt::format("  oracle {:.2f} mph", r.oracle.mph());
+    o << "\n";
   }
   if (worst >= 0) {
     o << fmt::format("worst episode   seed {} ({} incidents in {:.3f} mi)\n", episodes[worst].seed,

@@ -191,6 +191,16 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   std::vector<double> path_x, path_y;
   path_x.reserve(256);
   path_y.reserve(256);
+  std::optional<OracleTrace> oracle;
+  auto sample = [&] {
+    const plan::Telemetry& t = ep.telemetry();
+    oracle->Add(ep.sim().time(), t.s, t.d, t.speed, t.sensor_fusion);
+  };
+  if (options.oracle) {
+    if (Status s = options.oracle->Validate(); !s.ok()) return s;
+    oracle.emplace(ep.sim().world().track.max_s);
+    sample();
+  }
   while (!ep.done()) {
     const double t_sent = ep.sim().time();
     if (record != nullptr) telemetry_json = net::TelemetryToJson(ep.telemetry());
@@ -215,6 +225,7 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
                    result.x.size(), result.y.size(), path_x.size());
     }
     (void)ep.Submit(path_x, path_y);  // the wire's path is always one the simulator accepts
+    if (oracle) sample();
     if (record != nullptr) {
       record->WriteExchange(index, t_sent, telemetry_json, result, &trace, ms, ep.sim(),
                             first_incident, ep.last_l_old(), ep.last_l_new());
@@ -223,6 +234,10 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   }
   if (record != nullptr) planner.set_trace(nullptr, 0);
   DriveReport report = MakeReport(ep, planner.name(), plan_ms, fallbacks);
+  if (oracle) {
+    report.oracle_run = true;
+    report.oracle = SearchOracle(*oracle, *options.oracle);
+  }
   if (record != nullptr) {
     record->WriteFooter(report);
     if (Status s = record->status(); !s.ok()) return s;
@@ -238,6 +253,9 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
   if (Status s = limits.Validate(); !s.ok()) return s;
   if (options.judge) {
     if (Status s = options.judge->Validate(); !s.ok()) return s;
+  }
+  if (options.oracle) {
+    if (Status s = options.oracle->Validate(); !s.ok()) return s;
   }
   if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   jobs = std::min(jobs, episodes);
@@ -271,6 +289,7 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
       RunOptions run;
       run.timing = options.timing;
       run.judge = options.judge;
+      run.oracle = options.oracle;
       if (options.progress) {
         run.progress = [&, w, exchanges = 0](const Episode& ep) mutable {
           if (++exchanges % 256 != 0) return;

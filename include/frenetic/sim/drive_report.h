@@ -12,6 +12,7 @@
 #include "frenetic/sim/drive_breakdown.h"
 #include "frenetic/sim/incident_judge.h"
 #include "frenetic/sim/incident_monitor.h"
+#include "frenetic/sim/oracle.h"
 
 namespace frenetic::sim {
 
@@ -40,6 +41,10 @@ struct DriveReport {
   // limits have avoided it?), in JSON under each entry's "judgement" and counted in "judged".
   bool judged = false;
   std::vector<IncidentJudgement> judgements;
+  // With --oracle: the best distance along the road any planner could have driven in this
+  // drive's time against its traffic as it moved (oracle.h), beside the ego's own.
+  bool oracle_run = false;
+  OracleResult oracle;
   // Where the time went: the whole drive and each lap (following, at the limit, passes).
   LapBreakdown breakdown;
   std::vector<LapBreakdown> laps;
@@ -62,6 +67,8 @@ struct AggregateReport {
   LapBreakdown breakdown;  // summed over episodes
   bool judged = false;     // the episodes' incidents were judged
   std::array<int, 4> verdicts{};  // incidents per Verdict, summed over episodes
+  bool oracle_run = false;        // the episodes have an oracle search
+  double oracle_mph = 0, driven_mph = 0;  // its speed and the ego's along the road, mean over episodes
   static AggregateReport From(std::vector<DriveReport> episodes);
   nlohmann::json ToJson() const;
   std::string ToText() const;

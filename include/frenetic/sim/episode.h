@@ -18,6 +18,7 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/sim/drive_report.h"
 #include "frenetic/sim/incident_judge.h"
+#include "frenetic/sim/oracle.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 
@@ -96,6 +97,9 @@ struct RunOptions {
   std::function<void(const Episode&)> progress;
   // Judge every incident (Episode::EnableJudging); unset: off.
   std::optional<JudgeOptions> judge;
+  // After the drive, search how far any planner could have driven against its traffic
+  // (oracle.h; DriveReport::oracle); unset: off. It never changes the drive.
+  std::optional<OracleOptions> oracle;
 };
 
 // Drives `planner` (Reset first) through one episode. The planner sees every telemetry number
@@ -122,6 +126,7 @@ struct EpisodesProgress {
 struct EpisodesOptions {
   bool timing = true;                 // RunOptions::timing
   std::optional<JudgeOptions> judge;  // RunOptions::judge
+  std::optional<OracleOptions> oracle;  // RunOptions::oracle
   // Called after every finished episode and every 256 exchanges of a running one, one call at a
   // time (from the worker threads, under a lock); may be empty. It cannot change the results.
   std::function<void(const EpisodesProgress&)> progress;

@@ -1,0 +1,196 @@
+#include "frenetic/sim/oracle.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "frenetic/sim/episode.h"
+#include "sim_test_util.h"
+
+namespace frenetic::sim {
+namespace {
+
+// A car moving at constant speed along a lane centre: s(t) = s0 + v t.
+struct Mover {
+  int id;
+  double s0, v, d;
+};
+
+// A trace of `seconds` s, a row every 0.1 s: the ego at ego_v m/s from s = 0 in lane ego_lane
+// (4 m lanes), and the movers (no wrap: max_s 0).
+OracleTrace Trace(double seconds, double ego_v, int ego_lane, const std::vector<Mover>& movers) {
+  OracleTrace trace(0.0);
+  for (int i = 0; i <= static_cast<int>(std::lround(seconds / 0.1)); ++i) {
+    const double t = 0.1 * i;
+    std::vector<plan::SensorCar> cars;
+    for (const Mover& m : movers) {
+      plan::SensorCar c;
+      c.id = m.id;
+      c.s = m.s0 + m.v * t;
+      c.d = m.d;
+      cars.push_back(c);
+    }
+    trace.Add(t, ego_v * t, 4.0 * ego_lane + 2.0, ego_v, cars);
+  }
+  return trace;
+}
+
+OracleOptions Lanes(int n) {
+  OracleOptions o;
+  o.lanes = n;
+  return o;
+}
+
+TEST(Oracle, OnAnEmptyRoadReachesTheTopSpeedAsFastAsItsAccelerationAllows) {
+  const OracleOptions o = Lanes(3);
+  const OracleResult r = SearchOracle(Trace(20.0, 10.0, 1, {}), o);
+  ASSERT_EQ(r.windows.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.seconds, 20.0);
+  EXPECT_NEAR(r.driven_m, 200.0, 1e-9);
+  // From 10 m/s, +2 m/s per 0.5 s stage (5 m/s^2 on the 1 m/s grid) to 22, then 22.2: the
+  // shortfall against 22.2 m/s all along is about (12.2 m/s)^2 / (2 x 4 m/s^2).
+  EXPECT_LT(r.distance_m, 22.2 * 20.0);
+  EXPECT_GT(r.distance_m, 22.2 * 20.0 - 22.0);
+  EXPECT_GT(r.mph(), r.driven_mph());
+  EXPECT_EQ(r.windows[0].lanes.size(), 40u);
+  EXPECT_EQ(r.windows[0].driven_lanes, std::string(40, '1'));
+}
+
+TEST(Oracle, BehindASlowCarOnAOneLaneRoadItCanOnlyFollow) {
+  const OracleOptions o = Lanes(1);
+  // A car 40 m ahead at 15 m/s; the ego too at 15 m/s. It may close to 4.6 m + 0.5 s x 15 m/s.
+  const OracleResult r = SearchOracle(Trace(20.0, 15.0, 0, {{0, 40.0, 15.0, 2.0}}), o);
+  const double room = 40.0 - (o.gap + o.headway * 15.0);
+  EXPECT_LE(r.distance_m, 15.0 * 20.0 + room + 1e-9);
+  EXPECT_GT(r.distance_m, 15.0 * 20.0 + room - 8.0);
+}
+
+TEST(Oracle, OnTwoLanesItPassesTheSlowCar) {
+  const OracleOptions o = Lanes(2);
+  const OracleResult r = SearchOracle(Trace(20.0, 15.0, 0, {{0, 40.0, 15.0, 2.0}}), o);
+  EXPECT_GT(r.distance_m, 15.0 * 20.0 + 60.0);
+  EXPECT_NE(r.windows[0].lanes.find('1'), std::string::npos) << r.windows[0].lanes;
+  EXPECT_NE(r.windows[0].lanes.find('/'), std::string::npos) << r.windows[0].lanes;
+}
+
+TEST(Oracle, AQueueAlongsideInTheOtherLaneKeepsItBehindItsLeader) {
+  const OracleOptions o = Lanes(2);
+  // Lane 0: a slow leader 30 m ahead. Lane 1: a queue at the same speed, 8 m apart (too close
+  // to slip between), from 16 m behind the ego to 40 m ahead.
+  std::vector<Mover> movers = {{0, 30.0, 15.0, 2.0}};
+  for (int i = 0; i < 8; ++i) movers.push_back({1 + i, -16.0 + 8.0 * i, 15.0, 6.0});
+  const OracleResult blocked = SearchOracle(Trace(20.0, 15.0, 0, movers), o);
+  const OracleResult open = SearchOracle(Trace(20.0, 15.0, 0, {movers[0]}), o);
+  EXPECT_LE(blocked.distance_m, 15.0 * 20.0 + 30.0 + 1e-9);
+  EXPECT_GT(open.distance_m, blocked.distance_m + 80.0);
+}
+
+TEST(Oracle, AFasterCarFromBehindInItsLaneIsTakenToBrakeForIt) {
+  const OracleOptions o = Lanes(1);
+  // Recorded as if it drove through the ego (the traffic brakes for a car ahead instead).
+  const OracleResult alone = SearchOracle(Trace(20.0, 15.0, 0, {}), o);
+  const OracleResult with = SearchOracle(Trace(20.0, 15.0, 0, {{0, -30.0, 24.0, 2.0}}), o);
+  EXPECT_DOUBLE_EQ(with.distance_m, alone.distance_m);
+}
+
+TEST(Oracle, ACarThatAppearsIsIgnoredForItsGraceOnly) {
+  OracleOptions o = Lanes(1);
+  // A car that jumps onto the ego's lane at s = 250 m at t = 5 s and stops there: it blocks
+  // the way once its grace has passed.
+  OracleTrace trace(0.0);
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.1 * i;
+    std::vector<plan::SensorCar> cars(1);
+    cars[0].id = 0;
+    cars[0].d = 2.0;
+    cars[0].s = t < 5.0 ? -500.0 : 250.0;
+    trace.Add(t, 10.0 * t, 2.0, 10.0, cars);
+  }
+  const OracleResult r = SearchOracle(trace, o);
+  EXPECT_LT(r.distance_m, 250.0 - o.gap);
+  EXPECT_GT(r.distance_m, 250.0 - o.gap - 5.0);
+  o.spawn_grace = 100.0;
+  EXPECT_GT(SearchOracle(trace, o).distance_m, 22.2 * 20.0 - 22.0);  // as on an empty road
+}
+
+TEST(Oracle, WindowsStartFromTheEgoAsItDroveAndAddUp) {
+  const OracleOptions o = Lanes(3);
+  const OracleResult r = SearchOracle(Trace(50.0, 10.0, 1, {}), o);
+  ASSERT_EQ(r.windows.size(), 3u);  // 20 + 20 + 10 s
+  double best = 0, driven = 0;
+  for (const OracleWindow& w : r.windows) {
+    best += w.best_m;
+    driven += w.driven_m;
+    EXPECT_GE(w.best_m, w.driven_m);
+  }
+  EXPECT_DOUBLE_EQ(r.distance_m, best);
+  EXPECT_DOUBLE_EQ(r.driven_m, driven);
+  EXPECT_DOUBLE_EQ(r.windows[1].t, 20.0);
+  // Each window starts again at 10 m/s, so the second is as long as the first.
+  EXPECT_NEAR(r.windows[1].best_m, r.windows[0].best_m, 1e-9);
+}
+
+TEST(Oracle, BadOptionsAndEmptyTracesGiveNothing) {
+  OracleOptions o;
+  o.step = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_NE(o.Validate().message().find("step"), std::string::npos);
+  o = OracleOptions();
+  o.change = 0.5;
+  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_TRUE(OracleOptions().Validate().ok());
+  EXPECT_EQ(SearchOracle(OracleTrace(100.0), OracleOptions()).distance_m, 0.0);
+  // Rows out of order or not finite are skipped.
+  OracleTrace trace(100.0);
+  trace.Add(1.0, 0.0, 2.0, 0.0, {});
+  trace.Add(0.5, 0.0, 2.0, 0.0, {});
+  trace.Add(2.0, NAN, 2.0, 0.0, {});
+  EXPECT_EQ(trace.rows().size(), 1u);
+}
+
+TEST(Oracle, TheEgoSAndTheCarsWrapWithTheTrack) {
+  // Track of 1000 m: the ego crosses s = 0 at 15 m/s and a car stays 40 m ahead of it.
+  OracleTrace trace(1000.0);
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.1 * i;
+    const double s = std::fmod(900.0 + 15.0 * t, 1000.0);
+    std::vector<plan::SensorCar> cars(1);
+    cars[0].id = 0;
+    cars[0].d = 2.0;
+    cars[0].s = std::fmod(s + 40.0, 1000.0);
+    trace.Add(t, s, 2.0, 15.0, cars);
+  }
+  ASSERT_EQ(trace.rows().size(), 201u);
+  EXPECT_NEAR(trace.rows().back().ego_s, 300.0, 1e-6);
+  const OracleResult r = SearchOracle(trace, Lanes(1));
+  EXPECT_NEAR(r.driven_m, 300.0, 1e-6);
+  EXPECT_LE(r.distance_m, 300.0 + 40.0);
+}
+
+TEST(RunEpisode, TheOracleNeverChangesTheDriveAndIsReported) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  testing::KeepLanePlanner planner(world->line, 15);
+  const EpisodeLimits limits{0, 0, 30, 60};
+  RunOptions off;
+  off.timing = false;
+  RunOptions on = off;
+  on.oracle = OracleOptions();
+  auto plain = RunEpisode(world, Scenario(), 5, limits, planner, off);
+  auto searched = RunEpisode(world, Scenario(), 5, limits, planner, on);
+  ASSERT_TRUE(plain.ok() && searched.ok());
+  EXPECT_FALSE(plain->oracle_run);
+  ASSERT_TRUE(searched->oracle_run);
+  nlohmann::json j = searched->ToJson();
+  ASSERT_TRUE(j.contains("oracle"));
+  EXPECT_GE(j["oracle"]["mph"].get<double>(), j["oracle"]["driven_mph"].get<double>());
+  // 15 m/s kept from a standstill: the search is faster than that.
+  EXPECT_GT(searched->oracle.mph(), searched->oracle.driven_mph() + 1.0);
+  EXPECT_NEAR(searched->oracle.seconds, 30.0, 0.6);
+  j.erase("oracle");
+  EXPECT_EQ(j.dump(), plain->ToJson().dump());
+  EXPECT_NE(searched->ToText().find("oracle          "), std::string::npos);
+}
+
+}  // namespace
+}  // namespace frenetic::sim
