@@ -40,6 +40,8 @@ struct DriveArgs {
   bool progress = false;
   bool no_judge = false;
   bool oracle = false;
+  double oracle_headway = sim::OracleOptions().headway;
+  double oracle_room = sim::OracleOptions().room_behind;
   int judge_budget = sim::JudgeOptions().budget_blocks;
   bool no_timing = false;
   bool real_time_deadlines = false;
@@ -121,6 +123,9 @@ int Drive(const DriveArgs& a) {
 
   sim::JudgeOptions judge;
   judge.budget_blocks = a.judge_budget;
+  sim::OracleOptions oracle;
+  oracle.headway = a.oracle_headway;
+  oracle.room_behind = a.oracle_room;
   if (!a.connect.empty()) {
     if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
     if (a.oracle) return Fail("--oracle needs the traffic's history: drive in-process (no --connect)");
@@ -164,7 +169,7 @@ int Drive(const DriveArgs& a) {
     sim::EpisodesOptions options;
     options.timing = !a.no_timing;
     if (!a.no_judge) options.judge = judge;
-    if (a.oracle) options.oracle = sim::OracleOptions();
+    if (a.oracle) options.oracle = oracle;
     std::unique_ptr<ProgressLine> line;
     if (a.progress || tty) {
       line = std::make_unique<ProgressLine>(tty);
@@ -185,7 +190,7 @@ int Drive(const DriveArgs& a) {
   sim::RunOptions options;
   options.timing = !a.no_timing;
   if (!a.no_judge) options.judge = judge;
-  if (a.oracle) options.oracle = sim::OracleOptions();
+  if (a.oracle) options.oracle = oracle;
   if (!a.record_path.empty()) {
     auto writer = sim::RecordWriter::Open(a.record_path);
     if (!writer.ok()) return Fail(writer.message());
@@ -280,12 +285,24 @@ void RegisterDrive(CLI::App& app) {
                 "the history kept while driving is not measurable; a search takes ~2.5 us of CPU "
                 "per 0.2 s block tried, a few ms for a typical incident");
   sub->add_flag("--oracle", args->oracle,
-                "After each episode, search how far any planner could have driven in its time "
-                "against its traffic as it moved: lanes, positions (0.5 m) and speeds (1 m/s, up "
-                "to 22.2 m/s = 49.7 mph along the road) every 0.5 s, +4/-8 m/s^2, a lane change "
-                "astride for 0.5 s, cars behind braking for the ego (src/sim/oracle.h). Reports "
-                "its mph along the road beside the ego's (an optimistic bound on what a lane "
-                "strategy could gain). Cost: ~1-3 s of CPU per lap. Default: off");
+                "After each episode, search how far a planner that knew the traffic's next 20 s "
+                "could have driven against it as it moved (src/sim/oracle.h): dynamic "
+                "programming over lanes, positions (0.5 m) and speeds (1 m/s steps up to 22.2 "
+                "m/s = 49.7 mph along the road) every 0.5 s, at +5/-7 m/s^2, lane changes of 3 s "
+                "(1 s astride), with the planner's margins (--oracle-headway, --oracle-room), in "
+                "20 s windows each started from the ego's state as it drove. Reports its mph "
+                "along the road beside the ego's, and the three windows where it gained most "
+                "with both lane sequences (JSON: every window). Cost: ~1 s of CPU per lap. "
+                "Default: off");
+  sub->add_option("--oracle-headway", args->oracle_headway,
+                  "With --oracle: s of the ego's speed kept to a car ahead, on top of one car "
+                  "length. Default: 0.5 (the planner's check.headway_min)")
+      ->check(CLI::Range(0.0, 5.0));
+  sub->add_option("--oracle-room", args->oracle_room,
+                  "With --oracle: m of room (on top of one car length, plus 1 s of its closing "
+                  "speed) left behind when moving in front of a car in another lane. Default: 5 "
+                  "(the planner's)")
+      ->check(CLI::Range(0.0, 50.0));
   sub->add_option("--judge-budget", args->judge_budget,
                   "Judging: 0.2 s blocks simulated per start before a search gives up (the start "
                   "is then undecided, never unavoidable). Default: " +

@@ -35,6 +35,7 @@ nlohmann::json OracleWindowsJson(const OracleResult& r) {
                    {"driven_m", w.driven_m},
                    {"best_m", w.best_m},
                    {"lanes", w.lanes},
+                   {"speeds", w.speeds},
                    {"driven_lanes", w.driven_lanes}});
   }
   return arr;

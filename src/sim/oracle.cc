@@ -56,9 +56,13 @@ std::vector<Stage> MakeStages(const OracleTrace& trace, const OracleOptions& o, 
 }
 
 // No car in the way of the ego moving from (lanes `ma`, s0) at stage a to (lanes `mb`, s1) at
-// stage b. A car in one of b's lanes blocks it from `gap` behind s1 to `gap` + headway x v1
-// ahead, unless it was behind the ego in a lane they shared (a follower, which brakes for it);
-// so does a car it was level with or behind in a lane they shared that it has now passed.
+// stage b. Of the cars in b's lanes:
+// - one behind the ego at a in a lane they shared is a follower, which brakes for it (skipped),
+//   and so is one ahead there moving away at least as fast;
+// - any other blocks it from `gap` behind s1 to `gap` + headway x v1 ahead;
+// - one in a lane the ego moves into, behind it, needs `room_behind` more, plus closing_time of
+//   the speed it closes in with;
+// - one it has passed in a lane they shared, it drove through.
 bool Free(const Stage& a, const Stage& b, unsigned ma, unsigned mb, double s0, double s1,
           double v1, double step, const OracleOptions& o) {
   const double gap = o.gap, ahead = o.gap + o.headway * v1;
@@ -75,6 +79,11 @@ bool Free(const Stage& a, const Stage& b, unsigned ma, unsigned mb, double s0, d
     // record shows overtaking, where it would have stayed behind).
     if (shared && ds1 > 0 && (cb.s - ca->s) >= v1 * step) continue;
     if (ds1 > -gap && ds1 < ahead) return false;
+    // Moving into its lane in front of it: room behind, plus a second of its closing speed.
+    if (!shared && ds1 < 0) {
+      const double closing = ca != nullptr ? std::max(0.0, (cb.s - ca->s) / step - v1) : 0.0;
+      if (ds1 > -(gap + o.room_behind + closing * o.closing_time)) return false;
+    }
     if (shared && ds1 <= -gap) return false;  // driven through
   }
   return true;
@@ -101,6 +110,9 @@ Status OracleOptions::Validate() const {
   if (!positive(behind)) return Status::Error("oracle behind must be > 0 m");
   if (!positive(horizon)) return Status::Error("oracle horizon must be > 0 s");
   if (!(headway >= 0)) return Status::Error("oracle headway must be >= 0 s");
+  if (!(room_behind >= 0) || !(closing_time >= 0)) {
+    return Status::Error("oracle room_behind and closing_time must be >= 0");
+  }
   if (!(change >= 3 * step)) return Status::Error("oracle change must be >= 3 steps");
   return Status::Ok();
 }
@@ -194,7 +206,7 @@ class Search {
 
   // The farthest s reached at k1, and in *lanes the path's lane at each stage after k0 (a digit,
   // or '/' astride).
-  double Run(int k0, int k1, int start_row, std::string* lanes) {
+  double Run(int k0, int k1, int start_row, std::string* lanes, std::vector<double>* speeds) {
     parents_.clear();
     const OracleTrace::Row& r0 = trace_.rows()[start_row];
     double lo = 0, lo1 = 0;
@@ -257,11 +269,13 @@ class Search {
     }
     if (lanes != nullptr) {
       lanes->assign(parents_.size(), '?');
+      speeds->assign(parents_.size(), std::numeric_limits<double>::quiet_NaN());
       if (best != kNegInf) {
         long at = static_cast<long>(best_at);
         for (std::size_t k = parents_.size(); k-- > 0 && at >= 0;) {
           const int g = static_cast<int>(at / (static_cast<long>(nv_) * cell_count[k + 1]));
           (*lanes)[k] = astride_[g] ? '/' : static_cast<char>('0' + __builtin_ctz(occupies_[g]));
+          (*speeds)[k] = speeds_[(at / cell_count[k + 1]) % nv_];
           at = parents_[k][at];
         }
       }
@@ -319,7 +333,8 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
     OracleWindow w;
     w.t = st[k0].t;
     w.driven_m = st[k1].ego_s - st[k0].ego_s;
-    w.best_m = std::max(w.driven_m, search.Run(k0, k1, st[k0].row, &w.lanes) - st[k0].ego_s);
+    const double best = search.Run(k0, k1, st[k0].row, &w.lanes, &w.speeds);
+    w.best_m = std::max(w.driven_m, best - st[k0].ego_s);
     for (int k = k0 + 1; k <= k1; ++k) {
       const double d = trace.rows()[st[k].row].ego_d;
       w.driven_lanes.push_back(

@@ -34,6 +34,8 @@ struct OracleOptions {
   double s_bin = 0.5;        // m: of the states at one speed this near, the farthest is kept
   double gap = 4.6;          // m along the road between the ego's centre and a car's (a car length)
   double headway = 0.5;      // s: plus this long at the ego's speed to a car ahead (the planner's)
+  double room_behind = 5.0;  // m: moving in front of a car in another lane, plus `gap`...
+  double closing_time = 1.0; // s: ...plus this long at the speed it closes in with (the planner's)
   double change = 3.0;       // s a lane change takes: a third in its lane, a third astride, a
                              // third in the next (the planner's lateral moves take 2-4 s)
   double lane_width = 4.0;   // m
@@ -84,8 +86,9 @@ struct OracleWindow {
   double t = 0;          // s, its start
   double driven_m = 0;   // the ego's distance along the road in it
   double best_m = 0;     // the search's (at least the ego's)
-  std::string lanes;     // the search's lane at each stage: a digit, '/' astride (the ego's when
-                         // the search found no better than it)
+  std::string lanes;     // the search's lane at each stage: a digit, '/' astride ('?' when it
+                         // found no way through)
+  std::vector<double> speeds;  // the search's speed at each stage, m/s
   std::string driven_lanes;  // the ego's lane at each stage (its d's)
 };
 
