@@ -180,13 +180,8 @@ nlohmann::json Unjudged(nlohmann::json j) {
 TEST(RunEpisode, JudgingReportsEveryIncidentAndNeverChangesTheDrive) {
   FRENETIC_REQUIRE_UDACITY(world);
   KeepLanePlanner planner(world->line, 22);  // keeps its lane into the traffic
-  const EpisodeLimits limits{0, 0, 90, 60};
-  RunOptions off;
-  off.timing = false;
-  RunOptions on = off;
-  on.judge = JudgeOptions();
-  auto plain = RunEpisode(world, Scenario(), 3, limits, planner, off);
-  auto judged = RunEpisode(world, Scenario(), 3, limits, planner, on);
+  auto [plain, judged] = testing::DriveWithAndWithout(
+      world, planner, 3, 90, [](RunOptions& o) { o.judge = JudgeOptions(); });
   ASSERT_TRUE(plain.ok() && judged.ok());
   ASSERT_GT(judged->incidents, 0);
   EXPECT_FALSE(plain->judged);

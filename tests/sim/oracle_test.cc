@@ -171,13 +171,8 @@ TEST(Oracle, TheEgoSAndTheCarsWrapWithTheTrack) {
 TEST(RunEpisode, TheOracleNeverChangesTheDriveAndIsReported) {
   FRENETIC_REQUIRE_UDACITY(world);
   testing::KeepLanePlanner planner(world->line, 15);
-  const EpisodeLimits limits{0, 0, 30, 60};
-  RunOptions off;
-  off.timing = false;
-  RunOptions on = off;
-  on.oracle = OracleOptions();
-  auto plain = RunEpisode(world, Scenario(), 5, limits, planner, off);
-  auto searched = RunEpisode(world, Scenario(), 5, limits, planner, on);
+  auto [plain, searched] = testing::DriveWithAndWithout(
+      world, planner, 5, 30, [](RunOptions& o) { o.oracle = OracleOptions(); });
   ASSERT_TRUE(plain.ok() && searched.ok());
   EXPECT_FALSE(plain->oracle_run);
   ASSERT_TRUE(searched->oracle_run);
