@@ -284,12 +284,12 @@ void RegisterDrive(CLI::App& app) {
                 "t = ...\" or \"unavoidable\" (the traffic's) in the report and the JSON. Cost: "
                 "the history kept while driving is not measurable; a search takes ~2.5 us of CPU "
                 "per 0.2 s block tried, a few ms for a typical incident");
-  sub->add_flag("--oracle", args->oracle,
+  CLI::Option* oracle_flag = sub->add_flag("--oracle", args->oracle,
                 "After each episode, search how far a planner that knew the traffic's next 20 s "
                 "could have driven against it as it moved (src/sim/oracle.h): dynamic "
                 "programming over lanes, positions (0.5 m) and speeds (1 m/s steps up to 22.2 "
-                "m/s = 49.7 mph along the road) every 0.5 s, at +5/-7 m/s^2, lane changes of 3 s "
-                "(1 s astride), with the planner's margins (--oracle-headway, --oracle-room), in "
+                "m/s = 49.7 mph along the road) every 0.5 s, +4/-6 m/s^2 at most, lane changes "
+                "of 3 s (1 s astride), with the planner's margins (--oracle-headway, --oracle-room), in "
                 "20 s windows each started from the ego's state as it drove. Reports its mph "
                 "along the road beside the ego's, and the three windows where it gained most "
                 "with both lane sequences (JSON: every window). Cost: ~1 s of CPU per lap. "
@@ -297,12 +297,14 @@ void RegisterDrive(CLI::App& app) {
   sub->add_option("--oracle-headway", args->oracle_headway,
                   "With --oracle: s of the ego's speed kept to a car ahead, on top of one car "
                   "length. Default: 0.5 (the planner's check.headway_min)")
-      ->check(CLI::Range(0.0, 5.0));
+      ->check(CLI::Range(0.0, 5.0))
+      ->needs(oracle_flag);
   sub->add_option("--oracle-room", args->oracle_room,
                   "With --oracle: m of room (on top of one car length, plus 1 s of its closing "
                   "speed) left behind when moving in front of a car in another lane. Default: 5 "
                   "(the planner's)")
-      ->check(CLI::Range(0.0, 50.0));
+      ->check(CLI::Range(0.0, 50.0))
+      ->needs(oracle_flag);
   sub->add_option("--judge-budget", args->judge_budget,
                   "Judging: 0.2 s blocks simulated per start before a search gives up (the start "
                   "is then undecided, never unavoidable). Default: " +

@@ -192,9 +192,18 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   path_x.reserve(256);
   path_y.reserve(256);
   std::optional<OracleTrace> oracle;
+  std::vector<plan::SensorCar> oracle_cars;
   auto sample = [&] {
     const plan::Telemetry& t = ep.telemetry();
-    oracle->Add(ep.sim().time(), t.s, t.d, t.speed, t.sensor_fusion);
+    // A row at the seam may read s = d = 0 (udacity-sim.md §8.6): its Frenet from x, y instead.
+    oracle_cars.assign(t.sensor_fusion.begin(), t.sensor_fusion.end());
+    for (plan::SensorCar& c : oracle_cars) {
+      if (c.s != 0 || c.d != 0) continue;
+      const map::FrenetPoint f = ep.sim().world().line->ToFrenet(c.x, c.y, t.s);
+      c.s = f.s;
+      c.d = f.d;
+    }
+    oracle->Add(ep.sim().time(), t.s, t.d, t.speed, oracle_cars);
   };
   if (options.oracle) {
     if (Status s = options.oracle->Validate(); !s.ok()) return s;

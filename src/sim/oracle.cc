@@ -10,6 +10,7 @@ namespace {
 
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 constexpr int kMaxId = 4096;  // sensor_fusion ids beyond this are not traffic the search follows
+constexpr double kMaxStages = 2e5;  // a longer trace (28 h of 0.5 s stages) is not searched
 constexpr double kJump = 30.0;  // m along (or 4.5 m across) between two rows: a respawn
 
 // A car at one stage: along-road position and the lanes it is in (bit per lane).
@@ -75,9 +76,11 @@ bool Free(const Stage& a, const Stage& b, unsigned ma, unsigned mb, double s0, d
     const bool shared = ca != nullptr && (ca->mask & ma & m) != 0;
     const double ds0 = ca != nullptr ? ca->s - s0 : 0;
     if (shared && ds0 < 0) continue;  // a follower
-    // Ahead in a lane they shared and at least as fast: pulling away (or a follower that the
-    // record shows overtaking, where it would have stayed behind).
-    if (shared && ds1 > 0 && (cb.s - ca->s) >= v1 * step) continue;
+    // Ahead in a lane they shared and at least as fast: pulling away (never closing into its
+    // body), or a follower that the record shows overtaking, where it would have stayed behind.
+    if (shared && ds1 > 0 && (ds1 >= gap || ds0 < gap) && (cb.s - ca->s) >= v1 * step - 1e-6) {
+      continue;
+    }
     if (ds1 > -gap && ds1 < ahead) return false;
     // Moving into its lane in front of it: room behind, plus a second of its closing speed.
     if (!shared && ds1 < 0) {
@@ -93,27 +96,31 @@ bool Free(const Stage& a, const Stage& b, unsigned ma, unsigned mb, double s0, d
 
 Status OracleOptions::Validate() const {
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  if (!positive(step)) return Status::Error("oracle step must be > 0 s, got " + std::to_string(step));
-  if (!positive(top_speed)) return Status::Error("oracle top_speed must be > 0 m/s");
-  if (!positive(speed_bin) || speed_bin > top_speed) {
-    return Status::Error("oracle speed_bin must be in (0, top_speed] m/s");
+  if (!(step >= 0.05 && step <= 5)) {
+    return Status::Error("oracle step must be 0.05..5 s, got " + std::to_string(step));
+  }
+  if (!(top_speed > 0 && top_speed <= 100)) return Status::Error("oracle top_speed must be in (0, 100] m/s");
+  if (!(speed_bin >= 0.1) || speed_bin > top_speed) {
+    return Status::Error("oracle speed_bin must be in [0.1, top_speed] m/s");
   }
   if (!positive(max_accel) || !positive(max_decel)) {
     return Status::Error("oracle max_accel and max_decel must be > 0 m/s^2");
   }
-  if (!positive(s_bin)) return Status::Error("oracle s_bin must be > 0 m");
+  if (!(s_bin >= 0.05 && s_bin <= 10)) return Status::Error("oracle s_bin must be 0.05..10 m");
   if (!positive(gap)) return Status::Error("oracle gap must be > 0 m");
   if (!positive(lane_width)) return Status::Error("oracle lane_width must be > 0 m");
   if (lanes < 1 || lanes > 16) return Status::Error("oracle lanes must be 1..16");
   if (!positive(lane_reach)) return Status::Error("oracle lane_reach must be > 0 m");
   if (!(spawn_grace >= 0)) return Status::Error("oracle spawn_grace must be >= 0 s");
-  if (!positive(behind)) return Status::Error("oracle behind must be > 0 m");
-  if (!positive(horizon)) return Status::Error("oracle horizon must be > 0 s");
+  if (!(behind > 0 && behind <= 1000)) return Status::Error("oracle behind must be in (0, 1000] m");
+  if (!(horizon > 0 && horizon <= 120)) return Status::Error("oracle horizon must be in (0, 120] s");
   if (!(headway >= 0)) return Status::Error("oracle headway must be >= 0 s");
   if (!(room_behind >= 0) || !(closing_time >= 0)) {
     return Status::Error("oracle room_behind and closing_time must be >= 0");
   }
-  if (!(change >= 3 * step)) return Status::Error("oracle change must be >= 3 steps");
+  if (!(change >= 3 * step && change <= 30)) {
+    return Status::Error("oracle change must be 3 steps..30 s");
+  }
   return Status::Ok();
 }
 
@@ -126,7 +133,8 @@ void OracleTrace::Add(double t, double ego_s, double ego_d, double ego_speed,
     if (ds < -0.5 * max_s_) ds += max_s_;
     return ds;
   };
-  if (!std::isfinite(t) || !std::isfinite(ego_s) || (!rows_.empty() && t <= rows_.back().t)) {
+  if (!std::isfinite(t) || !std::isfinite(ego_s) || !std::isfinite(ego_d) ||
+      !std::isfinite(ego_speed) || std::abs(ego_d) > 1e4 || (!rows_.empty() && t <= rows_.back().t)) {
     return;
   }
   Row row;
@@ -297,10 +305,11 @@ class Search {
     return n;
   }
   // Stage k's positions: from `behind` m behind the ego as driven to the farthest reachable.
+  // Both ends within what is reachable from the window's start, whatever the ego's s did.
   void Window(int k0, int k, double* lo, int* bins) const {
-    const double hi = std::max(st_[k0].ego_s + o_.top_speed * (k - k0) * o_.step, st_[k].ego_s) +
-                      o_.s_bin;
-    *lo = std::min(st_[k].ego_s - o_.behind, hi - o_.s_bin);
+    const double start = st_[k0].ego_s;
+    const double hi = start + o_.top_speed * (k - k0) * o_.step + o_.s_bin;
+    *lo = std::clamp(st_[k].ego_s - o_.behind, start - o_.s_bin, hi - o_.s_bin);
     *bins = static_cast<int>(std::ceil((hi - *lo) / o_.s_bin)) + 1;
   }
 
@@ -323,8 +332,9 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
   OracleResult result;
   const auto& rows = trace.rows();
   if (rows.size() < 2 || !o.Validate().ok()) return result;
-  const int stages = static_cast<int>(std::floor((rows.back().t - rows.front().t) / o.step + 1e-9));
-  if (stages < 1) return result;
+  const double span = (rows.back().t - rows.front().t) / o.step;
+  if (!(span >= 1) || span > kMaxStages) return result;
+  const int stages = static_cast<int>(std::floor(span + 1e-9));
   const std::vector<Stage> st = MakeStages(trace, o, stages);
   Search search(st, trace, o);
   const int per_window = std::max(1, static_cast<int>(std::lround(o.horizon / o.step)));

@@ -3,17 +3,23 @@
 // against the traffic as it moved (each exchange's sensor_fusion): the greatest distance along
 // the road in the drive's time, without ever running into a car.
 //
-// The estimate leans optimistic, so that a planner's shortfall from it bounds what any lane
-// strategy could still gain and a figure above it is out of reach on that traffic:
-// - speed changes within a stage are free up to `max_accel` / `max_decel`, jerk is not limited;
-// - a lane change takes one stage astride the two lanes (before and after it the ego counts in
-//   one lane only), and the next may follow one stage later;
-// - cars behind the ego in its lane are taken to brake for it (the traffic's follow rule,
-//   udacity-sim.md §8.3), so only cars it runs into, or moves beside, block it;
+// The rules are those of a planner with frenetic's margins, and lean optimistic besides the
+// foresight, so that a planner's shortfall from the result bounds what a lane strategy could
+// still gain:
+// - speeds on a grid of `speed_bin` up to `top_speed` along the road in every lane (on a bend
+//   the outer lanes' real limit is lower), changing by at most max_accel / max_decel x step
+//   per stage (+4 / -6 m/s^2 on the default grid); jerk is not limited;
+// - a lane change takes `change` s: its first third in its lane, the middle astride both, the
+//   last in the next; the next change may start one stage after it ends;
+// - a car ahead is kept `gap` + headway x speed away; moving in front of a car in another lane
+//   needs `room_behind` more, plus closing_time of the speed it closes in with;
+// - cars behind the ego in its lane brake for it (the traffic's follow rule, udacity-sim.md
+//   §8.3), and so do not block it; nor does a car ahead there moving away at least as fast;
 // - a car is ignored for `spawn_grace` s after it (re)appears, and the road farther ahead than
 //   the traffic reaches is empty.
 // It is pessimistic in one way: the traffic moves as it did, not as it would have reacted to a
-// different ego (the simulator respawns cars around the ego, and followers brake for it).
+// different ego (the simulator respawns cars around the ego). Each window of `horizon` s starts
+// again from the ego's state as it drove, which keeps that small.
 #pragma once
 
 #include <span>
