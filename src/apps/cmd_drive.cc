@@ -292,7 +292,7 @@ void RegisterDrive(CLI::App& app) {
                 "of 3 s (1 s astride), with the planner's margins (--oracle-headway, --oracle-room), in "
                 "20 s windows each started from the ego's state as it drove. Reports its mph "
                 "along the road beside the ego's, and the three windows where it gained most "
-                "with both lane sequences (JSON: every window). Cost: ~1 s of CPU per lap. "
+                "with both lane sequences (JSON: every window). Cost: ~1.5 s of CPU per lap. "
                 "Default: off");
   sub->add_option("--oracle-headway", args->oracle_headway,
                   "With --oracle: s of the ego's speed kept to a car ahead, on top of one car "

@@ -353,12 +353,12 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
       std::clamp((sep_d - std::abs(cd - ego.cy)) / (sep_d - kFollowerLateral), 0.0, 1.0);
   // An oncoming car (moving the other way: a two-way road's other lane) is passed, not
   // followed: no headway.
-  const double margin =
-      cs >= ego.cx ? margin_scale * std::max(cfg_.margin_s, ws_.step_v[at] >= 0
-                                                                ? inside * cfg_.headway_min * e.s_d
-                                                                : 0.0)
-      : behind_other_lane ? behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing)
-                          : margin_scale * cfg_.margin_s;
+  double margin = margin_scale * cfg_.margin_s;
+  if (cs >= ego.cx && ws_.step_v[at] >= 0) {
+    margin = margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d);
+  } else if (behind_other_lane) {  // (only ever behind: cs < ego.cx)
+    margin = behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing);
+  }
   if (std::abs(cs - ego.cx) > ws_.reach_s_base + ws_.car_reach_s[c] + margin ||
       std::abs(cd - ego.cy) > ws_.reach_d + ws_.car_reach_d[c]) {
     return false;
