@@ -163,6 +163,9 @@ json ProblemJson(const FileResult& f, size_t i) {
     failures.push_back(e);
   }
   j["failures"] = failures;
+  if (p.verdict.infeasible_at_start) {
+    j["infeasible_at_start"] = p.verdict.infeasible_at_start->detail;
+  }
   j["stop"] = p.stop_reason;
   j["steps"] = static_cast<int>(p.cycles.size());
   j["lanes"] = p.lanes;
@@ -191,7 +194,9 @@ std::string ProblemLine(const FileResult& f, size_t i) {
   const cr::ProblemRun& p = f.run.problems[i];
   char buf[512];
   std::string verdict;
-  if (!p.road.ok()) {
+  if (p.verdict.infeasible_at_start) {
+    verdict = p.verdict.Summary();
+  } else if (!p.road.ok()) {
     verdict = "no road: " + p.road.message();
   } else if (p.verdict.solved) {
     verdict = "solved, goal at step " + std::to_string(*p.verdict.goal_step);

@@ -504,12 +504,12 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
         lane.oncoming = other_way;
         const Lanelet& first_piece = net.at(net.Index(ids.front()));
         const Lanelet& last_piece = net.at(net.Index(ids.back()));
-        if ((other_way ? first_piece.successors : first_piece.predecessors).empty()) {
+        if (kOpenEnd > 0 && (other_way ? first_piece.successors : first_piece.predecessors).empty()) {
           lane.s.insert(lane.s.begin(), lane.s.front() - kOpenEnd);
           lane.left.insert(lane.left.begin(), lane.left.front());
           lane.right.insert(lane.right.begin(), lane.right.front());
         }
-        if ((other_way ? last_piece.predecessors : last_piece.successors).empty()) {
+        if (kOpenEnd > 0 && (other_way ? last_piece.predecessors : last_piece.successors).empty()) {
           lane.s.push_back(lane.s.back() + kOpenEnd);
           lane.left.push_back(lane.left.back());
           lane.right.push_back(lane.right.back());

@@ -350,6 +350,23 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
   for (const PlanningProblem& problem : sc.problems) {
     ProblemRun run;
     run.problem_id = problem.id;
+    if (checker.StartFailure(problem)) {
+      // Infeasible at start: the initial state already collides or lies off the road. Nothing
+      // is planned; the verdict reports it apart.
+      KsState ego;
+      ego.time_step = problem.initial.time_step;
+      ego.x = problem.initial.position.x;
+      ego.y = problem.initial.position.y;
+      ego.velocity = problem.initial.velocity.value_or(0.0);
+      ego.orientation = problem.initial.orientation.value_or(0.0);
+      ego.steering_angle = problem.initial.steering_angle.value_or(0.0);
+      run.trajectory.push_back(ego);
+      run.stop_reason = "infeasible_at_start";
+      run.verdict = checker.Check(problem, run.trajectory);
+      if (options.on_problem_end) options.on_problem_end(problem, run);
+      out.problems.push_back(std::move(run));
+      continue;
+    }
     auto built = BuildRoad(sc, problem);
     if (!built.ok()) {
       run.road = built.status();

@@ -35,6 +35,11 @@ const Failure* Verdict::Find(FailureKind kind) const {
 
 std::string Verdict::Summary() const {
   std::string out;
+  if (infeasible_at_start) {
+    const Failure& f = *infeasible_at_start;
+    return "infeasible at start: " + std::string(ToString(f.kind)) + " at step " +
+           std::to_string(f.step) + " (" + f.detail + ")";
+  }
   if (solved) {
     out = "solved: goal at step " + std::to_string(*goal_step);
     return out;
@@ -267,39 +272,21 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
          GoalMissDetail(problem.goals, traj, polygons));
   }
 
-  // Collision and road, per state.
-  const VehicleParams& p = vehicle_;
-  const double ego_radius = std::hypot(p.length, p.width) / 2;
+  // Collision and road, every state from the first to the last.
   for (const KsState& s : traj) {
-    const Vec2 center{s.x, s.y};
-    const auto box = BoxCorners(center, s.orientation, p.length, p.width);
     if (!have[static_cast<int>(FailureKind::kCollision)]) {
-      for (const Obstacle& o : scenario_->obstacles) {
-        const std::optional<State> state = o.StateAt(s.time_step);
-        if (!state) continue;
-        const ShapeGroup occupancy =
-            o.shape.Transformed(state->position, state->orientation.value_or(0.0));
-        const bool near = std::any_of(
-            occupancy.shapes.begin(), occupancy.shapes.end(), [&](const Shape& shape) {
-              return Distance(shape.Centroid(), center) <= ego_radius + shape.BoundingRadius();
-            });
-        if (near && occupancy.Overlaps(box)) {
-          fail(FailureKind::kCollision, s.time_step,
-               "the ego overlaps obstacle " + std::to_string(o.id) + " (" + o.type +
-                   Fmt(") at (%.2f, %.2f)", state->position.x, state->position.y),
-               o.id);
-          break;
-        }
+      if (std::optional<Failure> f = CollisionAt(s)) {
+        fail(f->kind, f->step, std::move(f->detail), f->obstacle_id);
       }
     }
-    if (!have[static_cast<int>(FailureKind::kOffRoad)] && !road_.ContainsConvex(box)) {
-      fail(FailureKind::kOffRoad, s.time_step,
-           Fmt("the ego's box at (%.2f, %.2f), orientation %.3f rad, leaves the lanelets",
-               s.x, s.y, s.orientation));
+    if (!have[static_cast<int>(FailureKind::kOffRoad)]) {
+      if (std::optional<Failure> f = OffRoadAt(s)) fail(f->kind, f->step, std::move(f->detail));
     }
   }
+  verdict.infeasible_at_start = StartFailure(problem);
 
   // Kinematic limits and the KS model.
+  const VehicleParams& p = vehicle_;
   const double tol = options_.limit_tolerance;
   const double dt = scenario_->dt;
   for (size_t i = 0; i < traj.size(); ++i) {
@@ -349,6 +336,49 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
     }
   }
   return finish();
+}
+
+std::optional<Failure> VerdictChecker::CollisionAt(const KsState& s) const {
+  const VehicleParams& p = vehicle_;
+  const double ego_radius = std::hypot(p.length, p.width) / 2;
+  const Vec2 center{s.x, s.y};
+  const auto box = BoxCorners(center, s.orientation, p.length, p.width);
+  for (const Obstacle& o : scenario_->obstacles) {
+    const std::optional<State> state = o.StateAt(s.time_step);
+    if (!state) continue;
+    const ShapeGroup occupancy =
+        o.shape.Transformed(state->position, state->orientation.value_or(0.0));
+    const bool near = std::any_of(
+        occupancy.shapes.begin(), occupancy.shapes.end(), [&](const Shape& shape) {
+          return Distance(shape.Centroid(), center) <= ego_radius + shape.BoundingRadius();
+        });
+    if (near && occupancy.Overlaps(box)) {
+      return Failure{FailureKind::kCollision, s.time_step,
+                     "the ego overlaps obstacle " + std::to_string(o.id) + " (" + o.type +
+                         Fmt(") at (%.2f, %.2f)", state->position.x, state->position.y),
+                     o.id};
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Failure> VerdictChecker::OffRoadAt(const KsState& s) const {
+  const auto box = BoxCorners({s.x, s.y}, s.orientation, vehicle_.length, vehicle_.width);
+  if (road_.ContainsConvex(box)) return std::nullopt;
+  return Failure{FailureKind::kOffRoad, s.time_step,
+                 Fmt("the ego's box at (%.2f, %.2f), orientation %.3f rad, leaves the lanelets",
+                     s.x, s.y, s.orientation),
+                 std::nullopt};
+}
+
+std::optional<Failure> VerdictChecker::StartFailure(const PlanningProblem& problem) const {
+  KsState s;
+  s.time_step = problem.initial.time_step;
+  s.x = problem.initial.position.x;
+  s.y = problem.initial.position.y;
+  s.orientation = problem.initial.orientation.value_or(0.0);
+  if (std::optional<Failure> f = CollisionAt(s)) return f;
+  return OffRoadAt(s);
 }
 
 Verdict CheckTrajectory(const Scenario& scenario, const PlanningProblem& problem,

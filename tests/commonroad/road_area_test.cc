@@ -33,7 +33,7 @@ TEST(RoadAreaTest, TwoLanesWithASliverBetweenThemAreOneRoad) {
 
 TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {
   const std::vector<Lanelet> lane = {Make(1, Line(0, 100, 2), Line(0, 100, -2))};
-  const RoadArea road = RoadArea::Build(lane, 0.02);
+  const RoadArea road = RoadArea::Build(lane, 0.02, 5.0);  // ends open by 5 m
   EXPECT_DOUBLE_EQ(road.tolerance(), 0.02);
   // A 2 m wide box whose left side is 1 cm beyond the bound: on the road; 3 cm: off.
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, 1.01}, 0, 4, 2)));
@@ -43,10 +43,16 @@ TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({103, 0}, 0, 4, 2)));
   EXPECT_FALSE(road.ContainsConvex(BoxCorners({103.1, 0}, 0, 4, 2)));
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({-2.5, 0}, 0, 4, 2)));  // across the start
-  // Closed ends.
-  const RoadArea closed = RoadArea::Build(lane, 0.02, 0.0);
+  // Closed ends, the default (CommonRoad's solution checker): past the end by 1 cm is on the
+  // road (the tolerance), by 3 cm off; likewise before the start.
+  const RoadArea closed = RoadArea::Build(lane, 0.02);
   EXPECT_TRUE(closed.ContainsConvex(BoxCorners({97.5, 0}, 0, 4, 2)));
+  EXPECT_TRUE(closed.ContainsConvex(BoxCorners({98.01, 0}, 0, 4, 2)));
+  EXPECT_FALSE(closed.ContainsConvex(BoxCorners({98.03, 0}, 0, 4, 2)));
   EXPECT_FALSE(closed.ContainsConvex(BoxCorners({98.5, 0}, 0, 4, 2)));
+  EXPECT_TRUE(closed.ContainsConvex(BoxCorners({1.99, 0}, 0, 4, 2)));
+  EXPECT_FALSE(closed.ContainsConvex(BoxCorners({1.97, 0}, 0, 4, 2)));
+  EXPECT_FALSE(closed.Contains({-0.5, 1}));
   // Entirely outside.
   EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 10}, 0, 4, 2)));
   EXPECT_TRUE(road.Contains({1, 1}));

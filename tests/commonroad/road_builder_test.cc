@@ -107,11 +107,11 @@ TEST(RoadBuilderTest, ALaneDropKeepsTheReferenceOnTheLaneThatGoesOn) {
   EXPECT_EQ(b.skeleton, (std::vector<int>{2, 3}));
   ASSERT_EQ(b.road->num_lanes(), 2);
   EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1}}));
-  // The right lane ends where lanelet 1 does, plus the open end's 5 m: a lane drop. Both lanes
-  // run on 300 m before the map's start, the left one 300 m past the map's end.
-  EXPECT_NEAR(b.road->LaneEnd(1), 155, 1.0);
-  EXPECT_NEAR(b.road->LaneBegin(1), -305, 1.0);
-  EXPECT_NEAR(b.road->LaneEnd(0), 605, 1.0);
+  // The right lane ends where lanelet 1 does (the network's ends are closed): a lane drop.
+  // Both lanes run on 300 m before the map's start, the left one 300 m past the map's end.
+  EXPECT_NEAR(b.road->LaneEnd(1), 150, 1.0);
+  EXPECT_NEAR(b.road->LaneBegin(1), -300, 1.0);
+  EXPECT_NEAR(b.road->LaneEnd(0), 600, 1.0);
   EXPECT_GT(b.road->LaneEnd(0), 290);
   // The left lane's centre is y = 1.75 in XY everywhere (the line itself).
   for (double s : {20.0, 120.0, 160.0, 250.0}) {

@@ -249,15 +249,43 @@ TEST(VerdictTest, FollowingACurvedLaneSolvesIt) {
   // the rear axle runs on the circle of radius sqrt(R^2 - b^2) about the same point.
   const double r_rear = std::sqrt(radius * radius - p.b * p.b);
   const double psi0 = -std::atan(p.b / r_rear), delta = std::atan(p.Wheelbase() / r_rear);
-  xml.Problem(100, {0, 0}, psi0, 15, {GoalLaneletXml(1, 40, 50)});
+  // From 5 m into the arc: the network's start is closed, the ego's rear must be on it.
+  const double a = 5.0 / radius;
+  const Vec2 at{radius * std::sin(a), radius - radius * std::cos(a)};
+  xml.Problem(100, at, psi0 + a, 15, {GoalLaneletXml(1, 40, 50)});
   const Scenario s = Parse(xml);
-  const std::vector<KsState> traj = Drive(Start(0, 0, 15, psi0, delta), 50);
+  const std::vector<KsState> traj = Drive(Start(at.x, at.y, 15, psi0 + a, delta), 50);
   for (const KsState& st : traj) {
     EXPECT_NEAR(std::hypot(st.x, st.y - radius), radius, 1e-6);  // on the centre line
   }
   const Verdict v = CheckTrajectory(s, s.problems[0], p, traj);
   EXPECT_TRUE(v.solved) << v.Summary();
   EXPECT_EQ(v.goal_step, 40);
+}
+
+TEST(VerdictTest, AStartOnAnObstacleIsInfeasibleAtStart) {
+  // A parked car 3 m ahead of the start overlaps the ego's 4.5 m box at step 0; 6 m ahead it
+  // does not (and the run into it later is the trajectory's own collision).
+  for (const double gap : {3.0, 6.0}) {
+    ScenarioXml xml;
+    AddStraightRoad(xml, 300)
+        .StaticObstacle(9, 4.0, 1.8, {10 + gap, -1.75}, 0)
+        .Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+    const Scenario s = Parse(xml);
+    const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 20));
+    EXPECT_FALSE(v.solved);
+    ASSERT_NE(v.Find(FailureKind::kCollision), nullptr) << v.Summary();
+    if (gap < 4) {
+      ASSERT_TRUE(v.infeasible_at_start.has_value()) << v.Summary();
+      EXPECT_EQ(v.infeasible_at_start->kind, FailureKind::kCollision);
+      EXPECT_EQ(v.infeasible_at_start->obstacle_id, 9);
+      EXPECT_EQ(v.Find(FailureKind::kCollision)->step, 0);
+      EXPECT_THAT(v.Summary(), HasSubstr("infeasible at start: collision at step 0"));
+    } else {
+      EXPECT_FALSE(v.infeasible_at_start.has_value()) << v.Summary();
+      EXPECT_GT(v.Find(FailureKind::kCollision)->step, 0);
+    }
+  }
 }
 
 TEST(VerdictTest, SteeringAngleBeyondItsLimit) {
@@ -465,9 +493,13 @@ TEST(VerdictTest, SharedExamplesCheckAStraightRun) {
       EXPECT_EQ(v.Find(FailureKind::kStart), nullptr) << e.path() << ": " << v.Summary();
       EXPECT_EQ(v.Find(FailureKind::kDynamics), nullptr) << e.path() << ": " << v.Summary();
       EXPECT_EQ(v.Find(FailureKind::kTrajectory), nullptr) << e.path() << ": " << v.Summary();
-      // The ego's box at the initial state is on the road.
+      // The ego's box at the initial state is on the road, or the problem is infeasible at
+      // start for it (ZAM_Ramp: its rear past the network's closed start).
       const Failure* off = v.Find(FailureKind::kOffRoad);
-      EXPECT_TRUE(off == nullptr || off->step > 0) << e.path() << ": " << v.Summary();
+      const bool off_at_start = off != nullptr && off->step == p.initial.time_step;
+      EXPECT_EQ(off_at_start, v.infeasible_at_start.has_value() &&
+                                  v.infeasible_at_start->kind == FailureKind::kOffRoad)
+          << e.path() << ": " << v.Summary();
     }
     ++files;
   }

@@ -12,12 +12,12 @@
 // examples), and a car straddling the lane line there is on the road. So a box counts as on the
 // road when it sticks out over the road's edge by at most `tolerance`.
 //
-// Open ends: a lanelet without predecessors is extended backwards, one without successors forwards,
-// by `open_end_margin` along its bounds' end directions, so a car may stand across the road's start
-// or end (ZAM_Ramp-1_1-T-1's ego starts at rest with its rear half behind the road's start). The
-// drivability checker's obb_rectangles road boundary leaves these ends open
-// (construct_boundary_obstacle_obb_rectangles, open_lane_ends=True); the triangulated boundary its
-// solution checker builds appears to close them, which would fail that ramp scenario at step 0.
+// Ends: by default the network's ends are closed, as in CommonRoad's solution checker, whose road
+// boundary is the outline of the lanelet network (the triangulated boundary closes the ends): a
+// box that sticks out past the last point of a lanelet without successors, or before the first
+// of one without predecessors, is off the road. With `open_end_margin` > 0, such a lanelet is
+// extended by that much along its bounds' end directions instead (the drivability checker's
+// obb_rectangles boundary with open_lane_ends=True leaves the ends open).
 #pragma once
 
 #include <memory>
@@ -31,7 +31,7 @@ namespace frenetic::commonroad {
 class RoadArea {
  public:
   static constexpr double kDefaultTolerance = 0.02;      // m
-  static constexpr double kDefaultOpenEndMargin = 5.0;   // m
+  static constexpr double kDefaultOpenEndMargin = 0.0;   // m: closed ends
 
   // An empty area (contains nothing).
   RoadArea();

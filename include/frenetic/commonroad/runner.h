@@ -86,7 +86,7 @@ struct ProblemRun {
   std::vector<int> route;  // lanelet ids
   std::vector<KsState> trajectory;
   std::vector<RunCycle> cycles;
-  std::string stop_reason;  // "goal", "time"
+  std::string stop_reason;  // "goal", "time", "infeasible_at_start" (nothing planned)
   Verdict verdict;
   double computation_s = 0;  // planning time of the whole run (0 without timing)
 };

@@ -14,8 +14,11 @@
 //  - collision: the ego's l x w box centred on (x, y) along psi overlaps an obstacle's shape at
 //    the same step: a dynamic obstacle at its recorded state there (none before its initial step or
 //    after its trajectory's end), a static one at every step. Touching counts.
-//  - road: the ego's box lies inside the union of all lanelets, both directions, their open ends
-//    extended (RoadArea, with options.road_tolerance and options.open_end_margin).
+//  - road: the ego's box lies inside the union of all lanelets, both directions, the network's
+//    ends closed (RoadArea, with options.road_tolerance and options.open_end_margin).
+//  - infeasible at start: the problem's initial state itself collides (its box overlaps an
+//    obstacle at the initial step) or lies off the road; no trajectory can solve it (it starts
+//    there), so the problem is reported apart, not as a planner's failure.
 //  - kinematic limits, per state: steering angle in [steering_min, steering_max], velocity in
 //    [v_min, v_max]; per step k -> k+1 with the input reconstructed from the two states
 //    (steering rate = (delta_{k+1} - delta_k) / dt, acceleration = (v_{k+1} - v_k) / dt, both
@@ -79,9 +82,13 @@ struct Verdict {
   std::optional<int> goal_step;  // first time step meeting a goal state
   // The first failure of each kind, in the order of FailureKind.
   std::vector<Failure> failures;
+  // Set when the initial state already fails a collision or road check (then the same failure
+  // is among `failures` at the initial step): the problem has no solution.
+  std::optional<Failure> infeasible_at_start;
 
   const Failure* Find(FailureKind kind) const;
-  // "solved: goal at step 42" or "failed: collision at step 12 (...); goal at step 49 (...)".
+  // "solved: goal at step 42", "failed: collision at step 12 (...); goal at step 49 (...)" or
+  // "infeasible at start: collision at step 0 (...)".
   std::string Summary() const;
 };
 
@@ -114,10 +121,18 @@ class VerdictChecker {
   // `trajectory`: the ego's states from the problem's initial time step, one per step. Never
   // fails: bad trajectories give kTrajectory failures.
   Verdict Check(const PlanningProblem& problem, std::span<const KsState> trajectory) const;
+  // The problem's initial state (at its time step, with its orientation, else 0) checked for
+  // collision and road as a trajectory's state is: the failure when it fails (the problem is
+  // infeasible at start), else nothing.
+  std::optional<Failure> StartFailure(const PlanningProblem& problem) const;
 
   const RoadArea& road() const { return road_; }
 
  private:
+  // The collision and road failures of one state (collision first), each when it fails.
+  std::optional<Failure> CollisionAt(const KsState& s) const;
+  std::optional<Failure> OffRoadAt(const KsState& s) const;
+
   const Scenario* scenario_;
   VehicleParams vehicle_;
   VerdictOptions options_;
