@@ -593,8 +593,14 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     first = std::min(first, l.s.front());
     last = std::max(last, l.s.back());
   }
+  // A problem whose goals are times only is met by staying on the map until then: its lanes end
+  // at a wall at the map's end (the verdict closes the network's ends). A goal with a position
+  // lies on the map, and the run ends there: the run-on stays open.
+  bool time_only = true;
+  for (const GoalState& g : problem.goals) time_only = time_only && !g.HasPosition();
   for (map::LaneProfile& l : lanes) {
     if (l.s.back() > last - kMapEndSlack) {
+      if (time_only) l.wall = l.s.back();
       l.s.push_back(l.s.back() + kMapRunOn);
       l.left.push_back(l.left.back());
       l.right.push_back(l.right.back());

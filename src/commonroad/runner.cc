@@ -27,10 +27,9 @@ constexpr double kInsetS = 1.0, kInsetD = 0.2, kInsetV = 0.5, kInsetH = 0.02, kT
 // Recorded futures the planner is given: enough samples for its horizons (6 s and a little).
 constexpr int kFutureSteps = 80;
 constexpr double kMphToMps = 0.44704;
-// m/s: the ego's speed limit is at least this much above its initial speed (the planner's
-// speed limit is hard), and at least kGoalSpeedFactor times the mean speed a timed goal needs.
-constexpr double kGoalSpeedFactor = 1.8;
-constexpr double kStartSpeedRoom = 2.0;
+// The planner's top speed: this share of the vehicle's v_max (the path's speed is checked on its
+// 0.02 s points, which the KS ego tracks to within centimetres per second).
+constexpr double kTopSpeedShare = 0.97;
 
 // An obstacle's footprint at a step: centre, heading, length and width (its shape's bounding
 // box in its own frame).
@@ -232,6 +231,19 @@ int EndStep(const Scenario& sc, const PlanningProblem& p) {
   return std::min(end, p.initial.time_step + kMaxSteps);
 }
 
+// m: the ego's centre this far past the far end (s) of every goal region has missed them all.
+constexpr double kPassedMargin = 1.0;
+
+// Whether the ego at s has driven past every goal region (all of them with a position): the
+// planner never reverses, so none can be met any more.
+bool PassedEveryGoal(const std::vector<FrenetGoal>& goals, double s) {
+  if (goals.empty()) return false;
+  for (const FrenetGoal& g : goals) {
+    if (!(std::isfinite(g.region.s_hi) && s > g.region.s_hi + kPassedMargin)) return false;
+  }
+  return true;
+}
+
 // Signed Menger curvature of three points (left positive).
 double Curvature(double x1, double y1, double x2, double y2, double x3, double y3) {
   const double ax = x2 - x1, ay = y2 - y1, bx = x3 - x2, by = y3 - y2, cx = x3 - x1, cy = y3 - y1;
@@ -323,6 +335,7 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig c, const Vehi
                                                PredictionMode /*prediction*/) {
   c.PinDeadlines();
   const std::pair<const char*, double> values[] = {
+      {"limits.max_speed_mph", kTopSpeedShare * vp.v_max / kMphToMps},
       {"check.ego_length", vp.length},
       {"check.ego_width", vp.width},
       {"vehicle.wheelbase", vp.Wheelbase()},
@@ -381,25 +394,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     run.road_length = line.length();
     run.route = built->route;
     const std::vector<FrenetGoal> goals = FrenetGoals(sc, problem, line);
-    // The ego's cruise speed: the configured one, but never below its initial speed (the
-    // planner's speed limit is hard), nor below kGoalSpeedFactor times the mean speed that
-    // reaches a goal in time (corners and traffic take their share), nor above the vehicle's.
-    plan::PlannerConfig problem_config = config;
-    {
-      const double v0 = problem.initial.velocity.value_or(0.0);
-      const double s0 = line.ToFrenet(problem.initial.position.x, problem.initial.position.y).s;
-      double needed = 0;
-      for (const FrenetGoal& g : goals) {
-        const double t = (g.region.t_hi - problem.initial.time_step) * sc.dt;
-        if (g.timed_hi && t > 0 && std::isfinite(g.region.s_lo)) {
-          needed = std::max(needed, (g.region.s_lo - s0) / t);
-        }
-      }
-      const double mps = std::min(std::max({config.value("limits.max_speed_mph") * kMphToMps,
-                                            v0 + kStartSpeedRoom, kGoalSpeedFactor * needed}),
-                                  kLimitMargin * vp.v_max);
-      (void)problem_config.Set("limits.max_speed_mph", mps / kMphToMps);
-    }
+    // The top speed is the vehicle's (CommonRoadConfig); the lanes' signs limit it further.
+    const plan::PlannerConfig& problem_config = config;
     auto planner = plan::MakePlanner("search", problem_config, built->road);
     if (!planner.ok()) {
       run.road = planner.status();
@@ -449,6 +445,10 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       t.yaw = ego.orientation;
       t.speed = ego.velocity;
       const map::FrenetPoint fe = line.ToFrenet(ego.x, ego.y);
+      if (PassedEveryGoal(goals, fe.s)) {
+        run.stop_reason = "goal_passed";
+        break;
+      }
       t.s = fe.s;
       t.d = fe.d;
       t.previous_path_x = path_x;

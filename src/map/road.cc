@@ -66,6 +66,7 @@ StatusOr<std::shared_ptr<const Road>> Road::Make(std::shared_ptr<const Reference
       widths.push_back(p.right[i] - p.left[i]);
     }
     if (!(p.speed_limit > 0)) return Status::Error(where + "speed limit must be > 0");
+    if (std::isnan(p.wall)) return Status::Error(where + "wall is not a number");
   }
   std::shared_ptr<Road> road(new Road());
   road->line_ = std::move(line);
@@ -105,6 +106,11 @@ double Road::LaneEnd(int lane) const {
 double Road::SpeedLimit(int lane) const {
   if (lane < 0 || lane >= num_lanes()) return kNaN;
   return lanes_[lane].speed_limit;
+}
+
+double Road::Wall(int lane) const {
+  if (lane < 0 || lane >= num_lanes()) return kNaN;
+  return lanes_[lane].wall;
 }
 
 bool Road::Oncoming(int lane) const {

@@ -84,7 +84,7 @@ constexpr Default kDefaults[] = {
     {"prediction.range", 200, 50, 400, false},
     {"prediction.d_min", -1, -5, 0, false},
     {"prediction.d_max", 13, 12, 20, false},
-    {"prediction.max_speed", 30, 20, 60, false},
+    {"prediction.max_speed", 30, 20, 150, false},
     {"prediction.spike_ratio", 1.8, 1.2, 3, false},
     {"prediction.manoeuvres", 1, 0, 1, false},
     {"prediction.brake_threshold", 2, 0.5, 9, false},

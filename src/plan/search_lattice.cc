@@ -396,6 +396,18 @@ void Lattice::AddAccelerating(const bool reachable[], double vmax) {
   }
 }
 
+double ReachableSpeed(const VehicleLimits& veh, double max_accel, double v0, double T) {
+  if (!(veh.max_accel > 0)) return v0 + max_accel * T;
+  // dv/dt = a up to the switch speed, a v_switch / v above it (v^2 grows linearly).
+  const double a = veh.max_accel, vs = veh.switch_speed;
+  if (v0 < vs) {
+    const double t1 = (vs - v0) / a;
+    if (t1 >= T) return v0 + a * T;
+    return std::sqrt(vs * vs + 2 * a * vs * (T - t1));
+  }
+  return std::sqrt(v0 * v0 + 2 * a * vs * T);
+}
+
 // The car in `lane` nearest to the ego along s within kAlongside at the start instant (context
 // index), or -1: the one a lane change into that lane must pass behind or in front of.
 int Lattice::Alongside(int lane) const {
@@ -426,11 +438,14 @@ void Lattice::Generate() {
   }
   double vmax = 0;
   for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
+  // The end speeds' grid reaches no higher than the ego can speed up to within the longest
+  // duration (its steps stay as fine where it can go, however high the top speed).
+  const double vgrid = std::min(vmax, ReachableSpeed(cfg_.vehicle, cfg_.max_accel, std::max(start.s_d, 0.0), cfg_.max_duration));
   for (int di = 0; di < cfg_.durations; ++di) {
     const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
     for (int vi = 0; vi < cfg_.speeds; ++vi) {
       // Velocity keeping to end speeds from 0 to the fastest lane's limit.
-      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vmax, cfg_.speeds, vi), T));
+      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vgrid, cfg_.speeds, vi), T));
     }
     // ...and to each slower lane's own limit (the outer lanes of a bend, where the XY speed is
     // s' (1 + kappa d)): the grid's step would otherwise leave such a lane up to a whole step

@@ -39,6 +39,11 @@ struct LatTraj {
   bool pass() const { return traj.back_duration > 0; }
 };
 
+// m/s: the fastest a vehicle can be T s after v0 at its forward acceleration limit: the
+// vehicle's (VehicleLimits::max_accel up to switch_speed, max_accel switch_speed / v above it,
+// CommonRoad's rule) when it has one, else `max_accel` throughout.
+double ReachableSpeed(const VehicleLimits& vehicle, double max_accel, double v0, double T);
+
 class Lattice {
  public:
   // Reads the context (start state, lanes, traffic) from `ws`, which must outlive the lattice.

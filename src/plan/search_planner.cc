@@ -487,16 +487,17 @@ class SearchPlanner : public Planner {
   }
 
   // The sensor rows plus, for every lane that ends ahead before the road does (a lane drop, an
-  // on-ramp's end), a car at rest in its last metre: the lattice follows and stops for it, the
-  // costs and checks see the lane as blocked there, as a driver sees a lane drop. Rows are
-  // returned as they are on a road whose lanes never end.
+  // on-ramp's end) or at a wall (the map's closed end), a car at rest in its last metre: the
+  // lattice follows and stops for it, the costs and checks see the lane as blocked there, as a
+  // driver sees a lane drop. Rows are returned as they are on a road whose lanes never end.
   std::span<const SensorCar> WithLaneEnds(const std::vector<SensorCar>& rows, double start_s) {
     if (road_->uniform()) return rows;
     rows_.assign(rows.begin(), rows.begin() + std::min<std::size_t>(rows.size(), search::kMaxCars));
     for (int l = 0; l < road_->num_lanes(); ++l) {
-      const double end = road_->LaneEnd(l);
-      if (!(end < road_end_ - kLaneEndSlack) || end < start_s - kLaneEndSlack ||
-          end > start_s + kLaneEndRange) {
+      // The lane's wall (a closed end of the map), or its own end before the road's.
+      double end = road_->Wall(l);
+      if (road_->LaneEnd(l) < road_end_ - kLaneEndSlack) end = std::min(end, road_->LaneEnd(l));
+      if (!std::isfinite(end) || end < start_s - kLaneEndSlack || end > start_s + kLaneEndRange) {
         continue;
       }
       // The car fills the lane's last kLaneEndLength m (inside the road, where the predictor

@@ -277,6 +277,64 @@ TEST(RunnerTest, AProblemWithoutARoadSaysWhy) {
   EXPECT_TRUE(p.trajectory.empty());
 }
 
+TEST(RunnerTest, TheTopSpeedIsTheSignsElseTheVehicles) {
+  // An empty straight kilometre, the ego at 30 m/s, a goal far ahead: unsigned, it speeds up
+  // past the 36 m/s an advisory limit would hold it to (toward the vehicle's 50.8 m/s); under a
+  // 25 m/s sign it slows to the sign.
+  for (const bool signed_lane : {false, true}) {
+    ScenarioXml xml;
+    LaneletXml l = Lane(1, Line(0, 1000, 0), Line(0, 1000, -3.5));
+    if (signed_lane) l.signs = {7};
+    xml.Lanelet(l);
+    if (signed_lane) xml.SpeedSign(7, 25.0);
+    xml.Problem(1, {10, -1.75}, 0, 30,
+                {GoalRectangleXml({900, -1.75}, 20, 3.5, 0, 0, 400)});
+    const ProblemRun p = RunOne(xml);
+    EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+    double vmax = 0;
+    for (const KsState& st : p.trajectory) vmax = std::max(vmax, st.velocity);
+    if (signed_lane) {
+      double late = 0;  // after 10 s
+      for (size_t k = 100; k < p.trajectory.size(); ++k) late = std::max(late, p.trajectory[k].velocity);
+      EXPECT_LT(late, 25.5);
+      EXPECT_GT(late, 23.0);
+    } else {
+      EXPECT_GT(vmax, 38.0);
+      EXPECT_LT(vmax, VehicleParams().v_max);
+    }
+  }
+}
+
+TEST(RunnerTest, StopsBeforeTheMapsEndForATimeOnlyGoal) {
+  // The map ends 120 m ahead of the ego at 20 m/s; the goal is a time only, 10 s in: the ego
+  // must be on the lanelets (the network's end is closed) at every step until then. It stops
+  // before the end and waits.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 130).Problem(1, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(100, 100)});
+  const ProblemRun p = RunOne(xml);
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  double front = -1e9;
+  for (const KsState& st : p.trajectory) front = std::max(front, st.x + 0.5 * VehicleParams().length);
+  EXPECT_LT(front, 130.0);
+  EXPECT_GT(front, 100.0);  // it used the road, not a panic stop
+}
+
+TEST(RunnerTest, ARunEndsOnceEveryGoalRegionIsBehind) {
+  // A goal region 25 m ahead asks to stand (0-1 m/s) in it from 2 s on; at 25 m/s the ego
+  // cannot stop in it and drives past. The run then ends (the planner never reverses): no
+  // cycles up to the window's end at 20 s.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 600).Problem(
+      1, {10, -1.75}, 0, 25,
+      {GoalRectangleXml({40, -1.75}, 6, 3.5, 0, 20, 200, IntervalXml("velocity", 0, 1))});
+  const ProblemRun p = RunOne(xml);
+  EXPECT_FALSE(p.verdict.solved);
+  ASSERT_NE(p.verdict.Find(FailureKind::kGoal), nullptr) << p.verdict.Summary();
+  EXPECT_EQ(p.stop_reason, "goal_passed");
+  EXPECT_LT(p.cycles.size(), 50u);
+  EXPECT_GT(p.trajectory.back().x, 44.0);
+}
+
 TEST(RunnerTest, AProblemInfeasibleAtStartIsNotPlanned) {
   // Three starts no trajectory can leave from: off the road beside it, across the road's closed
   // start, and on a parked car. Each is reported infeasible at start with the failure at the

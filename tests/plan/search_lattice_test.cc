@@ -37,6 +37,25 @@ int Count(const Workspace& ws, cost::LonKind kind) {
   return n;
 }
 
+TEST(SearchLatticeTest, ReachableSpeedFollowsTheVehiclesAccelerationRule) {
+  // Without a vehicle: limits.max_accel throughout.
+  EXPECT_DOUBLE_EQ(ReachableSpeed(VehicleLimits{}, 9.0, 10.0, 6.0), 64.0);
+  // CommonRoad's KS2: 11.5 m/s^2 up to 7.319 m/s, then a v_switch / v. From 30 m/s for 6 s:
+  // v^2 = 30^2 + 2 a v_switch T; from 2 m/s the first 0.46 s at a, the rest by the same law.
+  VehicleLimits ks2;
+  ks2.max_accel = 11.5;
+  ks2.switch_speed = 7.319;
+  EXPECT_NEAR(ReachableSpeed(ks2, 9.0, 30.0, 6.0), std::sqrt(900 + 2 * 11.5 * 7.319 * 6), 1e-9);
+  const double t1 = (7.319 - 2.0) / 11.5;
+  EXPECT_NEAR(ReachableSpeed(ks2, 9.0, 2.0, 6.0),
+              std::sqrt(7.319 * 7.319 + 2 * 11.5 * 7.319 * (6 - t1)), 1e-9);
+  EXPECT_NEAR(ReachableSpeed(ks2, 9.0, 2.0, 0.2), 2.0 + 11.5 * 0.2, 1e-12);
+  // Check by integrating dv/dt with small steps.
+  double v = 2.0;
+  for (int i = 0; i < 600000; ++i) v += 1e-5 * (v > 7.319 ? 11.5 * 7.319 / v : 11.5);
+  EXPECT_NEAR(ReachableSpeed(ks2, 9.0, 2.0, 6.0), v, 1e-3);
+}
+
 TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   REQUIRE_UDACITY_MAP();
   Stages st(GridOnly());

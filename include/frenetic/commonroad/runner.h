@@ -15,8 +15,9 @@
 // KS input (steering rate, acceleration) that best lands it on the planned state dt ahead
 // (position, orientation, steering angle, speed: a few Gauss-Newton steps on SimulateKs, the
 // inputs within the vehicle's limits), so the trajectory is a KS trajectory by construction.
-// The run ends at the first step that meets a goal state, or after the last goal time window (or,
-// for goals without one, the scenario's last recorded step), at most kMaxSteps.
+// The run ends at the first step that meets a goal state, after the last goal time window (or,
+// for goals without one, the scenario's last recorded step), once the ego has driven past every
+// goal region, or after kMaxSteps.
 #pragma once
 
 #include <functional>
@@ -86,7 +87,10 @@ struct ProblemRun {
   std::vector<int> route;  // lanelet ids
   std::vector<KsState> trajectory;
   std::vector<RunCycle> cycles;
-  std::string stop_reason;  // "goal", "time", "infeasible_at_start" (nothing planned)
+  // "goal"; "time" (the last goal window ended); "goal_passed" (the ego drove past every goal
+  // region: none can be met any more, the planner never reverses); "infeasible_at_start"
+  // (nothing planned).
+  std::string stop_reason;
   Verdict verdict;
   double computation_s = 0;  // planning time of the whole run (0 without timing)
 };
@@ -97,11 +101,11 @@ struct ScenarioRun {
 };
 
 // The planner configuration for CommonRoad: `base` (config/planner.yaml with
-// config/commonroad.yaml on top, as the command loads it) with the ego's footprint and the
-// vehicle's kinematic limits (vehicle.*, 15% inside the verdict's) and the wall-clock deadlines
-// pinned (the prediction mode changes what the runner tells the planner, not its config). Each problem
-// raises limits.max_speed_mph to 2 m/s above its initial speed when that is faster (the planner's
-// speed limit is hard); the lanes' signs limit it further.
+// config/commonroad.yaml on top, as the command loads it) with the ego's footprint, the
+// vehicle's kinematic limits (vehicle.*, 15% inside the verdict's), its top speed
+// (limits.max_speed_mph: 97% of its v_max; the lanes' traffic signs limit it further, as
+// targets) and the wall-clock deadlines pinned (the prediction mode changes what the runner
+// tells the planner, not its config).
 inline constexpr const char* kCommonRoadConfig = "config/commonroad.yaml";  // in the source tree
 StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const VehicleParams& vehicle,
                                                PredictionMode prediction);

@@ -24,6 +24,10 @@ struct LaneProfile {
   // Driven the other way (a two-way road's opposite lane): only for passing, against oncoming
   // traffic.
   bool oncoming = false;
+  // m: where the lane's surface ends at a wall the planner stops before (a lanelet network's
+  // closed end, past which the stations run on for the planner's horizons only); +inf: none.
+  // A lane's own end before the road's end (a lane drop) is a wall anyway.
+  double wall = std::numeric_limits<double>::infinity();
 };
 
 class Road {
@@ -65,6 +69,7 @@ class Road {
   double LaneBegin(int lane) const;
   double LaneEnd(int lane) const;
   double SpeedLimit(int lane) const;  // m/s, +inf when none
+  double Wall(int lane) const;        // LaneProfile::wall (NaN outside the lanes)
   bool Oncoming(int lane) const;      // LaneProfile::oncoming (false outside the lanes)
   // The road's edges at s: the leftmost existing lane's left border and the rightmost's right
   // border (exists false when no lane exists there).
