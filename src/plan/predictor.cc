@@ -164,6 +164,7 @@ class TrafficPredictor : public Predictor {
     for (auto* v : {&fut_s_, &fut_d_, &fut_v_, &fut_vd_}) v->assign(n, 0.0);
     fut_n_.assign(options_.max_cars, 0);
     fut_dt_.assign(options_.max_cars, 0.0);
+    fut_t0_.assign(options_.max_cars, 0.0);
   }
 
   void Observe(std::span<const SensorCar> rows, double ego_s, double now,
@@ -216,6 +217,7 @@ class TrafficPredictor : public Predictor {
       cars_.push_back(car);
       slot_.push_back(car.recorded ? slot : -1);
     }
+    AddCarsToCome(rows, futures, ego_s);
     if (manoeuvres_ && options_.lane_change_ghosts && road_->uniform()) {
       AddLaneChangeGhosts(now, ego_d);
     }
@@ -359,16 +361,50 @@ class TrafficPredictor : public Predictor {
     return e.exists && d >= e.left - options_.edge_slack && d <= e.right + options_.edge_slack;
   }
 
+  // The cars to come (CarFuture::start > 0, no row with their id): tracked from their first
+  // sample, absent until it.
+  void AddCarsToCome(std::span<const SensorCar> rows, std::span<const CarFuture> futures,
+                     double ego_s) {
+    for (const CarFuture& f : futures) {
+      if (static_cast<int>(cars_.size()) >= options_.max_cars) return;
+      if (!(f.start > 0) || !std::isfinite(f.start) || f.x.empty() || f.y.empty() ||
+          !std::isfinite(f.x[0]) || !std::isfinite(f.y[0])) {
+        continue;
+      }
+      bool has_row = false;
+      for (const SensorCar& row : rows) has_row = has_row || row.id == f.id;
+      if (has_row) continue;
+      const map::FrenetPoint p = line_->ToFrenet(f.x[0], f.y[0], ego_s);
+      if (!std::isfinite(p.s) || !std::isfinite(p.d) || !OnRoad(p.s, p.d)) continue;
+      if (std::abs(line_->DiffS(p.s, line_->WrapS(ego_s))) > options_.range) continue;
+      const int slot = static_cast<int>(cars_.size());
+      if (!LoadFuture(f.id, {&f, 1}, slot, p.s, ego_s, /*to_come=*/true)) continue;
+      TrackedCar car;
+      car.id = f.id;
+      car.s = kAbsentS;
+      car.d = p.d;
+      car.d_target = p.d;
+      car.length = f.length > 0 && std::isfinite(f.length) ? f.length : options_.car_length;
+      car.width = f.width > 0 && std::isfinite(f.width) ? f.width : options_.car_width;
+      car.recorded = true;
+      car.appears = f.start;
+      cars_.push_back(car);
+      slot_.push_back(slot);
+    }
+  }
+
   // Loads the future of car `id` (if `futures` has a usable one) into `slot`, s relative to
   // ego_s as TrackedCar::s; line_s is the car's line coordinate now (the projections' hint).
+  // A car there now (to_come false) takes a future that starts now only; a car to come one
+  // that starts later.
   bool LoadFuture(int id, std::span<const CarFuture> futures, int slot, double line_s,
-                  double ego_s) {
+                  double ego_s, bool to_come = false) {
     const CarFuture* fut = nullptr;
     for (const CarFuture& f : futures) {
-      if (f.id == id) fut = &f;
+      if (f.id == id && (f.start > 0) == to_come) fut = &f;
     }
     if (fut == nullptr || slot >= static_cast<int>(fut_n_.size()) || !(fut->dt > 0) ||
-        !std::isfinite(fut->dt)) {
+        !std::isfinite(fut->dt) || !(fut->start >= 0) || !std::isfinite(fut->start)) {
       return false;
     }
     // Every stride-th sample up to the horizon (and the last one before it): the predictions
@@ -418,6 +454,7 @@ class TrafficPredictor : public Predictor {
     // The last sample kept may be one the stride overshot (the recording's end): its time.
     fut_n_[slot] = n;
     fut_dt_[slot] = fut->dt * stride;
+    fut_t0_[slot] = fut->start;
     if (n >= 2 && (n - 1) * stride > given - 1) {
       // Rare (a recording that ends off the stride): keep only the samples on it.
       fut_n_[slot] = n - 1;
@@ -429,8 +466,13 @@ class TrafficPredictor : public Predictor {
   // the last one's speed.
   Prediction FromFuture(int slot, double t) const {
     const int base = slot * kMaxFutureSamples, n = fut_n_[slot];
-    const double x = std::max(t, 0.0) / fut_dt_[slot];
     Prediction p;
+    if (t < fut_t0_[slot]) {  // a car to come, not there yet
+      p.s = kAbsentS;
+      p.d = fut_d_[base];
+      return p;
+    }
+    const double x = std::max(t - fut_t0_[slot], 0.0) / fut_dt_[slot];
     if (x >= n - 1) {
       const double extra = (x - (n - 1)) * fut_dt_[slot];
       p.v = fut_v_[base + n - 1];
@@ -481,6 +523,7 @@ class TrafficPredictor : public Predictor {
   std::vector<int> slot_;  // per car: its future's slot, -1 when predicted
   // Recorded futures, kMaxFutureSamples per slot: s (relative, as TrackedCar::s), d, speeds.
   std::vector<double> fut_s_, fut_d_, fut_v_, fut_vd_, fut_dt_;
+  std::vector<double> fut_t0_;  // s: the future's first sample (> 0: a car to come)
   std::vector<int> fut_n_;
   std::vector<Memory> memory_;
   // Cars that gave a ghost last time, with the time they were first seen so (NaN: unknown).

@@ -256,6 +256,58 @@ TEST(RoadPlannerTest, RecordedFuturesAreWhatThePredictorPredicts) {
   EXPECT_NEAR(pred->Predict(0, 1.0).s, 10 + 10.0, 1e-6);
 }
 
+TEST(RoadPlannerTest, ACarToComeIsAbsentUntilItsFutureStarts) {
+  // A car not there yet (no row) enters 1.5 s from now 40 m behind the ego at 30 m/s, as a
+  // recorded car entering the map behind does. Before then it is out of reach (kAbsentS); from
+  // then on it is its recording. A future that starts later for a car that has a row is that
+  // row's car, not a second one.
+  auto road = Road(500, 2);
+  PredictorOptions o;
+  auto pred = MakeConstantVelocityPredictor(road, o);
+  CarFuture f;
+  f.id = 9;
+  f.dt = 0.1;
+  f.start = 1.5;
+  f.length = 12;
+  f.width = 2.5;
+  for (int k = 0; k <= 40; ++k) {
+    const map::CartesianPose q = road->line().ToCartesian(60 + 3.0 * k, 1.75);
+    f.x.push_back(q.x);
+    f.y.push_back(q.y);
+    f.v.push_back(30);
+    f.heading.push_back(q.heading);
+  }
+  const std::vector<CarFuture> futures = {f};
+  pred->Observe({}, 100, 0.0, futures);
+  ASSERT_EQ(pred->cars().size(), 1u);
+  const TrackedCar& car = pred->cars()[0];
+  EXPECT_EQ(car.id, 9);
+  EXPECT_TRUE(car.recorded);
+  EXPECT_DOUBLE_EQ(car.appears, 1.5);
+  EXPECT_DOUBLE_EQ(car.length, 12);
+  EXPECT_DOUBLE_EQ(car.s, kAbsentS);
+  EXPECT_DOUBLE_EQ(pred->Predict(0, 0.0).s, kAbsentS);
+  EXPECT_DOUBLE_EQ(pred->Predict(0, 1.49).s, kAbsentS);
+  EXPECT_NEAR(pred->Predict(0, 1.5).s, -40.0, 1e-6);  // its first sample, relative to the ego
+  EXPECT_NEAR(pred->Predict(0, 2.5).s, -40.0 + 30.0, 1e-6);
+  EXPECT_NEAR(pred->Predict(0, 2.5).d, 1.75, 1e-6);
+  EXPECT_NEAR(pred->Predict(0, 2.5).v, 30.0, 1e-6);
+  // With a row of the same id it is that row's car only.
+  const map::CartesianPose p = road->line().ToCartesian(80, 1.75);
+  const std::vector<SensorCar> rows = {{9, p.x, p.y, 10, 0, 80, 1.75}};
+  pred->Observe(rows, 100, 0.0, futures);
+  ASSERT_EQ(pred->cars().size(), 1u);
+  EXPECT_DOUBLE_EQ(pred->cars()[0].appears, 0.0);
+  EXPECT_NEAR(pred->Predict(0, 0.0).s, -20.0, 1e-6);
+  // Out of range (its first sample 300 m away), or a bad start: no car.
+  CarFuture far = f;
+  for (double& x : far.x) x += 300;
+  CarFuture bad = f;
+  bad.start = NAN;
+  pred->Observe({}, 100, 0.0, std::vector<CarFuture>{far, bad});
+  EXPECT_TRUE(pred->cars().empty());
+}
+
 TEST(RoadPlannerTest, RecordedFuturesPredictAsFreshWhenTheRecordingMovesOn) {
   // A bend (300 m radius), three recorded cars: one changing lanes, one braking, one cruising.
   // The predictor keeps its projections of the samples from cycle to cycle (each cycle's

@@ -31,7 +31,13 @@ struct TrackedCar {
   double lat_delay = 0;  // s before a predicted lateral move starts
   double length = 0, width = 0;  // footprint, m (the row's, else PredictorOptions' defaults)
   bool recorded = false;  // predicted from its CarFuture
+  // s after the observation a car to come appears (CarFuture::start); 0 for a car there now.
+  // Before it, Predict places the car kAbsentS behind the ego (out of every check's reach).
+  double appears = 0;
 };
+
+// m: where a car not there yet is predicted (TrackedCar::appears), relative to the ego.
+inline constexpr double kAbsentS = -1e6;
 
 struct PredictorOptions {
   double range = 200;        // m: cars farther along s are ignored
@@ -71,9 +77,10 @@ class Predictor {
   // coordinate `ego_s` (wrapped or not). `now` is the simulated time of the readings (s, any
   // origin, increasing between calls; NaN when unknown, e.g. after a resynchronisation): it
   // dates the readings from which later calls estimate accelerations. A row with a CarFuture
-  // in `futures` (same id) is predicted from it (its first kMaxFutureSamples samples) instead.
-  // Never fails: invalid rows and future samples are skipped (a future with any non-finite
-  // sample is not used). `ego_d` is the ego's lateral offset (m; NaN: unknown), which the
+  // in `futures` (same id) is predicted from it (its first kMaxFutureSamples samples) instead;
+  // a future with start > 0 whose id has no row is a car to come, tracked from then on (its
+  // first sample within `range`). Never fails: invalid rows and future samples are skipped (a
+  // future with any non-finite sample is not used). `ego_d` is the ego's lateral offset (m; NaN: unknown), which the
   // traffic's lane-change rule looks at (PredictorOptions::lane_change_ghosts).
   virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now,
                        std::span<const CarFuture> futures = {}, double ego_d = NAN) = 0;

@@ -21,12 +21,16 @@ struct SensorCar {
 };
 
 // A car's known future (a CommonRoad scenario's recorded trajectory, for `--prediction
-// recorded`): its centre, speed and heading every dt s from the telemetry's instant (sample 0)
-// on. The planner then uses it for that car instead of predicting it; past its last sample the
-// car keeps its last speed and heading.
+// recorded`): its centre, speed and heading every dt s from `start` s after the telemetry's
+// instant (sample 0) on. The planner then uses it for that car instead of predicting it; past
+// its last sample the car keeps its last speed and heading. A future with start > 0 is a car
+// not there yet (no SensorCar row): it appears at `start` with its first sample, and is absent
+// before.
 struct CarFuture {
-  int id = 0;      // the SensorCar it belongs to
+  int id = 0;       // the SensorCar it belongs to (start = 0), or a car to come (start > 0)
   double dt = 0.1;  // s
+  double start = 0;  // s, >= 0
+  double length = 0, width = 0;  // m: the footprint of a car to come (0: the default car's)
   std::vector<double> x, y, v, heading;  // m, m, m/s, rad (counter-clockwise from +x)
 };
 
