@@ -18,6 +18,8 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker
                      const CycleClock& clock)
     : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
   known_.reserve(ws_.order.capacity());
+  rest_.reserve(ws_.order.capacity());
+  clear_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
   contact_.reserve(ws_.order.capacity());
@@ -54,23 +56,58 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
 }
 
 int LeastHarm::CheapestClearEnough(bool* over_budget) {
+  // The cheapest candidate (exact cost, then index) that passes the three tests, found as
+  // CheckRest finds the cheapest feasible one: the candidates come off a heap by cost bound,
+  // the cheap tests first (bare boxes, clearance), and one that passes them waits in a second
+  // heap, by a bound raised one term at a time until it is its exact cost; the top of that
+  // heap, once no bound left ranks before it, is tested for the limits (the dearest test) and
+  // is the answer when it passes. The same candidate as walking the cost order, with no exact
+  // cost for one that collides.
   const int n = static_cast<int>(ws_.order.size());
+  rest_.clear();
+  clear_.clear();
   for (int r = 0; r < n; ++r) {
-    if (((r & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) || !scorer_.SortUpTo(r)) {
+    const int c = ws_.order[r];
+    rest_.push_back({scorer_.KnownBound(c), c});
+  }
+  const auto later = std::greater<BoundIndex>();
+  std::make_heap(rest_.begin(), rest_.end(), later);
+  for (int k = 0;; ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
       *over_budget = true;
       return -1;
     }
-    const int c = ws_.order[r];
+    if (!clear_.empty() && (rest_.empty() || clear_.front() < rest_.front())) {
+      if (const int c = clear_.front().second;
+          !scorer_.Resolved(c) || clear_.front().first != ws_.cand_cost[c]) {
+        clear_.front().first = scorer_.Advance(c);
+        SiftDownTop(clear_.begin(), clear_.end(), later);
+        continue;
+      }
+      std::pop_heap(clear_.begin(), clear_.end(), later);
+      const int c = clear_.back().second;
+      clear_.pop_back();
+      if (!checker_.CandidateBreaksLimits(c)) return c;
+      continue;
+    }
+    if (rest_.empty()) return -1;
+    const int c = rest_.front().second;
+    if (!scorer_.BoundComplete(c)) {
+      rest_.front().first = scorer_.Bound(c);
+      SiftDownTop(rest_.begin(), rest_.end(), later);
+      continue;
+    }
+    std::pop_heap(rest_.begin(), rest_.end(), later);
+    rest_.pop_back();
     if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
         ws_.n_steps) {
       continue;
     }
     const Checker::Rows rows = checker_.StepRows(c);
     if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.clear_enough) >= cfg_.clear_enough)) continue;
-    if (checker_.CandidateBreaksLimits(c)) continue;
-    return c;
+    clear_.push_back({scorer_.KnownBound(c), c});
+    std::push_heap(clear_.begin(), clear_.end(), later);
   }
-  return -1;
 }
 
 // In harm order the collision-free candidates come first, by clearance, then cost: when one

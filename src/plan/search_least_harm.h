@@ -220,6 +220,9 @@ class LeastHarm {
   int bounded_ = 0;
   std::vector<int> lon_hit_, lat_hit_;
   std::vector<int> heap_;  // BestClear's candidates, a heap by bound
+  // CheapestClearEnough: the candidates not taken yet (a heap by cost bound) and the ones
+  // that passed its cheap tests (a heap by a bound raised until it is the exact cost).
+  std::vector<BoundIndex> rest_, clear_;
   std::vector<char> visited_;  // BestClear: taken from the heap
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;
