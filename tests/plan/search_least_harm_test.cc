@@ -202,6 +202,58 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
   EXPECT_GT(chosen, 12);
 }
 
+// check.clear_enough: the cheapest candidate (exact cost, then index) whose bare boxes keep
+// that far from every car and that breaks no limit, also after the lazy check's Advance calls
+// moved bounds inside the scorer (a walk of the scorer's sorted order then went wrong: a dearer
+// candidate than the cheapest could win).
+TEST(SearchLeastHarmTest, ClearEnoughIsTheCheapestThatPassesAfterTheLazyCheck) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Overlay("check:\n  clear_enough: 0.5\n", "test").ok());
+  Stages st(config);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0), pick(0.0, 1.0);
+  int chosen = 0;
+  for (int scene = 0; scene < 48; ++scene) {
+    std::vector<SceneCar> cars;
+    for (int k = 0; k < 6 + scene / 3; ++k) {
+      cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
+    }
+    Start(st, cars);
+    st.Prepare({kS, 8.0 + scene % 12, 0, st.ws.lane_center[1], 0, 0}, cars);
+    st.lattice.Generate();
+    ASSERT_TRUE(st.scorer.Score());
+    // As CheckRest does: some bounds completed, some raised a term or more.
+    for (const int c : st.ws.order) {
+      if (pick(rng) < 0.5) st.scorer.Bound(c);
+      if (pick(rng) < 0.5) st.scorer.Advance(c);
+      if (pick(rng) < 0.5) st.scorer.Advance(c);
+    }
+    bool over_budget = false;
+    const bool ok = st.least_harm.Choose(&over_budget);
+    EXPECT_FALSE(over_budget);
+    // The reference: every exact cost, the cheapest that passes the three tests.
+    ASSERT_TRUE(st.scorer.ResolveAll());
+    int expected = -1;
+    for (const int c : st.ws.order) {
+      if (expected >= 0 && !Cheaper(st.ws, c, expected)) continue;
+      if (st.checker.FirstCollision(st.checker.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+          st.ws.n_steps) {
+        continue;
+      }
+      const Checker::Rows rows = st.checker.StepRows(c);
+      if (!(ClearanceAbove(st.ws, rows.s, rows.d, 0.5) >= 0.5)) continue;
+      if (st.checker.CandidateBreaksLimits(c)) continue;
+      expected = c;
+    }
+    if (expected < 0) continue;  // then the harm ranking decides (tested above)
+    ASSERT_TRUE(ok) << "scene " << scene;
+    EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    ++chosen;
+  }
+  EXPECT_GT(chosen, 16);
+}
+
 // Boxed in: a slow or stopped car ahead and cars alongside in the other lanes, so that every
 // candidate collides, and the latest contacts come from braking hard, which often breaks a
 // limit: the choice is then in an earlier contact group, which LatestContact reaches without
