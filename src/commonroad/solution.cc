@@ -16,8 +16,10 @@ namespace frenetic::commonroad {
 
 namespace {
 
-// CommonRoad's cost function ids (commonroad-io common/solution.py, CostFunction).
-constexpr const char* kCostIds[] = {"JB1", "SA1", "WX1", "SM1", "SM2", "SM3", "MW1", "TR1"};
+// CommonRoad's cost function ids (commonroad-io common/solution.py, CostFunction), and TR2, the
+// traffic-rule cost function of the drivability checker's traffic-rule evaluation set (its highD
+// solution files are "KS1:TR2:<scenario id>:2020a").
+constexpr const char* kCostIds[] = {"JB1", "SA1", "WX1", "SM1", "SM2", "SM3", "MW1", "TR1", "TR2"};
 
 bool KnownCost(std::string_view id) {
   return std::find(std::begin(kCostIds), std::end(kCostIds), id) != std::end(kCostIds);

@@ -153,6 +153,44 @@ TEST(SolutionTest, ReadsCommonRoadIoOutput) {
   EXPECT_DOUBLE_EQ(t.states[1].x, 0.93);
 }
 
+// The drivability checker's traffic-rule set names its cost function TR2 ("KS1:TR2:...").
+TEST(SolutionTest, ReadsTheTrafficRuleCostIdAndVehicleOne) {
+  std::string xml = kCommonRoadIoFile;
+  xml.replace(xml.find("KS2:JB1"), 7, "KS1:TR2");
+  const StatusOr<Solution> r = ParseSolution(xml, "tr2.xml");
+  ASSERT_TRUE(r.ok()) << r.message();
+  ASSERT_EQ(r->trajectories.size(), 1u);
+  EXPECT_EQ(r->trajectories[0].cost_function, "TR2");
+  EXPECT_EQ(r->trajectories[0].vehicle_type, 1);
+  EXPECT_EQ(r->BenchmarkId(), "KS1:TR2:USA_US101-10_1_T-1:2020a");
+}
+
+// Every solution file of ../shared/commonroad/highD (the recorded human drivers) reads: KS1, TR2,
+// one trajectory for the scenario beside it (named like the file, which the CLI does not rely on).
+TEST(SolutionTest, ReadsTheSharedHighDSolutionFiles) {
+  const std::filesystem::path dir = std::string(FRENETIC_SHARED_DIR) + "/commonroad/highD";
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > 13 && name.substr(name.size() - 13) == ".solution.xml") files.push_back(e.path());
+  }
+  if (files.empty()) GTEST_SKIP() << dir << " holds no solution files";
+  EXPECT_EQ(files.size(), 30u);
+  for (const std::filesystem::path& f : files) {
+    SCOPED_TRACE(f.string());
+    const StatusOr<Solution> r = LoadSolution(f.string());
+    ASSERT_TRUE(r.ok()) << r.message();
+    const std::string name = f.filename().string();
+    EXPECT_EQ(r->scenario_id, name.substr(0, name.size() - 13));
+    EXPECT_EQ(r->version, "2020a");
+    ASSERT_EQ(r->trajectories.size(), 1u);
+    EXPECT_EQ(r->trajectories[0].vehicle_type, 1);
+    EXPECT_EQ(r->trajectories[0].cost_function, "TR2");
+    EXPECT_GE(r->trajectories[0].states.size(), 2u);  // some are short: 2, 3, 7 states
+  }
+}
+
 struct BadSolution {
   const char* name;
   std::string from, to;  // every `from` in kCommonRoadIoFile replaced

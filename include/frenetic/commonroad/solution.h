@@ -26,7 +26,7 @@ namespace frenetic::commonroad {
 struct SolutionTrajectory {
   int problem_id = 0;
   int vehicle_type = 2;                 // 1, 2, 3 (vehicle id "KS<type>")
-  std::string cost_function = "WX1";    // JB1, SA1, WX1, SM1, SM2, SM3, MW1, TR1
+  std::string cost_function = "WX1";    // JB1, SA1, WX1, SM1, SM2, SM3, MW1, TR1, TR2
   std::vector<KsState> states;          // ordered by time step
 };
 
