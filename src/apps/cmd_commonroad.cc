@@ -20,6 +20,8 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/commonroad_report.h"
+#include "apps/commonroad_summary.h"
 #include "frenetic/commonroad/cost.h"
 #include "frenetic/commonroad/record.h"
 #include "frenetic/commonroad/runner.h"
@@ -32,6 +34,15 @@ namespace {
 
 namespace cr = commonroad;
 using nlohmann::json;
+using commonroad_cli::FileReport;
+using commonroad_cli::ProblemReport;
+using commonroad_cli::Summary;
+using commonroad_cli::SummarySettings;
+using commonroad_cli::Summarise;
+using commonroad_cli::SummaryJson;
+using commonroad_cli::SummaryText;
+using commonroad_cli::FileJson;
+using commonroad_cli::FileText;
 
 struct Args {
   std::vector<std::string> paths;
@@ -52,26 +63,6 @@ int Fail(const std::string& message) {
   return 1;
 }
 
-// One file's outcome.
-struct FileResult {
-  std::string path;
-  Status read;  // the scenario's parse
-  cr::ScenarioRun run;
-  // Per problem: the costs (when the trajectory has states) and the solution file written.
-  std::vector<std::map<std::string, double>> costs;
-  std::string solution_file;
-  Status solution_status;
-  Status record_status;  // the records' (--record)
-  cr::Vec2 origin;       // the scenario's local frame (Scenario::origin)
-};
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  return v[i];
-}
-
 // --record DIR: created when missing; an error names it when it is no writable directory.
 Status RecordDirWritable(const std::string& dir) {
   std::error_code ec;
@@ -89,44 +80,66 @@ Status RecordDirWritable(const std::string& dir) {
   return Status::Ok();
 }
 
-FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
+// What the output needs of one problem's run.
+ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem* problem) {
+  ProblemReport p;
+  p.problem_id = run.problem_id;
+  if (!run.road.ok()) p.road_error = run.road.message();
+  p.verdict = run.verdict;
+  p.stop = run.stop_reason;
+  if (problem != nullptr) p.initial_step = problem->initial.time_step;
+  p.lanes = run.lanes;
+  p.road_length_m = run.road_length;
+  p.route = run.route;
+  for (const cr::RunCycle& c : run.cycles) {
+    p.plan_ms.push_back(c.plan_ms);
+    p.candidates += c.candidates;
+    p.tracking_error_max_m = std::max(p.tracking_error_max_m, c.tracking_error);
+    p.not_ok_cycles += c.status != plan::PlanStatus::kOk;
+  }
+  p.computation_s = run.computation_s;
+  return p;
+}
+
+FileReport RunFile(const std::string& path, const plan::PlannerConfig& config,
                    const cr::RunOptions& options, const std::string& solution_dir,
                    const std::string& record_dir) {
-  FileResult r;
+  FileReport r;
   r.path = path;
   auto scenario = cr::LoadScenario(path);
   if (!scenario.ok()) {
-    r.read = scenario.status();
+    r.error = scenario.message();
     return r;
   }
   r.origin = scenario->origin;
+  r.dt = scenario->dt;
+  cr::ScenarioRun run;
   if (record_dir.empty()) {
-    r.run = cr::RunScenario(*scenario, config, options);
+    run = cr::RunScenario(*scenario, config, options);
   } else {
     cr::RunRecorder recorder(*scenario, record_dir, options.vehicle_type, options.prediction,
                              options.timing);
     cr::RunOptions recorded = options;
     recorder.Attach(&recorded);
-    r.run = cr::RunScenario(*scenario, config, recorded);
-    r.record_status = recorder.status();
+    run = cr::RunScenario(*scenario, config, recorded);
+    if (!recorder.status().ok()) r.record_error = recorder.status().message();
   }
+  r.benchmark_id = run.benchmark_id;
   const cr::VehicleParams vehicle = *cr::VehicleParamsForType(options.vehicle_type);
   cr::Solution solution;
   solution.scenario_id = scenario->benchmark_id;
   solution.date = cr::CurrentDate();
   solution.processor_name = cr::ProcessorName();
   double computation = 0;
-  for (size_t i = 0; i < r.run.problems.size(); ++i) {
-    const cr::ProblemRun& p = r.run.problems[i];
-    std::map<std::string, double> costs;
+  for (const cr::ProblemRun& p : run.problems) {
     const cr::PlanningProblem* problem = scenario->FindProblem(p.problem_id);
+    ProblemReport& report = r.problems.emplace_back(ReportProblem(p, problem));
     if (problem != nullptr && !p.trajectory.empty()) {
       for (const char* id : {"WX1", "JB1"}) {
         auto c = cr::EvaluateCost(id, *scenario, *problem, vehicle, p.trajectory);
-        if (c.ok()) costs[id] = c->total;
+        if (c.ok()) report.costs[id] = c->total;
       }
     }
-    r.costs.push_back(costs);
     computation += p.computation_s;
     if (!p.trajectory.empty()) {
       cr::SolutionTrajectory t;
@@ -143,84 +156,14 @@ FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
   }
   if (options.timing) solution.computation_time = computation;
   if (!solution_dir.empty() && !solution.trajectories.empty()) {
-    r.solution_status = cr::SaveSolution(solution, solution_dir);
-    if (r.solution_status.ok()) r.solution_file = solution.FileName();
-  }
-  return r;
-}
-
-json ProblemJson(const FileResult& f, size_t i) {
-  const cr::ProblemRun& p = f.run.problems[i];
-  json j;
-  j["problem"] = p.problem_id;
-  j["solved"] = p.verdict.solved;
-  if (!p.road.ok()) j["road_error"] = p.road.message();
-  j["goal_step"] = p.verdict.goal_step ? json(*p.verdict.goal_step) : json(nullptr);
-  json failures = json::array();
-  for (const cr::Failure& fl : p.verdict.failures) {
-    json e = {{"kind", cr::ToString(fl.kind)}, {"step", fl.step}, {"detail", fl.detail}};
-    if (fl.obstacle_id) e["obstacle"] = *fl.obstacle_id;
-    failures.push_back(e);
-  }
-  j["failures"] = failures;
-  if (p.verdict.infeasible_at_start) {
-    j["infeasible_at_start"] = p.verdict.infeasible_at_start->detail;
-  }
-  j["stop"] = p.stop_reason;
-  j["steps"] = static_cast<int>(p.cycles.size());
-  j["lanes"] = p.lanes;
-  j["road_length_m"] = p.road_length;
-  j["route"] = p.route;
-  std::vector<double> ms;
-  double cands = 0, track = 0;
-  int fallbacks = 0;
-  for (const cr::RunCycle& c : p.cycles) {
-    ms.push_back(c.plan_ms);
-    cands += c.candidates;
-    track = std::max(track, c.tracking_error);
-    fallbacks += c.status != plan::PlanStatus::kOk;
-  }
-  j["plan_ms"] = {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)},
-                  {"max", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())}};
-  j["candidates_mean"] = p.cycles.empty() ? 0.0 : cands / p.cycles.size();
-  j["not_ok_cycles"] = fallbacks;
-  j["tracking_error_max_m"] = track;
-  j["computation_s"] = p.computation_s;
-  j["costs"] = f.costs.size() > i ? json(f.costs[i]) : json::object();
-  return j;
-}
-
-std::string ProblemLine(const FileResult& f, size_t i) {
-  const cr::ProblemRun& p = f.run.problems[i];
-  char buf[512];
-  std::string verdict;
-  if (p.verdict.infeasible_at_start) {
-    verdict = p.verdict.Summary();
-  } else if (!p.road.ok()) {
-    verdict = "no road: " + p.road.message();
-  } else if (p.verdict.solved) {
-    verdict = "solved, goal at step " + std::to_string(*p.verdict.goal_step);
-  } else {
-    verdict = "FAILED: ";
-    for (size_t k = 0; k < p.verdict.failures.size(); ++k) {
-      const cr::Failure& fl = p.verdict.failures[k];
-      if (k > 0) verdict += "; ";
-      verdict += std::string(cr::ToString(fl.kind)) + " at step " + std::to_string(fl.step) +
-                 (fl.detail.empty() ? "" : " (" + fl.detail + ")");
+    const Status saved = cr::SaveSolution(solution, solution_dir);
+    if (saved.ok()) {
+      r.solution_file = solution.FileName();
+    } else {
+      r.solution_error = saved.message();
     }
   }
-  std::vector<double> ms;
-  for (const cr::RunCycle& c : p.cycles) ms.push_back(c.plan_ms);
-  std::snprintf(buf, sizeof(buf), "%-24s #%-5d %d lanes %5.0f m  %3zu steps  plan p50 %.2f p99 %.2f ms",
-                f.run.benchmark_id.c_str(), p.problem_id, p.lanes, p.road_length, p.cycles.size(),
-                Percentile(ms, 0.5), Percentile(ms, 0.99));
-  std::string line = buf;
-  if (f.costs.size() > i && f.costs[i].count("WX1")) {
-    std::snprintf(buf, sizeof(buf), "  WX1 %.1f  JB1 %.1f", f.costs[i].at("WX1"),
-                  f.costs[i].count("JB1") ? f.costs[i].at("JB1") : 0.0);
-    line += buf;
-  }
-  return line + "\n    " + verdict + "\n";
+  return r;
 }
 
 int Run(const Args& a) {
@@ -249,7 +192,7 @@ int Run(const Args& a) {
   if (!config.ok()) return Fail(config_path + ": " + config.message());
 
   const int n = static_cast<int>(files->size());
-  std::vector<FileResult> results(n);
+  std::vector<FileReport> results(n);
   const int jobs = std::clamp(a.jobs > 0 ? a.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, n);
   std::atomic<int> next{0}, done{0}, solved{0}, problems{0};
   std::mutex progress_mutex;
@@ -258,7 +201,7 @@ int Run(const Args& a) {
   auto worker = [&] {
     for (int i = next++; i < n; i = next++) {
       results[i] = RunFile((*files)[i], *config, options, a.solution_dir, a.record_dir);
-      for (const cr::ProblemRun& p : results[i].run.problems) {
+      for (const ProblemReport& p : results[i].problems) {
         ++problems;
         solved += p.verdict.solved;
       }
@@ -275,92 +218,25 @@ int Run(const Args& a) {
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
 
-  // Summary.
-  int total = 0, ok = 0, unreadable = 0;
-  std::map<std::string, int> reasons;
-  std::vector<double> ms;
-  double cands = 0;
-  int cycles = 0;
-  for (const FileResult& f : results) {
-    if (!f.read.ok()) {
-      ++unreadable;
-      continue;
-    }
-    for (const cr::ProblemRun& p : f.run.problems) {
-      ++total;
-      ok += p.verdict.solved;
-      if (!p.road.ok()) ++reasons["road"];
-      std::set<std::string> kinds;
-      for (const cr::Failure& fl : p.verdict.failures) kinds.insert(cr::ToString(fl.kind));
-      for (const std::string& k : kinds) ++reasons[k];
-      for (const cr::RunCycle& c : p.cycles) {
-        ms.push_back(c.plan_ms);
-        cands += c.candidates;
-        ++cycles;
-      }
-    }
-  }
-  const double max_ms = ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end());
+  const Summary summary = Summarise(results);
+  const SummarySettings settings{cr::ToString(*prediction), a.vehicle};
   if (a.json) {
-    json out;
-    json files_json = json::array();
-    for (const FileResult& f : results) {
-      json fj = {{"path", f.path}};
-      if (!f.read.ok()) {
-        fj["error"] = f.read.message();
-      } else {
-        fj["benchmark_id"] = f.run.benchmark_id;
-        // Read into a local frame (Scenario::origin): positions in failures are relative to it.
-        if (!(f.origin == cr::Vec2{})) fj["frame_origin"] = {f.origin.x, f.origin.y};
-        json probs = json::array();
-        for (size_t i = 0; i < f.run.problems.size(); ++i) probs.push_back(ProblemJson(f, i));
-        fj["problems"] = probs;
-        if (!f.solution_file.empty()) fj["solution_file"] = f.solution_file;
-        if (!f.solution_status.ok()) fj["solution_error"] = f.solution_status.message();
-      }
-      files_json.push_back(fj);
-    }
-    out["scenarios"] = files_json;
-    out["summary"] = {{"prediction", cr::ToString(*prediction)},
-                      {"vehicle", "KS" + std::to_string(a.vehicle)},
-                      {"problems", total},
-                      {"solved", ok},
-                      {"unreadable_files", unreadable},
-                      {"failures", reasons},
-                      {"cycles", cycles},
-                      {"plan_ms", {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)}, {"max", max_ms}}},
-                      {"candidates_mean", cycles ? cands / cycles : 0.0}};
+    json scenarios = json::array();
+    for (const FileReport& f : results) scenarios.push_back(FileJson(f));
+    const json out = {{"scenarios", scenarios}, {"summary", SummaryJson(summary, settings)}};
     std::printf("%s\n", out.dump().c_str());
   } else {
-    for (const FileResult& f : results) {
-      if (!f.read.ok()) {
-        std::printf("%s\n    UNREADABLE: %s\n", f.path.c_str(), f.read.message().c_str());
-        continue;
-      }
-      for (size_t i = 0; i < f.run.problems.size(); ++i) std::printf("%s", ProblemLine(f, i).c_str());
-      if (!f.solution_status.ok()) std::printf("    solution: %s\n", f.solution_status.message().c_str());
-    }
-    std::printf("\nsolved %d / %d problems (%s predictions, KS%d)", ok, total,
-                cr::ToString(*prediction), a.vehicle);
-    if (unreadable > 0) std::printf(", %d file(s) unreadable", unreadable);
-    std::printf("\n");
-    if (!reasons.empty()) {
-      std::printf("failures:");
-      for (const auto& [k, v] : reasons) std::printf(" %s %d", k.c_str(), v);
-      std::printf("\n");
-    }
-    std::printf("planning per cycle: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %d cycles\n",
-                Percentile(ms, 0.5), Percentile(ms, 0.99), max_ms, cycles);
-    std::printf("candidates per cycle: mean %.0f\n", cycles ? cands / cycles : 0.0);
+    for (const FileReport& f : results) std::printf("%s", FileText(f).c_str());
+    std::printf("%s", SummaryText(summary, settings).c_str());
   }
   // Records do not change the results above: a failure to write one is told on stderr.
   int record_errors = 0;
-  for (const FileResult& f : results) {
-    if (f.record_status.ok()) continue;
+  for (const FileReport& f : results) {
+    if (f.record_error.empty()) continue;
     ++record_errors;
-    std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_status.message().c_str());
+    std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_error.c_str());
   }
-  return unreadable > 0 || record_errors > 0 ? 1 : 0;
+  return summary.unreadable_files > 0 || record_errors > 0 ? 1 : 0;
 }
 
 }  // namespace
