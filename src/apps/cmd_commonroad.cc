@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/commonroad_reference.h"
 #include "apps/commonroad_report.h"
 #include "apps/commonroad_summary.h"
 #include "frenetic/commonroad/cost.h"
@@ -35,6 +36,7 @@ namespace {
 namespace cr = commonroad;
 using nlohmann::json;
 using commonroad_cli::FileReport;
+using commonroad_cli::ReferenceSet;
 using commonroad_cli::ProblemReport;
 using commonroad_cli::Summary;
 using commonroad_cli::SummarySettings;
@@ -52,6 +54,7 @@ struct Args {
   std::string overlay_path;
   std::string solution_dir;
   std::string record_dir;
+  std::vector<std::string> compare;
   bool json = false;
   int jobs = 0;
   bool progress = false;
@@ -101,11 +104,22 @@ ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem
   return p;
 }
 
-FileReport RunFile(const std::string& path, const plan::PlannerConfig& config,
-                   const cr::RunOptions& options, const std::string& solution_dir,
-                   const std::string& record_dir) {
+// One file to run: a scenario, or a solution file that could not be read (reported as is).
+struct WorkItem {
+  std::string path;
+  std::string error;
+};
+
+FileReport RunFile(const WorkItem& item, const plan::PlannerConfig& config,
+                   const cr::RunOptions& options, const ReferenceSet& references,
+                   const std::string& solution_dir, const std::string& record_dir) {
   FileReport r;
-  r.path = path;
+  r.path = item.path;
+  if (!item.error.empty()) {
+    r.error = item.error;
+    return r;
+  }
+  const std::string& path = item.path;
   auto scenario = cr::LoadScenario(path);
   if (!scenario.ok()) {
     r.error = scenario.message();
@@ -125,6 +139,7 @@ FileReport RunFile(const std::string& path, const plan::PlannerConfig& config,
     if (!recorder.status().ok()) r.record_error = recorder.status().message();
   }
   r.benchmark_id = run.benchmark_id;
+  const auto reference = references.by_scenario.find(scenario->benchmark_id);
   const cr::VehicleParams vehicle = *cr::VehicleParamsForType(options.vehicle_type);
   cr::Solution solution;
   solution.scenario_id = scenario->benchmark_id;
@@ -138,6 +153,14 @@ FileReport RunFile(const std::string& path, const plan::PlannerConfig& config,
       for (const char* id : {"WX1", "JB1"}) {
         auto c = cr::EvaluateCost(id, *scenario, *problem, vehicle, p.trajectory);
         if (c.ok()) report.costs[id] = c->total;
+      }
+    }
+    if (problem != nullptr && reference != references.by_scenario.end()) {
+      for (const cr::SolutionTrajectory& t : reference->second.solution.trajectories) {
+        if (t.problem_id != p.problem_id) continue;
+        report.reference =
+            commonroad_cli::EvaluateReference(*scenario, *problem, reference->second.path, t);
+        break;
       }
     }
     computation += p.computation_s;
@@ -176,6 +199,40 @@ int Run(const Args& a) {
   if (Status st = options.Validate(); !st.ok()) return Fail("--vehicle: " + st.message());
   auto files = cr::ScenarioFiles(a.paths);
   if (!files.ok()) return Fail(files.message());
+  // Solution files among the paths are references, not scenarios; --compare adds more.
+  std::vector<std::string> solution_files;
+  std::vector<bool> is_solution;
+  for (const std::string& f : *files) {
+    is_solution.push_back(commonroad_cli::IsSolutionFile(f));
+    if (is_solution.back()) solution_files.push_back(f);
+  }
+  if (solution_files.size() == files->size()) {
+    return Fail("no scenario files among the paths (" + std::to_string(solution_files.size()) +
+                " solution file(s))");
+  }
+  if (!a.compare.empty()) {
+    auto more = commonroad_cli::CompareFiles(a.compare);
+    if (!more.ok()) return Fail(more.message());
+    solution_files.insert(solution_files.end(), more->begin(), more->end());
+  }
+  const ReferenceSet references = commonroad_cli::LoadReferences(solution_files);
+  // The files to run in the order of the paths, with the solution files that could not be read
+  // (those of --compare last): they are reported as unreadable scenarios are.
+  std::map<std::string, std::string> unreadable;
+  for (const ReferenceSet::Unreadable& u : references.unreadable) unreadable[u.path] = u.message;
+  std::vector<WorkItem> items;
+  for (size_t i = 0; i < files->size(); ++i) {
+    const std::string& f = (*files)[i];
+    if (!is_solution[i]) {
+      items.push_back({f, ""});
+    } else if (const auto u = unreadable.find(f); u != unreadable.end()) {
+      items.push_back({f, u->second});
+      unreadable.erase(u);
+    }
+  }
+  for (const ReferenceSet::Unreadable& u : references.unreadable) {
+    if (unreadable.count(u.path)) items.push_back({u.path, u.message});
+  }
   if (!a.solution_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.solution_dir, ec);
@@ -191,7 +248,7 @@ int Run(const Args& a) {
   auto config = cr::CommonRoadConfig(*base, *cr::VehicleParamsForType(a.vehicle), *prediction);
   if (!config.ok()) return Fail(config_path + ": " + config.message());
 
-  const int n = static_cast<int>(files->size());
+  const int n = static_cast<int>(items.size());
   std::vector<FileReport> results(n);
   const int jobs = std::clamp(a.jobs > 0 ? a.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, n);
   std::atomic<int> next{0}, done{0}, solved{0}, problems{0};
@@ -200,7 +257,7 @@ int Run(const Args& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (int i = next++; i < n; i = next++) {
-      results[i] = RunFile((*files)[i], *config, options, a.solution_dir, a.record_dir);
+      results[i] = RunFile(items[i], *config, options, references, a.solution_dir, a.record_dir);
       for (const ProblemReport& p : results[i].problems) {
         ++problems;
         solved += p.verdict.solved;
@@ -218,7 +275,9 @@ int Run(const Args& a) {
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
 
-  const Summary summary = Summarise(results);
+  std::map<std::string, std::string> solution_paths;
+  for (const auto& [id, ref] : references.by_scenario) solution_paths[id] = ref.path;
+  const Summary summary = Summarise(results, solution_paths);
   const SummarySettings settings{cr::ToString(*prediction), a.vehicle};
   if (a.json) {
     json scenarios = json::array();
@@ -228,6 +287,15 @@ int Run(const Args& a) {
   } else {
     for (const FileReport& f : results) std::printf("%s", FileText(f).c_str());
     std::printf("%s", SummaryText(summary, settings).c_str());
+  }
+  for (const std::string& note : references.notes) {
+    std::fprintf(stderr, "frenetic commonroad: %s\n", note.c_str());
+  }
+  if (!summary.comparison.unpaired.empty()) {
+    std::string list;
+    for (const std::string& u : summary.comparison.unpaired) list += (list.empty() ? "" : ", ") + u;
+    std::fprintf(stderr, "frenetic commonroad: %zu solution file(s) without their scenario among the paths: %s\n",
+                 summary.comparison.unpaired.size(), list.c_str());
   }
   // Records do not change the results above: a failure to write one is told on stderr.
   int record_errors = 0;
@@ -276,6 +344,19 @@ void RegisterCommonRoad(CLI::App& app) {
                   "ego, its planned path and up to 40 candidates per cycle; `frenetic report "
                   "FILE` replays it. The results do not change (the candidates are traced by a "
                   "replica of the planner, off the planning thread). Default: none");
+  sub->add_option("--compare", args->compare,
+                  "CommonRoad solution files, or directories of them, to compare with (each "
+                  "paired with its scenario by the scenario id in its benchmark id, e.g. "
+                  "KS1:TR2:<scenario id>:2020a; other files there are skipped). Solution files "
+                  "among the paths are used too. Per problem with one: its WX1 and JB1 costs "
+                  "(with its own vehicle), its time to the goal (steps and s from its first "
+                  "state) beside ours, and its verdict in one field; the summary counts the "
+                  "problems both reach the goal (ours: solved; its: a state meets a goal) and "
+                  "among them those where ours is cheaper (WX1 strictly lower), and those only "
+                  "one reaches. Problems infeasible at start are not compared. Repeatable or a "
+                  "comma-separated list. Default: none")
+      ->allow_extra_args(false)
+      ->delimiter(',');
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
                   "Scenario files planned in parallel (0 = all cores). Results do not depend on "

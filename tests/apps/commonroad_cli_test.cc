@@ -282,7 +282,7 @@ TEST_F(CommonRoadCliTest, HelpListsEveryOptionWithItsDefault) {
   CommandResult r = RunFrenetic("commonroad --help");
   ASSERT_EQ(r.exit_code, 0);
   for (const char* option : {"--prediction", "--vehicle", "--config", "--commonroad-config",
-                             "--solution-dir", "--jobs"}) {
+                             "--solution-dir", "--compare", "--jobs"}) {
     const std::size_t at = r.out.find(std::string("  ") + option + " ");
     ASSERT_NE(at, std::string::npos) << option << " missing from\n" << r.out;
     const std::size_t next = r.out.find("\n  -", at + 1);

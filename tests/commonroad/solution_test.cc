@@ -239,6 +239,30 @@ INSTANTIATE_TEST_SUITE_P(
                     "<CommonRoadSolution ", "computation_time 'soon'"}),
     [](const auto& info) { return std::string(info.param.name); });
 
+TEST(SolutionTest, PeekRootElementNamesTheRootWithoutParsing) {
+  EXPECT_EQ(PeekRootElementOf(kCommonRoadIoFile), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf(WriteSolution(Sample())), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad timeStepSize=\"0.1\">"), "commonRoad");
+  // What may come before the root.
+  EXPECT_EQ(PeekRootElementOf("\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<!-- <commonRoad> -->\n"
+                              "<!DOCTYPE s [<!ENTITY a \"<b>\">]>\n<?pi x?><CommonRoadSolution/>"),
+            "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad>"), "commonRoad");
+  // The rest of the document is not read: an unclosed root still has its name.
+  EXPECT_EQ(PeekRootElementOf("<CommonRoadSolution benchmark_id=\"x"), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf(""), "");
+  EXPECT_EQ(PeekRootElementOf("not xml at all"), "");
+  EXPECT_EQ(PeekRootElementOf("<!-- never closed <commonRoad>"), "");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad"), "");  // cut before the name ends
+
+  const std::string dir = ::testing::TempDir() + "/frenetic_peek_test";
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(SaveSolution(Sample(), dir).ok());
+  EXPECT_EQ(PeekRootElement(dir + "/" + Sample().FileName()), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElement(dir + "/missing.xml"), "");
+  EXPECT_EQ(PeekRootElement(dir), "");  // a directory
+}
+
 TEST(SolutionTest, ProcessorNameAndDateHelpers) {
   const std::string date = CurrentDate();
   ASSERT_EQ(date.size(), 19u);

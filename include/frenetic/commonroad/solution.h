@@ -56,6 +56,15 @@ Status SaveSolution(const Solution& solution, const std::string& dir);
 StatusOr<Solution> ParseSolution(std::string_view xml, std::string_view source);
 StatusOr<Solution> LoadSolution(const std::string& path);
 
+// The name of the root element of the XML file at `path`, read from its first 64 KiB without
+// parsing the document (the XML declaration, processing instructions, comments and a doctype
+// skipped): "CommonRoadSolution" for a solution file, "commonRoad" for a scenario. "" when the
+// file cannot be read or no element starts there. Tells a directory's solution files from its
+// scenarios at the cost of one small read each.
+std::string PeekRootElement(const std::string& path);
+// The same on the start of a document.
+std::string PeekRootElementOf(std::string_view text);
+
 // "YYYY-MM-DDThh:mm:ss" of the current local time, and the processor's model name from
 // /proc/cpuinfo with "(R)" and "(TM)" removed ("" when unknown), as commonroad-io fills them in.
 std::string CurrentDate();
