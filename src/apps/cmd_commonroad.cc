@@ -316,8 +316,13 @@ void RegisterCommonRoad(CLI::App& app) {
       "Plan closed-loop through CommonRoad scenarios (format 2020a): every planning problem of "
       "every file, the other traffic following its recording, each step replanned; each "
       "problem's KS trajectory is judged like CommonRoad's solution checker (goal, collision, "
-      "road, kinematic limits, KS dynamics). Unsolved problems are results: the exit status is "
-      "0 unless a file could not be read (1).");
+      "road, kinematic limits, KS dynamics). The summary counts problems infeasible at start "
+      "(the initial state collides or is off the road) apart from the solved and the unsolved, "
+      "and gives per family of scenarios (country and map, the map's trailing site number "
+      "dropped: DEU_LocationALower26 -> DEU_LocationALower; a road's number kept: USA_US101) the "
+      "problems, solved, unsolved by their first failure (the earliest by step) and planning "
+      "time per cycle (ms). Unsolved problems are results: the exit status is 0 unless a file "
+      "could not be read (1).");
   sub->add_option("paths", args->paths, "Scenario files (.xml) or directories of them")
       ->required();
   sub->add_option("--prediction", args->prediction,
