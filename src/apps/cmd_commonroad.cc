@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/commonroad_mpi.h"
 #include "apps/commonroad_reference.h"
 #include "apps/commonroad_report.h"
 #include "apps/commonroad_summary.h"
@@ -29,6 +30,7 @@
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/tune/cluster.h"
 
 namespace frenetic::apps {
 namespace {
@@ -36,6 +38,7 @@ namespace {
 namespace cr = commonroad;
 using nlohmann::json;
 using commonroad_cli::FileReport;
+using commonroad_cli::InputFile;
 using commonroad_cli::ReferenceSet;
 using commonroad_cli::ProblemReport;
 using commonroad_cli::Summary;
@@ -60,11 +63,6 @@ struct Args {
   bool progress = false;
   bool no_timing = false;
 };
-
-int Fail(const std::string& message) {
-  std::fprintf(stderr, "frenetic commonroad: %s\n", message.c_str());
-  return 1;
-}
 
 // --record DIR: created when missing; an error names it when it is no writable directory.
 Status RecordDirWritable(const std::string& dir) {
@@ -104,13 +102,7 @@ ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem
   return p;
 }
 
-// One file to run: a scenario, or a solution file that could not be read (reported as is).
-struct WorkItem {
-  std::string path;
-  std::string error;
-};
-
-FileReport RunFile(const WorkItem& item, const plan::PlannerConfig& config,
+FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
                    const cr::RunOptions& options, const ReferenceSet& references,
                    const std::string& solution_dir, const std::string& record_dir) {
   FileReport r;
@@ -189,75 +181,74 @@ FileReport RunFile(const WorkItem& item, const plan::PlannerConfig& config,
   return r;
 }
 
-int Run(const Args& a) {
-  auto prediction = cr::ParsePredictionMode(a.prediction);
-  if (!prediction.ok()) return Fail("--prediction: " + prediction.message());
+// Everything a run needs, made from the arguments alone (the same on every rank).
+struct Setup {
+  cr::PredictionMode prediction = cr::PredictionMode::kRecorded;
   cr::RunOptions options;
-  options.prediction = *prediction;
-  options.vehicle_type = a.vehicle;
-  options.timing = !a.no_timing;
-  if (Status st = options.Validate(); !st.ok()) return Fail("--vehicle: " + st.message());
+  plan::PlannerConfig config;
+  commonroad_cli::Inputs inputs;
+};
+
+StatusOr<Setup> Prepare(const Args& a) {
+  Setup setup;
+  auto prediction = cr::ParsePredictionMode(a.prediction);
+  if (!prediction.ok()) return Status::Error("--prediction: " + prediction.message());
+  setup.prediction = *prediction;
+  setup.options.prediction = *prediction;
+  setup.options.vehicle_type = a.vehicle;
+  setup.options.timing = !a.no_timing;
+  if (Status st = setup.options.Validate(); !st.ok()) {
+    return Status::Error("--vehicle: " + st.message());
+  }
   auto files = cr::ScenarioFiles(a.paths);
-  if (!files.ok()) return Fail(files.message());
+  if (!files.ok()) return files.status();
   // Solution files among the paths are references, not scenarios; --compare adds more.
-  std::vector<std::string> solution_files;
-  std::vector<bool> is_solution;
-  for (const std::string& f : *files) {
-    is_solution.push_back(commonroad_cli::IsSolutionFile(f));
-    if (is_solution.back()) solution_files.push_back(f);
-  }
-  if (solution_files.size() == files->size()) {
-    return Fail("no scenario files among the paths (" + std::to_string(solution_files.size()) +
-                " solution file(s))");
-  }
-  if (!a.compare.empty()) {
-    auto more = commonroad_cli::CompareFiles(a.compare);
-    if (!more.ok()) return Fail(more.message());
-    solution_files.insert(solution_files.end(), more->begin(), more->end());
-  }
-  const ReferenceSet references = commonroad_cli::LoadReferences(solution_files);
-  // The files to run in the order of the paths, with the solution files that could not be read
-  // (those of --compare last): they are reported as unreadable scenarios are.
-  std::map<std::string, std::string> unreadable;
-  for (const ReferenceSet::Unreadable& u : references.unreadable) unreadable[u.path] = u.message;
-  std::vector<WorkItem> items;
-  for (size_t i = 0; i < files->size(); ++i) {
-    const std::string& f = (*files)[i];
-    if (!is_solution[i]) {
-      items.push_back({f, ""});
-    } else if (const auto u = unreadable.find(f); u != unreadable.end()) {
-      items.push_back({f, u->second});
-      unreadable.erase(u);
-    }
-  }
-  for (const ReferenceSet::Unreadable& u : references.unreadable) {
-    if (unreadable.count(u.path)) items.push_back({u.path, u.message});
-  }
+  auto inputs = commonroad_cli::SortInputs(*files, a.compare);
+  if (!inputs.ok()) return inputs.status();
+  setup.inputs = std::move(*inputs);
   if (!a.solution_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.solution_dir, ec);
-    if (ec) return Fail("--solution-dir " + a.solution_dir + ": " + ec.message());
+    if (ec) return Status::Error("--solution-dir " + a.solution_dir + ": " + ec.message());
   }
   if (!a.record_dir.empty()) {
-    if (Status st = RecordDirWritable(a.record_dir); !st.ok()) return Fail(st.message());
+    if (Status st = RecordDirWritable(a.record_dir); !st.ok()) return st;
   }
   const std::string config_path =
       a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
   auto base = cr::LoadBaseConfig(config_path, a.overlay_path);
-  if (!base.ok()) return Fail(base.message());
+  if (!base.ok()) return base.status();
   auto config = cr::CommonRoadConfig(*base, *cr::VehicleParamsForType(a.vehicle), *prediction);
-  if (!config.ok()) return Fail(config_path + ": " + config.message());
+  if (!config.ok()) return Status::Error(config_path + ": " + config.message());
+  setup.config = std::move(*config);
+  return setup;
+}
 
-  const int n = static_cast<int>(items.size());
+// Runs this rank's files (all of them on a single process) on --jobs threads; the other slots
+// stay empty.
+std::vector<FileReport> RunShare(const Args& a, const Setup& setup, const tune::Cluster& cluster) {
+  const std::vector<commonroad_cli::InputFile>& files = setup.inputs.files;
+  const int n = static_cast<int>(files.size());
+  std::vector<int> mine;
+  for (int i = 0; i < n; ++i) {
+    if (commonroad_cli::RunsHere(i, cluster)) mine.push_back(i);
+  }
+  const int share = static_cast<int>(mine.size());
   std::vector<FileReport> results(n);
-  const int jobs = std::clamp(a.jobs > 0 ? a.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, n);
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  const int jobs = std::max(1, std::min(a.jobs > 0 ? a.jobs : cores, share));
   std::atomic<int> next{0}, done{0}, solved{0}, problems{0};
   std::mutex progress_mutex;
-  const bool show = a.progress || isatty(fileno(stderr)) != 0;
+  const bool tty = isatty(fileno(stderr)) != 0;
+  const bool show = a.progress || tty;
+  const std::string rank =
+      cluster.distributed() ? "rank " + std::to_string(cluster.rank()) + ": " : "";
   const auto t0 = std::chrono::steady_clock::now();
   auto worker = [&] {
-    for (int i = next++; i < n; i = next++) {
-      results[i] = RunFile(items[i], *config, options, references, a.solution_dir, a.record_dir);
+    for (int k = next++; k < share; k = next++) {
+      const int i = mine[k];
+      results[i] = RunFile(files[i], setup.config, setup.options, setup.inputs.references,
+                           a.solution_dir, a.record_dir);
       for (const ProblemReport& p : results[i].problems) {
         ++problems;
         solved += p.verdict.solved;
@@ -266,19 +257,24 @@ int Run(const Args& a) {
       if (!show) continue;
       std::lock_guard<std::mutex> lock(progress_mutex);
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "%sscenarios %d/%d  solved %d/%d  elapsed %.1f s%s",
-                   isatty(fileno(stderr)) ? "\r" : "", d, n, solved.load(), problems.load(), s,
-                   isatty(fileno(stderr)) && d < n ? "   " : "\n");
+      std::fprintf(stderr, "%s%sscenarios %d/%d  solved %d/%d  elapsed %.1f s%s", tty ? "\r" : "",
+                   rank.c_str(), d, share, solved.load(), problems.load(), s,
+                   tty && d < share ? "   " : "\n");
     }
   };
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
+  return results;
+}
 
+// Rank 0's output from every file's report.
+int Print(const Args& a, const Setup& setup, const std::vector<FileReport>& results) {
+  const ReferenceSet& references = setup.inputs.references;
   std::map<std::string, std::string> solution_paths;
   for (const auto& [id, ref] : references.by_scenario) solution_paths[id] = ref.path;
   const Summary summary = Summarise(results, solution_paths);
-  const SummarySettings settings{cr::ToString(*prediction), a.vehicle};
+  const SummarySettings settings{cr::ToString(setup.prediction), a.vehicle};
   if (a.json) {
     json scenarios = json::array();
     for (const FileReport& f : results) scenarios.push_back(FileJson(f));
@@ -294,7 +290,9 @@ int Run(const Args& a) {
   if (!summary.comparison.unpaired.empty()) {
     std::string list;
     for (const std::string& u : summary.comparison.unpaired) list += (list.empty() ? "" : ", ") + u;
-    std::fprintf(stderr, "frenetic commonroad: %zu solution file(s) without their scenario among the paths: %s\n",
+    std::fprintf(stderr,
+                 "frenetic commonroad: %zu solution file(s) without their scenario among the "
+                 "paths: %s\n",
                  summary.comparison.unpaired.size(), list.c_str());
   }
   // Records do not change the results above: a failure to write one is told on stderr.
@@ -305,6 +303,32 @@ int Run(const Args& a) {
     std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_error.c_str());
   }
   return summary.unreadable_files > 0 || record_errors > 0 ? 1 : 0;
+}
+
+int Run(const Args& a) {
+  // MPI starts only under mpirun; a plain run is one process.
+  tune::Cluster cluster;
+  const bool root = cluster.rank() == 0;
+  auto fail = [&](const std::string& message) {
+    std::fprintf(stderr, "frenetic commonroad%s: %s\n",
+                 root ? "" : (" (rank " + std::to_string(cluster.rank()) + ")").c_str(),
+                 message.c_str());
+    return 1;
+  };
+  const StatusOr<Setup> setup = Prepare(a);
+  // Every rank must agree that set-up worked before any waits for another. Rank 0 tells its
+  // error; another rank tells its own only when rank 0 had none (the same arguments fail alike).
+  std::vector<double> failed = {root && !setup.ok() ? 1.0 : 0.0, setup.ok() ? 0.0 : 1.0};
+  cluster.SumToRoot(&failed);
+  cluster.Broadcast(&failed);
+  if (!setup.ok()) return root || failed[0] == 0 ? fail(setup.message()) : 1;
+  if (failed[1] > 0) return 1;
+
+  std::vector<FileReport> results = RunShare(a, *setup, cluster);
+  if (Status st = commonroad_cli::GatherReports(cluster, &results); !st.ok()) {
+    return fail(st.message());
+  }
+  return root ? Print(a, *setup, results) : 0;
 }
 
 }  // namespace
@@ -321,8 +345,9 @@ void RegisterCommonRoad(CLI::App& app) {
       "and gives per family of scenarios (country and map, the map's trailing site number "
       "dropped: DEU_LocationALower26 -> DEU_LocationALower; a road's number kept: USA_US101) the "
       "problems, solved, unsolved by their first failure (the earliest by step) and planning "
-      "time per cycle (ms). Unsolved problems are results: the exit status is 0 unless a file "
-      "could not be read (1).");
+      "time per cycle (ms). Under `mpirun -n N` the files are split across the ranks (file i on "
+      "rank i mod N, each with --jobs threads) and rank 0 prints what a single process prints. "
+      "Unsolved problems are results: the exit status is 0 unless a file could not be read (1).");
   sub->add_option("paths", args->paths, "Scenario files (.xml) or directories of them")
       ->required();
   sub->add_option("--prediction", args->prediction,
@@ -364,8 +389,8 @@ void RegisterCommonRoad(CLI::App& app) {
       ->delimiter(',');
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
-                  "Scenario files planned in parallel (0 = all cores). Results do not depend on "
-                  "it. Default: 0")
+                  "Scenario files planned in parallel per process (under mpirun, per rank; 0 = "
+                  "all cores). Results do not depend on it. Default: 0")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,
                 "Show the progress line on stderr even when it is not a terminal");

@@ -58,6 +58,41 @@ ReferenceSet LoadReferences(const std::vector<std::string>& files) {
   return set;
 }
 
+StatusOr<Inputs> SortInputs(const std::vector<std::string>& files,
+                            const std::vector<std::string>& compare) {
+  std::vector<std::string> solution_files;
+  std::vector<bool> is_solution;
+  for (const std::string& f : files) {
+    is_solution.push_back(IsSolutionFile(f));
+    if (is_solution.back()) solution_files.push_back(f);
+  }
+  if (solution_files.size() == files.size()) {
+    return Status::Error("no scenario files among the paths (" +
+                         std::to_string(solution_files.size()) + " solution file(s))");
+  }
+  if (!compare.empty()) {
+    auto more = CompareFiles(compare);
+    if (!more.ok()) return more.status();
+    solution_files.insert(solution_files.end(), more->begin(), more->end());
+  }
+  Inputs in;
+  in.references = LoadReferences(solution_files);
+  std::map<std::string, std::string> unreadable;
+  for (const ReferenceSet::Unreadable& u : in.references.unreadable) unreadable[u.path] = u.message;
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (!is_solution[i]) {
+      in.files.push_back({files[i], ""});
+    } else if (const auto u = unreadable.find(files[i]); u != unreadable.end()) {
+      in.files.push_back({files[i], u->second});
+      unreadable.erase(u);
+    }
+  }
+  for (const ReferenceSet::Unreadable& u : in.references.unreadable) {
+    if (unreadable.count(u.path)) in.files.push_back({u.path, u.message});
+  }
+  return in;
+}
+
 ReferenceReport EvaluateReference(const cr::Scenario& scenario, const cr::PlanningProblem& problem,
                                   const std::string& file, const cr::SolutionTrajectory& t) {
   ReferenceReport r;

@@ -41,6 +41,24 @@ struct ReferenceSet {
 // Loads the solution files in order; a path given twice (the same file) is loaded once.
 ReferenceSet LoadReferences(const std::vector<std::string>& files);
 
+// One file to run: a scenario, or a solution file that could not be read (reported as an
+// unreadable scenario is, with `error`).
+struct InputFile {
+  std::string path;
+  std::string error;
+};
+
+struct Inputs {
+  std::vector<InputFile> files;  // in the paths' order; --compare's unreadable ones last
+  ReferenceSet references;
+};
+
+// `files` (commonroad::ScenarioFiles of the paths) sorted by root element, with the solution
+// files --compare names (`compare`: its paths, may be empty). An error (one line) when no
+// scenario is left or --compare names nothing usable (CompareFiles).
+StatusOr<Inputs> SortInputs(const std::vector<std::string>& files,
+                            const std::vector<std::string>& compare);
+
 // The trajectory `t` (the solution file `file`'s, in the file's coordinates) judged and costed
 // on the scenario's problem with the file's vehicle (see ReferenceReport).
 ReferenceReport EvaluateReference(const cr::Scenario& scenario, const cr::PlanningProblem& problem,
