@@ -1,5 +1,8 @@
 // frenetic commonroad: closed-loop planning through CommonRoad scenarios (runner.h), each problem
-// judged by the verdict (verdict.h), with a summary over all of them.
+// judged by the verdict (verdict.h), with a summary over all of them. Here: the options, set-up,
+// running this process's share of the files; the reports and their output live in
+// commonroad_report.h, the summary in commonroad_summary.h, the reference trajectories in
+// commonroad_reference.h, the split across MPI ranks in commonroad_mpi.h.
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,7 +15,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -37,17 +39,17 @@ namespace {
 
 namespace cr = commonroad;
 using nlohmann::json;
-using commonroad_cli::FileReport;
-using commonroad_cli::InputFile;
-using commonroad_cli::ReferenceSet;
-using commonroad_cli::ProblemReport;
-using commonroad_cli::Summary;
-using commonroad_cli::SummarySettings;
-using commonroad_cli::Summarise;
-using commonroad_cli::SummaryJson;
-using commonroad_cli::SummaryText;
 using commonroad_cli::FileJson;
+using commonroad_cli::FileReport;
 using commonroad_cli::FileText;
+using commonroad_cli::InputFile;
+using commonroad_cli::ProblemReport;
+using commonroad_cli::ReferenceSet;
+using commonroad_cli::Summarise;
+using commonroad_cli::Summary;
+using commonroad_cli::SummaryJson;
+using commonroad_cli::SummarySettings;
+using commonroad_cli::SummaryText;
 
 struct Args {
   std::vector<std::string> paths;
@@ -227,7 +229,7 @@ StatusOr<Setup> Prepare(const Args& a) {
 // Runs this rank's files (all of them on a single process) on --jobs threads; the other slots
 // stay empty.
 std::vector<FileReport> RunShare(const Args& a, const Setup& setup, const tune::Cluster& cluster) {
-  const std::vector<commonroad_cli::InputFile>& files = setup.inputs.files;
+  const std::vector<InputFile>& files = setup.inputs.files;
   const int n = static_cast<int>(files.size());
   std::vector<int> mine;
   for (int i = 0; i < n; ++i) {
