@@ -143,7 +143,8 @@ FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
   for (const cr::ProblemRun& p : run.problems) {
     const cr::PlanningProblem* problem = scenario->FindProblem(p.problem_id);
     ProblemReport& report = r.problems.emplace_back(ReportProblem(p, problem));
-    if (problem != nullptr && !p.trajectory.empty()) {
+    // A problem infeasible at start planned nothing: its one state has no costs to speak of.
+    if (problem != nullptr && !p.trajectory.empty() && !p.verdict.infeasible_at_start) {
       for (const char* id : {"WX1", "JB1"}) {
         auto c = cr::EvaluateCost(id, *scenario, *problem, vehicle, p.trajectory);
         if (c.ok()) report.costs[id] = c->total;

@@ -253,6 +253,8 @@ TEST_F(CommonRoadCliTest, InfeasibleAtStartIsCountedApart) {
   CommandResult r = RunFrenetic("commonroad " + (dir_ / "blocked").string() + " --no-timing");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   EXPECT_THAT(r.out, HasSubstr("    infeasible at start: collision at step 0"));
+  // Nothing was planned: no costs.
+  EXPECT_THAT(r.out, ::testing::ContainsRegex("\nZAM_Blocked-2_1_T-1 +#1 [^\n]*ms\n"));
   EXPECT_THAT(r.out, HasSubstr("\nsolved 1 / 1 problems feasible at start (1 infeasible at start, "
                                "2 in all; recorded predictions, KS2)\n"));
   EXPECT_THAT(r.out, Not(HasSubstr("failures:")));
@@ -261,7 +263,14 @@ TEST_F(CommonRoadCliTest, InfeasibleAtStartIsCountedApart) {
 
   CommandResult j = RunFrenetic("commonroad " + (dir_ / "blocked").string() + " --json --no-timing");
   ASSERT_EQ(j.exit_code, 0) << j.out;
-  const json sum = json::parse(j.out).at("summary");
+  const json doc = json::parse(j.out);
+  for (const json& s : doc.at("scenarios")) {
+    if (s.at("benchmark_id") == "ZAM_Blocked-2_1_T-1") {
+      EXPECT_EQ(s.at("problems")[0].at("costs"), json::object());
+      EXPECT_EQ(s.at("problems")[0].at("stop"), "infeasible_at_start");
+    }
+  }
+  const json sum = doc.at("summary");
   EXPECT_EQ(sum.at("problems"), 2);
   EXPECT_EQ(sum.at("infeasible_at_start"), 1);
   EXPECT_EQ(sum.at("solved"), 1);
