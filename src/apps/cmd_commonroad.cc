@@ -1,5 +1,8 @@
 // frenetic commonroad: closed-loop planning through CommonRoad scenarios (runner.h), each problem
-// judged by the verdict (verdict.h), with a summary over all of them.
+// judged by the verdict (verdict.h), with a summary over all of them. Here: the options, set-up,
+// running this process's share of the files; the reports and their output live in
+// commonroad_report.h, the summary in commonroad_summary.h, the reference trajectories in
+// commonroad_reference.h, the split across MPI ranks in commonroad_mpi.h.
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,7 +15,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,18 +22,34 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/commonroad_mpi.h"
+#include "apps/commonroad_reference.h"
+#include "apps/commonroad_report.h"
+#include "apps/commonroad_summary.h"
 #include "frenetic/commonroad/cost.h"
 #include "frenetic/commonroad/record.h"
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/tune/cluster.h"
 
 namespace frenetic::apps {
 namespace {
 
 namespace cr = commonroad;
 using nlohmann::json;
+using commonroad_cli::FileJson;
+using commonroad_cli::FileReport;
+using commonroad_cli::FileText;
+using commonroad_cli::InputFile;
+using commonroad_cli::ProblemReport;
+using commonroad_cli::ReferenceSet;
+using commonroad_cli::Summarise;
+using commonroad_cli::Summary;
+using commonroad_cli::SummaryJson;
+using commonroad_cli::SummarySettings;
+using commonroad_cli::SummaryText;
 
 struct Args {
   std::vector<std::string> paths;
@@ -41,36 +59,12 @@ struct Args {
   std::string overlay_path;
   std::string solution_dir;
   std::string record_dir;
+  std::vector<std::string> compare;
   bool json = false;
   int jobs = 0;
   bool progress = false;
   bool no_timing = false;
 };
-
-int Fail(const std::string& message) {
-  std::fprintf(stderr, "frenetic commonroad: %s\n", message.c_str());
-  return 1;
-}
-
-// One file's outcome.
-struct FileResult {
-  std::string path;
-  Status read;  // the scenario's parse
-  cr::ScenarioRun run;
-  // Per problem: the costs (when the trajectory has states) and the solution file written.
-  std::vector<std::map<std::string, double>> costs;
-  std::string solution_file;
-  Status solution_status;
-  Status record_status;  // the records' (--record)
-  cr::Vec2 origin;       // the scenario's local frame (Scenario::origin)
-};
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  return v[i];
-}
 
 // --record DIR: created when missing; an error names it when it is no writable directory.
 Status RecordDirWritable(const std::string& dir) {
@@ -89,44 +83,81 @@ Status RecordDirWritable(const std::string& dir) {
   return Status::Ok();
 }
 
-FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
-                   const cr::RunOptions& options, const std::string& solution_dir,
-                   const std::string& record_dir) {
-  FileResult r;
-  r.path = path;
+// What the output needs of one problem's run.
+ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem* problem) {
+  ProblemReport p;
+  p.problem_id = run.problem_id;
+  if (!run.road.ok()) p.road_error = run.road.message();
+  p.verdict = run.verdict;
+  p.stop = run.stop_reason;
+  if (problem != nullptr) p.initial_step = problem->initial.time_step;
+  p.lanes = run.lanes;
+  p.road_length_m = run.road_length;
+  p.route = run.route;
+  for (const cr::RunCycle& c : run.cycles) {
+    p.plan_ms.push_back(c.plan_ms);
+    p.candidates += c.candidates;
+    p.tracking_error_max_m = std::max(p.tracking_error_max_m, c.tracking_error);
+    p.not_ok_cycles += c.status != plan::PlanStatus::kOk;
+  }
+  p.computation_s = run.computation_s;
+  return p;
+}
+
+FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
+                   const cr::RunOptions& options, const ReferenceSet& references,
+                   const std::string& solution_dir, const std::string& record_dir) {
+  FileReport r;
+  r.path = item.path;
+  if (!item.error.empty()) {
+    r.error = item.error;
+    return r;
+  }
+  const std::string& path = item.path;
   auto scenario = cr::LoadScenario(path);
   if (!scenario.ok()) {
-    r.read = scenario.status();
+    r.error = scenario.message();
     return r;
   }
   r.origin = scenario->origin;
+  r.dt = scenario->dt;
+  cr::ScenarioRun run;
   if (record_dir.empty()) {
-    r.run = cr::RunScenario(*scenario, config, options);
+    run = cr::RunScenario(*scenario, config, options);
   } else {
     cr::RunRecorder recorder(*scenario, record_dir, options.vehicle_type, options.prediction,
                              options.timing);
     cr::RunOptions recorded = options;
     recorder.Attach(&recorded);
-    r.run = cr::RunScenario(*scenario, config, recorded);
-    r.record_status = recorder.status();
+    run = cr::RunScenario(*scenario, config, recorded);
+    if (!recorder.status().ok()) r.record_error = recorder.status().message();
   }
+  r.benchmark_id = run.benchmark_id;
+  const auto reference = references.by_scenario.find(scenario->benchmark_id);
   const cr::VehicleParams vehicle = *cr::VehicleParamsForType(options.vehicle_type);
   cr::Solution solution;
   solution.scenario_id = scenario->benchmark_id;
   solution.date = cr::CurrentDate();
   solution.processor_name = cr::ProcessorName();
   double computation = 0;
-  for (size_t i = 0; i < r.run.problems.size(); ++i) {
-    const cr::ProblemRun& p = r.run.problems[i];
-    std::map<std::string, double> costs;
+  for (const cr::ProblemRun& p : run.problems) {
     const cr::PlanningProblem* problem = scenario->FindProblem(p.problem_id);
-    if (problem != nullptr && !p.trajectory.empty()) {
+    ProblemReport& report = r.problems.emplace_back(ReportProblem(p, problem));
+    // A problem infeasible at start planned nothing: its one state has no costs to speak of.
+    if (problem != nullptr && !p.trajectory.empty() && !p.verdict.infeasible_at_start) {
       for (const char* id : {"WX1", "JB1"}) {
         auto c = cr::EvaluateCost(id, *scenario, *problem, vehicle, p.trajectory);
-        if (c.ok()) costs[id] = c->total;
+        if (c.ok()) report.costs[id] = c->total;
       }
     }
-    r.costs.push_back(costs);
+    if (problem != nullptr && reference != references.by_scenario.end()) {
+      for (const cr::SolutionTrajectory& t : reference->second.solution.trajectories) {
+        if (t.problem_id != p.problem_id) continue;
+        report.reference =
+            commonroad_cli::EvaluateReference(*scenario, *problem, reference->second.path, t);
+        break;
+      }
+    }
     computation += p.computation_s;
     if (!p.trajectory.empty()) {
       cr::SolutionTrajectory t;
@@ -143,122 +174,85 @@ FileResult RunFile(const std::string& path, const plan::PlannerConfig& config,
   }
   if (options.timing) solution.computation_time = computation;
   if (!solution_dir.empty() && !solution.trajectories.empty()) {
-    r.solution_status = cr::SaveSolution(solution, solution_dir);
-    if (r.solution_status.ok()) r.solution_file = solution.FileName();
+    const Status saved = cr::SaveSolution(solution, solution_dir);
+    if (saved.ok()) {
+      r.solution_file = solution.FileName();
+    } else {
+      r.solution_error = saved.message();
+    }
   }
   return r;
 }
 
-json ProblemJson(const FileResult& f, size_t i) {
-  const cr::ProblemRun& p = f.run.problems[i];
-  json j;
-  j["problem"] = p.problem_id;
-  j["solved"] = p.verdict.solved;
-  if (!p.road.ok()) j["road_error"] = p.road.message();
-  j["goal_step"] = p.verdict.goal_step ? json(*p.verdict.goal_step) : json(nullptr);
-  json failures = json::array();
-  for (const cr::Failure& fl : p.verdict.failures) {
-    json e = {{"kind", cr::ToString(fl.kind)}, {"step", fl.step}, {"detail", fl.detail}};
-    if (fl.obstacle_id) e["obstacle"] = *fl.obstacle_id;
-    failures.push_back(e);
-  }
-  j["failures"] = failures;
-  if (p.verdict.infeasible_at_start) {
-    j["infeasible_at_start"] = p.verdict.infeasible_at_start->detail;
-  }
-  j["stop"] = p.stop_reason;
-  j["steps"] = static_cast<int>(p.cycles.size());
-  j["lanes"] = p.lanes;
-  j["road_length_m"] = p.road_length;
-  j["route"] = p.route;
-  std::vector<double> ms;
-  double cands = 0, track = 0;
-  int fallbacks = 0;
-  for (const cr::RunCycle& c : p.cycles) {
-    ms.push_back(c.plan_ms);
-    cands += c.candidates;
-    track = std::max(track, c.tracking_error);
-    fallbacks += c.status != plan::PlanStatus::kOk;
-  }
-  j["plan_ms"] = {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)},
-                  {"max", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())}};
-  j["candidates_mean"] = p.cycles.empty() ? 0.0 : cands / p.cycles.size();
-  j["not_ok_cycles"] = fallbacks;
-  j["tracking_error_max_m"] = track;
-  j["computation_s"] = p.computation_s;
-  j["costs"] = f.costs.size() > i ? json(f.costs[i]) : json::object();
-  return j;
-}
-
-std::string ProblemLine(const FileResult& f, size_t i) {
-  const cr::ProblemRun& p = f.run.problems[i];
-  char buf[512];
-  std::string verdict;
-  if (p.verdict.infeasible_at_start) {
-    verdict = p.verdict.Summary();
-  } else if (!p.road.ok()) {
-    verdict = "no road: " + p.road.message();
-  } else if (p.verdict.solved) {
-    verdict = "solved, goal at step " + std::to_string(*p.verdict.goal_step);
-  } else {
-    verdict = "FAILED: ";
-    for (size_t k = 0; k < p.verdict.failures.size(); ++k) {
-      const cr::Failure& fl = p.verdict.failures[k];
-      if (k > 0) verdict += "; ";
-      verdict += std::string(cr::ToString(fl.kind)) + " at step " + std::to_string(fl.step) +
-                 (fl.detail.empty() ? "" : " (" + fl.detail + ")");
-    }
-  }
-  std::vector<double> ms;
-  for (const cr::RunCycle& c : p.cycles) ms.push_back(c.plan_ms);
-  std::snprintf(buf, sizeof(buf), "%-24s #%-5d %d lanes %5.0f m  %3zu steps  plan p50 %.2f p99 %.2f ms",
-                f.run.benchmark_id.c_str(), p.problem_id, p.lanes, p.road_length, p.cycles.size(),
-                Percentile(ms, 0.5), Percentile(ms, 0.99));
-  std::string line = buf;
-  if (f.costs.size() > i && f.costs[i].count("WX1")) {
-    std::snprintf(buf, sizeof(buf), "  WX1 %.1f  JB1 %.1f", f.costs[i].at("WX1"),
-                  f.costs[i].count("JB1") ? f.costs[i].at("JB1") : 0.0);
-    line += buf;
-  }
-  return line + "\n    " + verdict + "\n";
-}
-
-int Run(const Args& a) {
-  auto prediction = cr::ParsePredictionMode(a.prediction);
-  if (!prediction.ok()) return Fail("--prediction: " + prediction.message());
+// Everything a run needs, made from the arguments alone (the same on every rank).
+struct Setup {
+  cr::PredictionMode prediction = cr::PredictionMode::kRecorded;
   cr::RunOptions options;
-  options.prediction = *prediction;
-  options.vehicle_type = a.vehicle;
-  options.timing = !a.no_timing;
-  if (Status st = options.Validate(); !st.ok()) return Fail("--vehicle: " + st.message());
+  plan::PlannerConfig config;
+  commonroad_cli::Inputs inputs;
+};
+
+StatusOr<Setup> Prepare(const Args& a) {
+  Setup setup;
+  auto prediction = cr::ParsePredictionMode(a.prediction);
+  if (!prediction.ok()) return Status::Error("--prediction: " + prediction.message());
+  setup.prediction = *prediction;
+  setup.options.prediction = *prediction;
+  setup.options.vehicle_type = a.vehicle;
+  setup.options.timing = !a.no_timing;
+  if (Status st = setup.options.Validate(); !st.ok()) {
+    return Status::Error("--vehicle: " + st.message());
+  }
   auto files = cr::ScenarioFiles(a.paths);
-  if (!files.ok()) return Fail(files.message());
+  if (!files.ok()) return files.status();
+  // Solution files among the paths are references, not scenarios; --compare adds more.
+  auto inputs = commonroad_cli::SortInputs(*files, a.compare);
+  if (!inputs.ok()) return inputs.status();
+  setup.inputs = std::move(*inputs);
   if (!a.solution_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.solution_dir, ec);
-    if (ec) return Fail("--solution-dir " + a.solution_dir + ": " + ec.message());
+    if (ec) return Status::Error("--solution-dir " + a.solution_dir + ": " + ec.message());
   }
   if (!a.record_dir.empty()) {
-    if (Status st = RecordDirWritable(a.record_dir); !st.ok()) return Fail(st.message());
+    if (Status st = RecordDirWritable(a.record_dir); !st.ok()) return st;
   }
   const std::string config_path =
       a.config_path.empty() ? plan::PlannerConfig::DefaultPath() : a.config_path;
   auto base = cr::LoadBaseConfig(config_path, a.overlay_path);
-  if (!base.ok()) return Fail(base.message());
+  if (!base.ok()) return base.status();
   auto config = cr::CommonRoadConfig(*base, *cr::VehicleParamsForType(a.vehicle), *prediction);
-  if (!config.ok()) return Fail(config_path + ": " + config.message());
+  if (!config.ok()) return Status::Error(config_path + ": " + config.message());
+  setup.config = std::move(*config);
+  return setup;
+}
 
-  const int n = static_cast<int>(files->size());
-  std::vector<FileResult> results(n);
-  const int jobs = std::clamp(a.jobs > 0 ? a.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1, n);
+// Runs this rank's files (all of them on a single process) on --jobs threads; the other slots
+// stay empty.
+std::vector<FileReport> RunShare(const Args& a, const Setup& setup, const tune::Cluster& cluster) {
+  const std::vector<InputFile>& files = setup.inputs.files;
+  const int n = static_cast<int>(files.size());
+  std::vector<int> mine;
+  for (int i = 0; i < n; ++i) {
+    if (commonroad_cli::RunsHere(i, cluster)) mine.push_back(i);
+  }
+  const int share = static_cast<int>(mine.size());
+  std::vector<FileReport> results(n);
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  const int jobs = std::max(1, std::min(a.jobs > 0 ? a.jobs : cores, share));
   std::atomic<int> next{0}, done{0}, solved{0}, problems{0};
   std::mutex progress_mutex;
-  const bool show = a.progress || isatty(fileno(stderr)) != 0;
+  const bool tty = isatty(fileno(stderr)) != 0;
+  const bool show = a.progress || tty;
+  const std::string rank =
+      cluster.distributed() ? "rank " + std::to_string(cluster.rank()) + ": " : "";
   const auto t0 = std::chrono::steady_clock::now();
   auto worker = [&] {
-    for (int i = next++; i < n; i = next++) {
-      results[i] = RunFile((*files)[i], *config, options, a.solution_dir, a.record_dir);
-      for (const cr::ProblemRun& p : results[i].run.problems) {
+    for (int k = next++; k < share; k = next++) {
+      const int i = mine[k];
+      results[i] = RunFile(files[i], setup.config, setup.options, setup.inputs.references,
+                           a.solution_dir, a.record_dir);
+      for (const ProblemReport& p : results[i].problems) {
         ++problems;
         solved += p.verdict.solved;
       }
@@ -266,101 +260,78 @@ int Run(const Args& a) {
       if (!show) continue;
       std::lock_guard<std::mutex> lock(progress_mutex);
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::fprintf(stderr, "%sscenarios %d/%d  solved %d/%d  elapsed %.1f s%s",
-                   isatty(fileno(stderr)) ? "\r" : "", d, n, solved.load(), problems.load(), s,
-                   isatty(fileno(stderr)) && d < n ? "   " : "\n");
+      std::fprintf(stderr, "%s%sscenarios %d/%d  solved %d/%d  elapsed %.1f s%s", tty ? "\r" : "",
+                   rank.c_str(), d, share, solved.load(), problems.load(), s,
+                   tty && d < share ? "   " : "\n");
     }
   };
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
+  return results;
+}
 
-  // Summary.
-  int total = 0, ok = 0, unreadable = 0;
-  std::map<std::string, int> reasons;
-  std::vector<double> ms;
-  double cands = 0;
-  int cycles = 0;
-  for (const FileResult& f : results) {
-    if (!f.read.ok()) {
-      ++unreadable;
-      continue;
-    }
-    for (const cr::ProblemRun& p : f.run.problems) {
-      ++total;
-      ok += p.verdict.solved;
-      if (!p.road.ok()) ++reasons["road"];
-      std::set<std::string> kinds;
-      for (const cr::Failure& fl : p.verdict.failures) kinds.insert(cr::ToString(fl.kind));
-      for (const std::string& k : kinds) ++reasons[k];
-      for (const cr::RunCycle& c : p.cycles) {
-        ms.push_back(c.plan_ms);
-        cands += c.candidates;
-        ++cycles;
-      }
-    }
-  }
-  const double max_ms = ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end());
+// Rank 0's output from every file's report.
+int Print(const Args& a, const Setup& setup, const std::vector<FileReport>& results) {
+  const ReferenceSet& references = setup.inputs.references;
+  std::map<std::string, std::string> solution_paths;
+  for (const auto& [id, ref] : references.by_scenario) solution_paths[id] = ref.path;
+  const Summary summary = Summarise(results, solution_paths);
+  const SummarySettings settings{cr::ToString(setup.prediction), a.vehicle};
   if (a.json) {
-    json out;
-    json files_json = json::array();
-    for (const FileResult& f : results) {
-      json fj = {{"path", f.path}};
-      if (!f.read.ok()) {
-        fj["error"] = f.read.message();
-      } else {
-        fj["benchmark_id"] = f.run.benchmark_id;
-        // Read into a local frame (Scenario::origin): positions in failures are relative to it.
-        if (!(f.origin == cr::Vec2{})) fj["frame_origin"] = {f.origin.x, f.origin.y};
-        json probs = json::array();
-        for (size_t i = 0; i < f.run.problems.size(); ++i) probs.push_back(ProblemJson(f, i));
-        fj["problems"] = probs;
-        if (!f.solution_file.empty()) fj["solution_file"] = f.solution_file;
-        if (!f.solution_status.ok()) fj["solution_error"] = f.solution_status.message();
-      }
-      files_json.push_back(fj);
-    }
-    out["scenarios"] = files_json;
-    out["summary"] = {{"prediction", cr::ToString(*prediction)},
-                      {"vehicle", "KS" + std::to_string(a.vehicle)},
-                      {"problems", total},
-                      {"solved", ok},
-                      {"unreadable_files", unreadable},
-                      {"failures", reasons},
-                      {"cycles", cycles},
-                      {"plan_ms", {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)}, {"max", max_ms}}},
-                      {"candidates_mean", cycles ? cands / cycles : 0.0}};
+    json scenarios = json::array();
+    for (const FileReport& f : results) scenarios.push_back(FileJson(f));
+    const json out = {{"scenarios", scenarios}, {"summary", SummaryJson(summary, settings)}};
     std::printf("%s\n", out.dump().c_str());
   } else {
-    for (const FileResult& f : results) {
-      if (!f.read.ok()) {
-        std::printf("%s\n    UNREADABLE: %s\n", f.path.c_str(), f.read.message().c_str());
-        continue;
-      }
-      for (size_t i = 0; i < f.run.problems.size(); ++i) std::printf("%s", ProblemLine(f, i).c_str());
-      if (!f.solution_status.ok()) std::printf("    solution: %s\n", f.solution_status.message().c_str());
-    }
-    std::printf("\nsolved %d / %d problems (%s predictions, KS%d)", ok, total,
-                cr::ToString(*prediction), a.vehicle);
-    if (unreadable > 0) std::printf(", %d file(s) unreadable", unreadable);
-    std::printf("\n");
-    if (!reasons.empty()) {
-      std::printf("failures:");
-      for (const auto& [k, v] : reasons) std::printf(" %s %d", k.c_str(), v);
-      std::printf("\n");
-    }
-    std::printf("planning per cycle: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %d cycles\n",
-                Percentile(ms, 0.5), Percentile(ms, 0.99), max_ms, cycles);
-    std::printf("candidates per cycle: mean %.0f\n", cycles ? cands / cycles : 0.0);
+    for (const FileReport& f : results) std::printf("%s", FileText(f).c_str());
+    std::printf("%s", SummaryText(summary, settings).c_str());
+  }
+  for (const std::string& note : references.notes) {
+    std::fprintf(stderr, "frenetic commonroad: %s\n", note.c_str());
+  }
+  if (!summary.comparison.unpaired.empty()) {
+    std::string list;
+    for (const std::string& u : summary.comparison.unpaired) list += (list.empty() ? "" : ", ") + u;
+    std::fprintf(stderr,
+                 "frenetic commonroad: %zu solution file(s) without their scenario among the "
+                 "paths: %s\n",
+                 summary.comparison.unpaired.size(), list.c_str());
   }
   // Records do not change the results above: a failure to write one is told on stderr.
   int record_errors = 0;
-  for (const FileResult& f : results) {
-    if (f.record_status.ok()) continue;
+  for (const FileReport& f : results) {
+    if (f.record_error.empty()) continue;
     ++record_errors;
-    std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_status.message().c_str());
+    std::fprintf(stderr, "frenetic commonroad: --record: %s\n", f.record_error.c_str());
   }
-  return unreadable > 0 || record_errors > 0 ? 1 : 0;
+  return summary.unreadable_files > 0 || record_errors > 0 ? 1 : 0;
+}
+
+int Run(const Args& a) {
+  // MPI starts only under mpirun; a plain run is one process.
+  tune::Cluster cluster;
+  const bool root = cluster.rank() == 0;
+  auto fail = [&](const std::string& message) {
+    std::fprintf(stderr, "frenetic commonroad%s: %s\n",
+                 root ? "" : (" (rank " + std::to_string(cluster.rank()) + ")").c_str(),
+                 message.c_str());
+    return 1;
+  };
+  const StatusOr<Setup> setup = Prepare(a);
+  // Every rank must agree that set-up worked before any waits for another. Rank 0 tells its
+  // error; another rank tells its own only when rank 0 had none (the same arguments fail alike).
+  std::vector<double> failed = {root && !setup.ok() ? 1.0 : 0.0, setup.ok() ? 0.0 : 1.0};
+  cluster.SumToRoot(&failed);
+  cluster.Broadcast(&failed);
+  if (!setup.ok()) return root || failed[0] == 0 ? fail(setup.message()) : 1;
+  if (failed[1] > 0) return 1;
+
+  std::vector<FileReport> results = RunShare(a, *setup, cluster);
+  if (Status st = commonroad_cli::GatherReports(cluster, &results); !st.ok()) {
+    return fail(st.message());
+  }
+  return root ? Print(a, *setup, results) : 0;
 }
 
 }  // namespace
@@ -372,8 +343,14 @@ void RegisterCommonRoad(CLI::App& app) {
       "Plan closed-loop through CommonRoad scenarios (format 2020a): every planning problem of "
       "every file, the other traffic following its recording, each step replanned; each "
       "problem's KS trajectory is judged like CommonRoad's solution checker (goal, collision, "
-      "road, kinematic limits, KS dynamics). Unsolved problems are results: the exit status is "
-      "0 unless a file could not be read (1).");
+      "road, kinematic limits, KS dynamics). The summary counts problems infeasible at start "
+      "(the initial state collides or is off the road) apart from the solved and the unsolved, "
+      "and gives per family of scenarios (country and map, the map's trailing site number "
+      "dropped: DEU_LocationALower26 -> DEU_LocationALower; a road's number kept: USA_US101) the "
+      "problems, solved, unsolved by their first failure (the earliest by step) and planning "
+      "time per cycle (ms). Under `mpirun -n N` the files are split across the ranks (file i on "
+      "rank i mod N, each with --jobs threads) and rank 0 prints what a single process prints. "
+      "Unsolved problems are results: the exit status is 0 unless a file could not be read (1).");
   sub->add_option("paths", args->paths, "Scenario files (.xml) or directories of them")
       ->required();
   sub->add_option("--prediction", args->prediction,
@@ -400,10 +377,23 @@ void RegisterCommonRoad(CLI::App& app) {
                   "ego, its planned path and up to 40 candidates per cycle; `frenetic report "
                   "FILE` replays it. The results do not change (the candidates are traced by a "
                   "replica of the planner, off the planning thread). Default: none");
+  sub->add_option("--compare", args->compare,
+                  "CommonRoad solution files, or directories of them, to compare with (each "
+                  "paired with its scenario by the scenario id in its benchmark id, e.g. "
+                  "KS1:TR2:<scenario id>:2020a; other files there are skipped). Solution files "
+                  "among the paths are used too. Per problem with one: its WX1 and JB1 costs "
+                  "(with its own vehicle), its time to the goal (steps and s from its first "
+                  "state) beside ours, and its verdict in one field; the summary counts the "
+                  "problems both reach the goal (ours: solved; its: a state meets a goal) and "
+                  "among them those where ours is cheaper (WX1 strictly lower), and those only "
+                  "one reaches. Problems infeasible at start are not compared. Repeatable or a "
+                  "comma-separated list. Default: none")
+      ->allow_extra_args(false)
+      ->delimiter(',');
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
-                  "Scenario files planned in parallel (0 = all cores). Results do not depend on "
-                  "it. Default: 0")
+                  "Scenario files planned in parallel per process (under mpirun, per rank; 0 = "
+                  "all cores). Results do not depend on it. Default: 0")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,
                 "Show the progress line on stderr even when it is not a terminal");

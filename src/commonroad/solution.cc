@@ -16,8 +16,10 @@ namespace frenetic::commonroad {
 
 namespace {
 
-// CommonRoad's cost function ids (commonroad-io common/solution.py, CostFunction).
-constexpr const char* kCostIds[] = {"JB1", "SA1", "WX1", "SM1", "SM2", "SM3", "MW1", "TR1"};
+// CommonRoad's cost function ids (commonroad-io common/solution.py, CostFunction), and TR2, the
+// traffic-rule cost function of the drivability checker's traffic-rule evaluation set (its highD
+// solution files are "KS1:TR2:<scenario id>:2020a").
+constexpr const char* kCostIds[] = {"JB1", "SA1", "WX1", "SM1", "SM2", "SM3", "MW1", "TR1", "TR2"};
 
 bool KnownCost(std::string_view id) {
   return std::find(std::begin(kCostIds), std::end(kCostIds), id) != std::end(kCostIds);
@@ -221,6 +223,45 @@ StatusOr<Solution> LoadSolution(const std::string& path) {
   StatusOr<std::string> text = ReadXmlFile(path);
   if (!text.ok()) return text.status();
   return ParseSolution(*text, path);
+}
+
+std::string PeekRootElementOf(std::string_view text) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+  size_t at = 0;
+  // Skips to just past `end`; false when it does not occur.
+  auto skip_past = [&](std::string_view end) {
+    const size_t found = text.find(end, at);
+    if (found == std::string_view::npos) return false;
+    at = found + end.size();
+    return true;
+  };
+  while (true) {
+    at = text.find('<', at);
+    if (at == std::string_view::npos || at + 1 >= text.size()) return "";
+    const std::string_view rest = text.substr(at);
+    if (rest.substr(0, 2) == "<?") {
+      if (!skip_past("?>")) return "";
+    } else if (rest.substr(0, 4) == "<!--") {
+      if (!skip_past("-->")) return "";
+    } else if (rest.substr(0, 2) == "<!") {  // a doctype, with its internal subset if any
+      const size_t bracket = text.find('[', at), close = text.find('>', at);
+      if (bracket != std::string_view::npos && bracket < close && !skip_past("]")) return "";
+      if (!skip_past(">")) return "";
+    } else {
+      const size_t end = rest.find_first_of(" \t\r\n/>", 1);
+      if (end == std::string_view::npos) return "";
+      return std::string(rest.substr(1, end - 1));
+    }
+  }
+}
+
+std::string PeekRootElement(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::string head(64 * 1024, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return PeekRootElementOf(head);
 }
 
 std::string CurrentDate() {

@@ -1,5 +1,6 @@
 #include "frenetic/tune/cluster.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 #ifdef FRENETIC_HAVE_MPI
@@ -64,6 +65,40 @@ void Cluster::SumToRoot(std::vector<double>* data) const {
     (*data)[i] = sum;
   }
 #endif
+}
+
+std::vector<std::string> Cluster::GatherToRoot(const std::string& data) const {
+  if (size_ <= 1) return {data};
+  std::vector<std::string> all;
+#ifdef FRENETIC_HAVE_MPI
+  // The lengths first, then each rank's bytes from rank 0 in rank order, in pieces that fit an
+  // int count (a report of many files may exceed one).
+  constexpr long long kPiece = 1 << 30;
+  long long n = static_cast<long long>(data.size());
+  std::vector<long long> sizes(rank_ == 0 ? static_cast<std::size_t>(size_) : 0);
+  MPI_Gather(&n, 1, MPI_LONG_LONG, sizes.data(), 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  if (rank_ != 0) {
+    for (long long at = 0; at < n; at += kPiece) {
+      MPI_Send(data.data() + at, static_cast<int>(std::min(kPiece, n - at)), MPI_BYTE, 0, 0,
+               MPI_COMM_WORLD);
+    }
+    return all;
+  }
+  all.resize(static_cast<std::size_t>(size_));
+  all[0] = data;
+  for (int r = 1; r < size_; ++r) {
+    std::string& s = all[static_cast<std::size_t>(r)];
+    s.resize(static_cast<std::size_t>(sizes[static_cast<std::size_t>(r)]));
+    for (long long at = 0; at < static_cast<long long>(s.size()); at += kPiece) {
+      MPI_Recv(s.data() + at,
+               static_cast<int>(std::min(kPiece, static_cast<long long>(s.size()) - at)), MPI_BYTE,
+               r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    }
+  }
+#else
+  (void)data;
+#endif
+  return all;
 }
 
 }  // namespace frenetic::tune

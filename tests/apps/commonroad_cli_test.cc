@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 namespace crt = commonroad::testing;
 using nlohmann::json;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // A goal 140 m ahead at the ego's speed, within 5-9 s: solved.
 std::string SolvableXml() {
@@ -51,6 +52,15 @@ std::string MalformedXml() {
   return xml.Str();
 }
 
+// A parked car where the ego starts: infeasible at start.
+std::string BlockedXml() {
+  crt::ScenarioXml xml("ZAM_Blocked-2_1_T-1");
+  crt::AddStraightRoad(xml, 400)
+      .StaticObstacle(9, 4.5, 2, {12, -1.75}, 0)
+      .Problem(1, {10, -1.75}, 0, 20, {crt::GoalRectangleXml({150, -1.75}, 10, 3, 0, 50, 90)});
+  return xml.Str();
+}
+
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
   std::istringstream in(text);
@@ -68,6 +78,9 @@ class CommonRoadCliTest : public ::testing::Test {
     fs::create_directories(dir_ / "mixed");
     std::ofstream(dir_ / "mixed" / "a_broken.xml") << MalformedXml();
     std::ofstream(dir_ / "mixed" / "b_reach.xml") << SolvableXml();
+    fs::create_directories(dir_ / "blocked");
+    std::ofstream(dir_ / "blocked" / "a_reach.xml") << SolvableXml();
+    std::ofstream(dir_ / "blocked" / "b_blocked.xml") << BlockedXml();
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
   void SetUp() override {
@@ -91,7 +104,7 @@ TEST_F(CommonRoadCliTest, TextNamesEachProblemsVerdict) {
   EXPECT_THAT(verdict_after("ZAM_Reach-1_1_T-1"),
               ::testing::MatchesRegex("    solved, goal at step [0-9]+"));
   EXPECT_THAT(verdict_after("ZAM_Far-1_1_T-1"), HasSubstr("FAILED: goal at step"));
-  EXPECT_THAT(r.out, HasSubstr("solved 1 / 2 problems (recorded predictions, KS2)"));
+  EXPECT_THAT(r.out, HasSubstr("solved 1 / 2 problems feasible at start (0 infeasible at start, 2 in all; recorded predictions, KS2)"));
   EXPECT_THAT(r.out, HasSubstr("failures: goal 1\n"));
   EXPECT_THAT(r.out, HasSubstr("WX1 "));
 }
@@ -137,6 +150,11 @@ TEST_F(CommonRoadCliTest, JsonHasScenariosProblemsAndSummary) {
   EXPECT_EQ(sum.at("solved"), 1);
   EXPECT_EQ(sum.at("failures"), json({{"goal", 1}}));
   EXPECT_EQ(sum.at("unreadable_files"), 0);
+  EXPECT_EQ(sum.at("infeasible_at_start"), 0);
+  EXPECT_EQ(sum.at("unsolved"), json({{"goal", 1}}));
+  ASSERT_EQ(sum.at("families").size(), 2u) << sum.dump();
+  EXPECT_EQ(sum.at("families").at("ZAM_Reach").at("solved"), 1);
+  EXPECT_EQ(sum.at("families").at("ZAM_Far").at("unsolved"), json({{"goal", 1}}));
   EXPECT_EQ(sum.at("prediction"), "recorded");
   for (const char* k : {"p50", "p99", "max"}) {
     EXPECT_EQ(sum.at("plan_ms").at(k), 0.0) << k << ": --no-timing reports 0";
@@ -230,6 +248,42 @@ TEST_F(CommonRoadCliTest, AFileFarFromItsOriginGetsItsSolutionInItsOwnFrame) {
   EXPECT_FALSE(json::parse(home.out).at("scenarios")[0].contains("frame_origin"));
 }
 
+// Counted apart: not solved, not unsolved, not in the solved rate's denominator.
+TEST_F(CommonRoadCliTest, InfeasibleAtStartIsCountedApart) {
+  CommandResult r = RunFrenetic("commonroad " + (dir_ / "blocked").string() + " --no-timing");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("    infeasible at start: collision at step 0"));
+  // Nothing was planned: no costs.
+  EXPECT_THAT(r.out, ::testing::ContainsRegex("\nZAM_Blocked-2_1_T-1 +#1 [^\n]*ms\n"));
+  EXPECT_THAT(r.out, HasSubstr("\nsolved 1 / 1 problems feasible at start (1 infeasible at start, "
+                               "2 in all; recorded predictions, KS2)\n"));
+  EXPECT_THAT(r.out, Not(HasSubstr("failures:")));
+  EXPECT_THAT(r.out, ::testing::ContainsRegex("\n  ZAM_Blocked +1 +1 +0 / 0 .* -\n"));
+  EXPECT_THAT(r.out, ::testing::ContainsRegex("\n  all +2 +1 +1 / 1 .* -\n"));
+
+  CommandResult j = RunFrenetic("commonroad " + (dir_ / "blocked").string() + " --json --no-timing");
+  ASSERT_EQ(j.exit_code, 0) << j.out;
+  const json doc = json::parse(j.out);
+  for (const json& s : doc.at("scenarios")) {
+    if (s.at("benchmark_id") == "ZAM_Blocked-2_1_T-1") {
+      EXPECT_EQ(s.at("problems")[0].at("costs"), json::object());
+      EXPECT_EQ(s.at("problems")[0].at("stop"), "infeasible_at_start");
+    }
+  }
+  const json sum = doc.at("summary");
+  EXPECT_EQ(sum.at("problems"), 2);
+  EXPECT_EQ(sum.at("infeasible_at_start"), 1);
+  EXPECT_EQ(sum.at("solved"), 1);
+  EXPECT_EQ(sum.at("solved_share"), 1.0);
+  EXPECT_EQ(sum.at("unsolved"), json::object());
+  EXPECT_EQ(sum.at("failures"), json::object());
+  const json& blocked = sum.at("families").at("ZAM_Blocked");
+  EXPECT_EQ(blocked.at("problems"), 1);
+  EXPECT_EQ(blocked.at("infeasible_at_start"), 1);
+  EXPECT_EQ(blocked.at("solved"), 0);
+  EXPECT_EQ(blocked.at("solved_share"), 0.0);
+}
+
 TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {
   const std::string broken = (dir_ / "mixed" / "a_broken.xml").string();
   const int line = crt::LineOf(MalformedXml(), "<point><x>1</x></point>");
@@ -243,7 +297,7 @@ TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {
     EXPECT_THAT(l, HasSubstr(broken + ":" + std::to_string(line) + ":")) << l;
   }
   EXPECT_EQ(naming, 1) << r.out;
-  EXPECT_THAT(r.out, HasSubstr("solved 1 / 1 problems"));
+  EXPECT_THAT(r.out, HasSubstr("solved 1 / 1 problems feasible at start"));
   EXPECT_THAT(r.out, HasSubstr("1 file(s) unreadable"));
 
   CommandResult j = RunFrenetic("commonroad " + (dir_ / "mixed").string() + " --json --no-timing");
@@ -282,7 +336,7 @@ TEST_F(CommonRoadCliTest, HelpListsEveryOptionWithItsDefault) {
   CommandResult r = RunFrenetic("commonroad --help");
   ASSERT_EQ(r.exit_code, 0);
   for (const char* option : {"--prediction", "--vehicle", "--config", "--commonroad-config",
-                             "--solution-dir", "--jobs"}) {
+                             "--solution-dir", "--compare", "--jobs"}) {
     const std::size_t at = r.out.find(std::string("  ") + option + " ");
     ASSERT_NE(at, std::string::npos) << option << " missing from\n" << r.out;
     const std::size_t next = r.out.find("\n  -", at + 1);

@@ -153,6 +153,44 @@ TEST(SolutionTest, ReadsCommonRoadIoOutput) {
   EXPECT_DOUBLE_EQ(t.states[1].x, 0.93);
 }
 
+// The drivability checker's traffic-rule set names its cost function TR2 ("KS1:TR2:...").
+TEST(SolutionTest, ReadsTheTrafficRuleCostIdAndVehicleOne) {
+  std::string xml = kCommonRoadIoFile;
+  xml.replace(xml.find("KS2:JB1"), 7, "KS1:TR2");
+  const StatusOr<Solution> r = ParseSolution(xml, "tr2.xml");
+  ASSERT_TRUE(r.ok()) << r.message();
+  ASSERT_EQ(r->trajectories.size(), 1u);
+  EXPECT_EQ(r->trajectories[0].cost_function, "TR2");
+  EXPECT_EQ(r->trajectories[0].vehicle_type, 1);
+  EXPECT_EQ(r->BenchmarkId(), "KS1:TR2:USA_US101-10_1_T-1:2020a");
+}
+
+// Every solution file of ../shared/commonroad/highD (the recorded human drivers) reads: KS1, TR2,
+// one trajectory for the scenario beside it (named like the file, which the CLI does not rely on).
+TEST(SolutionTest, ReadsTheSharedHighDSolutionFiles) {
+  const std::filesystem::path dir = std::string(FRENETIC_SHARED_DIR) + "/commonroad/highD";
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > 13 && name.substr(name.size() - 13) == ".solution.xml") files.push_back(e.path());
+  }
+  if (files.empty()) GTEST_SKIP() << dir << " holds no solution files";
+  EXPECT_EQ(files.size(), 30u);
+  for (const std::filesystem::path& f : files) {
+    SCOPED_TRACE(f.string());
+    const StatusOr<Solution> r = LoadSolution(f.string());
+    ASSERT_TRUE(r.ok()) << r.message();
+    const std::string name = f.filename().string();
+    EXPECT_EQ(r->scenario_id, name.substr(0, name.size() - 13));
+    EXPECT_EQ(r->version, "2020a");
+    ASSERT_EQ(r->trajectories.size(), 1u);
+    EXPECT_EQ(r->trajectories[0].vehicle_type, 1);
+    EXPECT_EQ(r->trajectories[0].cost_function, "TR2");
+    EXPECT_GE(r->trajectories[0].states.size(), 2u);  // some are short: 2, 3, 7 states
+  }
+}
+
 struct BadSolution {
   const char* name;
   std::string from, to;  // every `from` in kCommonRoadIoFile replaced
@@ -200,6 +238,30 @@ INSTANTIATE_TEST_SUITE_P(
         BadSolution{"ComputationTime", "computation_time=\"42.5\"", "computation_time=\"soon\"",
                     "<CommonRoadSolution ", "computation_time 'soon'"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+TEST(SolutionTest, PeekRootElementNamesTheRootWithoutParsing) {
+  EXPECT_EQ(PeekRootElementOf(kCommonRoadIoFile), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf(WriteSolution(Sample())), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad timeStepSize=\"0.1\">"), "commonRoad");
+  // What may come before the root.
+  EXPECT_EQ(PeekRootElementOf("\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<!-- <commonRoad> -->\n"
+                              "<!DOCTYPE s [<!ENTITY a \"<b>\">]>\n<?pi x?><CommonRoadSolution/>"),
+            "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad>"), "commonRoad");
+  // The rest of the document is not read: an unclosed root still has its name.
+  EXPECT_EQ(PeekRootElementOf("<CommonRoadSolution benchmark_id=\"x"), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElementOf(""), "");
+  EXPECT_EQ(PeekRootElementOf("not xml at all"), "");
+  EXPECT_EQ(PeekRootElementOf("<!-- never closed <commonRoad>"), "");
+  EXPECT_EQ(PeekRootElementOf("<commonRoad"), "");  // cut before the name ends
+
+  const std::string dir = ::testing::TempDir() + "/frenetic_peek_test";
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(SaveSolution(Sample(), dir).ok());
+  EXPECT_EQ(PeekRootElement(dir + "/" + Sample().FileName()), "CommonRoadSolution");
+  EXPECT_EQ(PeekRootElement(dir + "/missing.xml"), "");
+  EXPECT_EQ(PeekRootElement(dir), "");  // a directory
+}
 
 TEST(SolutionTest, ProcessorNameAndDateHelpers) {
   const std::string date = CurrentDate();

@@ -26,7 +26,7 @@ namespace frenetic::commonroad {
 struct SolutionTrajectory {
   int problem_id = 0;
   int vehicle_type = 2;                 // 1, 2, 3 (vehicle id "KS<type>")
-  std::string cost_function = "WX1";    // JB1, SA1, WX1, SM1, SM2, SM3, MW1, TR1
+  std::string cost_function = "WX1";    // JB1, SA1, WX1, SM1, SM2, SM3, MW1, TR1, TR2
   std::vector<KsState> states;          // ordered by time step
 };
 
@@ -55,6 +55,15 @@ Status SaveSolution(const Solution& solution, const std::string& dir);
 // States are sorted by time step.
 StatusOr<Solution> ParseSolution(std::string_view xml, std::string_view source);
 StatusOr<Solution> LoadSolution(const std::string& path);
+
+// The name of the root element of the XML file at `path`, read from its first 64 KiB without
+// parsing the document (the XML declaration, processing instructions, comments and a doctype
+// skipped): "CommonRoadSolution" for a solution file, "commonRoad" for a scenario. "" when the
+// file cannot be read or no element starts there. Tells a directory's solution files from its
+// scenarios at the cost of one small read each.
+std::string PeekRootElement(const std::string& path);
+// The same on the start of a document.
+std::string PeekRootElementOf(std::string_view text);
 
 // "YYYY-MM-DDThh:mm:ss" of the current local time, and the processor's model name from
 // /proc/cpuinfo with "(R)" and "(TM)" removed ("" when unknown), as commonroad-io fills them in.

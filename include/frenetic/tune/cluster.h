@@ -3,6 +3,7 @@
 // their share of each evaluation's episodes. No MPI type appears here.
 #pragma once
 
+#include <string>
 #include <vector>
 
 namespace frenetic::tune {
@@ -30,6 +31,9 @@ class Cluster {
   // that only one rank sets (others 0) arrives exactly.
   void Broadcast(std::vector<double>* data) const;
   void SumToRoot(std::vector<double>* data) const;
+  // Every rank's `data` (bytes, any length) on rank 0, in rank order (its own first); an empty
+  // vector on the other ranks.
+  std::vector<std::string> GatherToRoot(const std::string& data) const;
 
  private:
   struct LocalTag {};
