@@ -1,0 +1,95 @@
+#include "frenetic/commonroad/observation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace frenetic::commonroad {
+
+Footprint FootprintOf(const Obstacle& o, const State& st) {
+  double x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
+  for (const Shape& sh : o.shape.shapes) {
+    if (sh.kind == Shape::Kind::kCircle) {
+      x0 = std::min(x0, sh.center.x - sh.radius);
+      x1 = std::max(x1, sh.center.x + sh.radius);
+      y0 = std::min(y0, sh.center.y - sh.radius);
+      y1 = std::max(y1, sh.center.y + sh.radius);
+      continue;
+    }
+    for (const Vec2& v : sh.Vertices()) {
+      x0 = std::min(x0, v.x);
+      x1 = std::max(x1, v.x);
+      y0 = std::min(y0, v.y);
+      y1 = std::max(y1, v.y);
+    }
+  }
+  Footprint f;
+  f.heading = st.orientation.value_or(0.0);
+  if (!(x1 > x0) || !(y1 > y0)) {
+    f.centre = st.position;
+    return f;
+  }
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  const double c = std::cos(f.heading), s = std::sin(f.heading);
+  f.centre = {st.position.x + c * cx - s * cy, st.position.y + s * cx + c * cy};
+  f.length = x1 - x0;
+  f.width = y1 - y0;
+  return f;
+}
+
+double SpeedAt(const Obstacle& o, int step, double dt) {
+  const std::optional<State> st = o.StateAt(step);
+  if (!st) return 0;
+  if (st->velocity) return *st->velocity;
+  if (o.role == ObstacleRole::kStatic) return 0;
+  const std::optional<State> next = o.StateAt(step + 1), prev = o.StateAt(step - 1);
+  if (next) return Distance(next->position, st->position) / dt;
+  if (prev) return Distance(st->position, prev->position) / dt;
+  return 0;
+}
+
+void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, double ego_s,
+             PredictionMode mode, plan::Telemetry* out) {
+  const double dt = sc.dt;
+  out->sensor_fusion.clear();
+  size_t futures = 0;  // out->futures in use; the rest are reused or dropped at the end
+  for (const Obstacle& o : sc.obstacles) {
+    const std::optional<State> st = o.StateAt(step);
+    if (!st) continue;
+    const Footprint fp = FootprintOf(o, *st);
+    const double v = SpeedAt(o, step, dt);
+    plan::SensorCar row;
+    row.id = o.id;
+    row.x = fp.centre.x;
+    row.y = fp.centre.y;
+    row.vx = v * std::cos(fp.heading);
+    row.vy = v * std::sin(fp.heading);
+    const map::FrenetPoint fo = line.ToFrenet(row.x, row.y, ego_s);
+    row.s = fo.s;
+    row.d = fo.d;
+    row.length = fp.length;
+    row.width = fp.width;
+    out->sensor_fusion.push_back(row);
+    if (mode != PredictionMode::kRecorded) continue;
+    if (futures == out->futures.size()) out->futures.emplace_back();
+    plan::CarFuture& fut = out->futures[futures++];
+    fut.id = o.id;
+    fut.dt = dt;
+    fut.x.clear();
+    fut.y.clear();
+    fut.v.clear();
+    fut.heading.clear();
+    for (int q = step; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
+      const std::optional<State> sq = o.StateAt(q);
+      if (!sq) break;
+      const Footprint fq = FootprintOf(o, *sq);
+      fut.x.push_back(fq.centre.x);
+      fut.y.push_back(fq.centre.y);
+      fut.v.push_back(SpeedAt(o, q, dt));
+      fut.heading.push_back(fq.heading);
+    }
+  }
+  out->futures.resize(futures);
+}
+
+}  // namespace frenetic::commonroad

@@ -1,0 +1,175 @@
+// Observe: the sensor rows and recorded futures the planner is given at a step of a CommonRoad
+// run, from hand-made scenarios.
+#include "frenetic/commonroad/observation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "commonroad/scenario_xml.h"
+#include "frenetic/map/reference_line.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+using testing::AddStraightRoad;
+using testing::GoalTimeOnlyXml;
+using testing::ScenarioXml;
+using testing::StateXml;
+
+Scenario Parse(const ScenarioXml& xml) {
+  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
+  EXPECT_TRUE(s.ok()) << s.message();
+  return s.ok() ? std::move(s).value() : Scenario{};
+}
+
+// A reference line along y = 0 from x = -50 to 400.
+const map::ReferenceLine& Line() {
+  static const std::shared_ptr<const map::ReferenceLine> line = [] {
+    std::vector<map::ReferenceLine::Point> points;
+    for (int i = 0; i <= 45; ++i) points.push_back({-50 + 10.0 * i, 0});
+    auto fitted = map::ReferenceLine::FitOpen(points, {}, "test");
+    EXPECT_TRUE(fitted.ok()) << fitted.message();
+    return std::move(fitted).value();
+  }();
+  return *line;
+}
+
+// `n` + 1 states from (x0, y) at `v` m/s along `heading`, the stated velocity `stated`.
+std::vector<StateXml> Drive(Vec2 from, double heading, double v, double stated, int n,
+                            int first = 0) {
+  std::vector<StateXml> out;
+  for (int k = 0; k <= n; ++k) {
+    const double d = v * 0.1 * k;
+    out.push_back(
+        {first + k, from + Vec2{d * std::cos(heading), d * std::sin(heading)}, heading, stated});
+  }
+  return out;
+}
+
+const plan::SensorCar* Row(const plan::Telemetry& t, int id) {
+  for (const plan::SensorCar& c : t.sensor_fusion) {
+    if (c.id == id) return &c;
+  }
+  return nullptr;
+}
+
+const plan::CarFuture* Future(const plan::Telemetry& t, int id) {
+  for (const plan::CarFuture& f : t.futures) {
+    if (f.id == id) return &f;
+  }
+  return nullptr;
+}
+
+TEST(ObserveTest, RowsOfTheObstaclesPresent) {
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  xml.StaticObstacle(30, 4, 2, {100, -1.75}, 0.1);
+  xml.DynamicObstacle(31, 4.5, 1.8, Drive({20, 1.75}, 0, 10, 10, 5));
+  xml.DynamicObstacle(32, 4.5, 1.8, Drive({60, -1.75}, 0, 12, 12, 10, 3));  // from step 3
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  plan::Telemetry t;
+  Observe(s, 2, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  ASSERT_EQ(t.sensor_fusion.size(), 2u);  // 32 is not there yet
+  EXPECT_TRUE(t.futures.empty());
+  const plan::SensorCar* parked = Row(t, 30);
+  ASSERT_NE(parked, nullptr);
+  EXPECT_DOUBLE_EQ(parked->x, 100);
+  EXPECT_DOUBLE_EQ(parked->vx, 0);
+  EXPECT_NEAR(parked->s, Line().ToFrenet(100, -1.75).s, 1e-6);
+  EXPECT_NEAR(parked->d, 1.75, 1e-3);  // d grows to the right
+  EXPECT_DOUBLE_EQ(parked->length, 4);
+  EXPECT_DOUBLE_EQ(parked->width, 2);
+  const plan::SensorCar* car = Row(t, 31);
+  ASSERT_NE(car, nullptr);
+  EXPECT_NEAR(car->x, 22, 1e-9);
+  EXPECT_NEAR(car->vx, 10, 1e-9);
+  EXPECT_NEAR(car->vy, 0, 1e-9);
+  EXPECT_NEAR(car->d, -1.75, 1e-3);
+  EXPECT_DOUBLE_EQ(car->length, 4.5);
+
+  Observe(s, 4, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  EXPECT_EQ(t.sensor_fusion.size(), 3u);
+  Observe(s, 9, Line(), 10, PredictionMode::kConstantVelocity, &t);  // 31 is gone
+  EXPECT_EQ(t.sensor_fusion.size(), 2u);
+  EXPECT_EQ(Row(t, 31), nullptr);
+}
+
+TEST(ObserveTest, RecordedFuturesFromTheStepOn) {
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  xml.StaticObstacle(30, 4, 2, {100, -1.75}, 0);
+  xml.DynamicObstacle(31, 4.5, 1.8, Drive({20, 1.75}, 0, 10, 10, 120));
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  plan::Telemetry t;
+  Observe(s, 5, Line(), 10, PredictionMode::kRecorded, &t);
+  ASSERT_EQ(t.futures.size(), 2u);
+  const plan::CarFuture* car = Future(t, 31);
+  ASSERT_NE(car, nullptr);
+  EXPECT_DOUBLE_EQ(car->dt, 0.1);
+  ASSERT_EQ(car->x.size(), static_cast<size_t>(kFutureSteps) + 1);
+  EXPECT_NEAR(car->x[0], 25, 1e-9);
+  EXPECT_NEAR(car->x[10], 35, 1e-9);
+  EXPECT_NEAR(car->v[10], 10, 1e-9);
+  EXPECT_NEAR(car->heading[10], 0, 1e-9);
+  // Near its end the future stops with the trajectory.
+  Observe(s, 100, Line(), 10, PredictionMode::kRecorded, &t);
+  ASSERT_NE(Future(t, 31), nullptr);
+  EXPECT_EQ(Future(t, 31)->x.size(), 21u);
+  // The standing one: its state at every step.
+  ASSERT_NE(Future(t, 30), nullptr);
+  EXPECT_EQ(Future(t, 30)->x.size(), static_cast<size_t>(kFutureSteps) + 1);
+  // Constant velocity: the futures of the previous call go.
+  Observe(s, 100, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  EXPECT_TRUE(t.futures.empty());
+  EXPECT_EQ(t.sensor_fusion.size(), 2u);
+}
+
+TEST(ObserveTest, ASpeedNotStatedComesFromThePositions) {
+  // A trajectory without velocities: 15 m/s from its positions, forward where it can.
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  std::string states;
+  for (int k = 1; k <= 3; ++k) {
+    states += "<state>\n<position>" + testing::PointXml({20 + 1.5 * k, 1.75}) +
+              "</position>\n<orientation><exact>0</exact></orientation>\n<time><exact>" +
+              std::to_string(k) + "</exact></time>\n</state>\n";
+  }
+  xml.Raw(
+      "<dynamicObstacle id=\"33\">\n<type>car</type>\n<shape><rectangle><length>4</length>"
+      "<width>2</width></rectangle></shape>\n<initialState>\n<position>" +
+      testing::PointXml({20, 1.75}) +
+      "</position>\n<orientation><exact>0</exact></orientation>\n<time><exact>0</exact>"
+      "</time>\n</initialState>\n<trajectory>\n" +
+      states +
+      "</trajectory>\n"
+      "</dynamicObstacle>\n");
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  const Obstacle& o = *s.FindObstacle(33);
+  EXPECT_NEAR(SpeedAt(o, 0, 0.1), 15, 1e-9);
+  EXPECT_NEAR(SpeedAt(o, 3, 0.1), 15, 1e-9);
+  EXPECT_EQ(SpeedAt(o, 4, 0.1), 0);
+}
+
+TEST(ObserveTest, FootprintIsTheShapesBoxPlacedAtTheState) {
+  Obstacle o;
+  o.shape.shapes = {Shape::Rectangle(4, 2, {1, 0}), Shape::Circle(0.5, {-1.5, 0})};
+  State st;
+  st.position = {10, 5};
+  st.orientation = std::numbers::pi / 2;
+  const Footprint f = FootprintOf(o, st);
+  // x in [-2, 3], y in [-1, 1] in its own frame: centre (0.5, 0) turned a quarter.
+  EXPECT_NEAR(f.centre.x, 10, 1e-9);
+  EXPECT_NEAR(f.centre.y, 5.5, 1e-9);
+  EXPECT_DOUBLE_EQ(f.length, 5);
+  EXPECT_DOUBLE_EQ(f.width, 2);
+  EXPECT_DOUBLE_EQ(f.heading, std::numbers::pi / 2);
+}
+
+}  // namespace
+}  // namespace frenetic::commonroad
