@@ -37,6 +37,19 @@ Footprint FootprintOf(const Obstacle& o, const State& st) {
   return f;
 }
 
+std::optional<Footprint> FootprintAt(const Obstacle& o, int step) {
+  const std::optional<State> st = o.StateAt(step);
+  if (!st) return std::nullopt;
+  if (o.role == ObstacleRole::kStatic || o.prediction != ObstaclePrediction::kSetBased ||
+      step == o.initial.time_step) {
+    return FootprintOf(o, *st);
+  }
+  // StateAt's position and orientation are this box's centre and heading.
+  const double heading = st->orientation.value_or(0.0);
+  const OrientedBox box = o.OccupancyAt(step)->BoundingBox(heading);
+  return Footprint{box.center, heading, box.length, box.width};
+}
+
 double SpeedAt(const Obstacle& o, int step, double dt) {
   const std::optional<State> st = o.StateAt(step);
   if (!st) return 0;
@@ -54,9 +67,9 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
   out->sensor_fusion.clear();
   size_t futures = 0;  // out->futures in use; the rest are reused or dropped at the end
   for (const Obstacle& o : sc.obstacles) {
-    const std::optional<State> st = o.StateAt(step);
-    if (!st) continue;
-    const Footprint fp = FootprintOf(o, *st);
+    const std::optional<Footprint> present = FootprintAt(o, step);
+    if (!present) continue;
+    const Footprint& fp = *present;
     const double v = SpeedAt(o, step, dt);
     plan::SensorCar row;
     row.id = o.id;
@@ -80,13 +93,12 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     fut.v.clear();
     fut.heading.clear();
     for (int q = step; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
-      const std::optional<State> sq = o.StateAt(q);
-      if (!sq) break;
-      const Footprint fq = FootprintOf(o, *sq);
-      fut.x.push_back(fq.centre.x);
-      fut.y.push_back(fq.centre.y);
+      const std::optional<Footprint> fq = FootprintAt(o, q);
+      if (!fq) break;
+      fut.x.push_back(fq->centre.x);
+      fut.y.push_back(fq->centre.y);
       fut.v.push_back(SpeedAt(o, q, dt));
-      fut.heading.push_back(fq.heading);
+      fut.heading.push_back(fq->heading);
     }
   }
   out->futures.resize(futures);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <numbers>
 
@@ -169,6 +170,95 @@ TEST(ObserveTest, FootprintIsTheShapesBoxPlacedAtTheState) {
   EXPECT_DOUBLE_EQ(f.length, 5);
   EXPECT_DOUBLE_EQ(f.width, 2);
   EXPECT_DOUBLE_EQ(f.heading, std::numbers::pi / 2);
+}
+
+// A car 4 x 2 m at (20, 1.75), 10 m/s at step 0, predicted as regions along the left lane that
+// grow 1 m longer and 0.2 m wider each step, their centres 1.5 m apart; none at step 5.
+ScenarioXml SetBasedXml() {
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  std::vector<testing::OccupancyXml> occupancies;
+  for (int k = 1; k <= 8; ++k) {
+    if (k == 5) continue;
+    occupancies.push_back({k, k, testing::RectangleXml(4 + k, 2 + 0.2 * k, {20 + 1.5 * k, 1.75})});
+  }
+  xml.SetBasedObstacle(40, 4, 2, {0, {20, 1.75}, 0, 10}, occupancies);
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  return xml;
+}
+
+TEST(ObserveTest, ASetBasedObstacleIsItsOccupancysBox) {
+  const Scenario s = Parse(SetBasedXml());
+  plan::Telemetry t;
+  // Step 0: its own shape at its initial state, its stated speed.
+  Observe(s, 0, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  const plan::SensorCar* row = Row(t, 40);
+  ASSERT_NE(row, nullptr);
+  EXPECT_DOUBLE_EQ(row->x, 20);
+  EXPECT_DOUBLE_EQ(row->vx, 10);
+  EXPECT_DOUBLE_EQ(row->length, 4);
+  EXPECT_DOUBLE_EQ(row->width, 2);
+  // Step 3: the region's box, the centre's speed since step 2.
+  Observe(s, 3, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  row = Row(t, 40);
+  ASSERT_NE(row, nullptr);
+  EXPECT_NEAR(row->x, 24.5, 1e-9);
+  EXPECT_NEAR(row->y, 1.75, 1e-9);
+  EXPECT_NEAR(row->vx, 15, 1e-9);
+  EXPECT_NEAR(row->vy, 0, 1e-9);
+  EXPECT_NEAR(row->length, 7, 1e-9);
+  EXPECT_NEAR(row->width, 2.6, 1e-9);
+  EXPECT_NEAR(row->d, -1.75, 1e-3);
+  // Step 5: nothing predicted, no row; step 6: the speed over the two steps since step 4.
+  Observe(s, 5, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  EXPECT_EQ(Row(t, 40), nullptr);
+  Observe(s, 6, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  ASSERT_NE(Row(t, 40), nullptr);
+  EXPECT_NEAR(Row(t, 40)->vx, 15, 1e-9);
+  EXPECT_NEAR(Row(t, 40)->length, 10, 1e-9);
+}
+
+TEST(ObserveTest, ASetBasedObstaclesFutureIsItsOccupanciesCentres) {
+  const Scenario s = Parse(SetBasedXml());
+  plan::Telemetry t;
+  Observe(s, 1, Line(), 10, PredictionMode::kRecorded, &t);
+  const plan::CarFuture* f = Future(t, 40);
+  ASSERT_NE(f, nullptr);
+  // Steps 1 to 4, up to the gap at step 5.
+  ASSERT_EQ(f->x.size(), 4u);
+  for (size_t i = 0; i < f->x.size(); ++i) {
+    EXPECT_NEAR(f->x[i], 20 + 1.5 * (1 + i), 1e-9) << i;
+    EXPECT_NEAR(f->y[i], 1.75, 1e-9) << i;
+    EXPECT_NEAR(f->v[i], 15, 1e-9) << i;
+    EXPECT_NEAR(f->heading[i], 0, 1e-9) << i;
+  }
+  Observe(s, 6, Line(), 10, PredictionMode::kRecorded, &t);
+  ASSERT_NE(Future(t, 40), nullptr);
+  EXPECT_EQ(Future(t, 40)->x.size(), 3u);  // steps 6 to 8
+}
+
+TEST(ObserveTest, TheSharedSpotSceneGivesARowPerCarAndStep) {
+  const std::string path =
+      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
+  const StatusOr<Scenario> s = LoadScenario(path);
+  ASSERT_TRUE(s.ok()) << s.message();
+  plan::Telemetry t;
+  double previous_length = 0;
+  for (int k = 0; k <= 10; ++k) {
+    Observe(*s, k, Line(), 0, PredictionMode::kRecorded, &t);
+    ASSERT_EQ(t.sensor_fusion.size(), 2u) << k;
+    ASSERT_EQ(t.futures.size(), 2u) << k;
+    EXPECT_EQ(t.futures[0].x.size(), static_cast<size_t>(11 - k)) << k;
+    const plan::SensorCar& car = *Row(t, 484);
+    EXPECT_GT(car.vx, 5) << k;
+    EXPECT_LT(car.vx, 20) << k;
+    EXPECT_GE(car.length, previous_length) << k;  // the region grows
+    previous_length = car.length;
+  }
+  Observe(*s, 11, Line(), 0, PredictionMode::kRecorded, &t);
+  EXPECT_TRUE(t.sensor_fusion.empty());
+  EXPECT_TRUE(t.futures.empty());
 }
 
 }  // namespace

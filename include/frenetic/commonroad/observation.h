@@ -3,7 +3,14 @@
 // then (plan::SensorCar: centre, velocity, Frenet s/d, footprint) and, with --prediction
 // recorded, each one's known future (plan::CarFuture). Positions in the scenario's frame (m),
 // angles counter-clockwise from +x (rad), speeds m/s; s/d on the planner's reference line.
+//
+// A set-based obstacle (Obstacle::occupancies) after its initial step is reported by what it may
+// occupy: its footprint is the bounding box of the step's occupancy (Obstacle::StateAt), which
+// grows with the prediction's uncertainty, and its speed the motion of that box's centre since
+// the previous step (known at the step); its recorded future, the boxes' centres ahead.
 #pragma once
+
+#include <optional>
 
 #include "frenetic/commonroad/obstacle.h"
 #include "frenetic/commonroad/runner.h"
@@ -25,6 +32,10 @@ struct Footprint {
   double heading = 0, length = 0, width = 0;
 };
 Footprint FootprintOf(const Obstacle& o, const State& st);
+// The footprint at `step`: FootprintOf its state there; for a set-based obstacle after its
+// initial step, the bounding box of its occupancy (the centre and heading of its StateAt).
+// Absent when the obstacle is not there.
+std::optional<Footprint> FootprintAt(const Obstacle& o, int step);
 
 // An obstacle's speed at `step` (m/s): its state's velocity, else from its positions a step
 // apart (the next one, else the previous one; a static obstacle 0); 0 when it is not there.
