@@ -261,5 +261,107 @@ TEST(ObserveTest, TheSharedSpotSceneGivesARowPerCarAndStep) {
   EXPECT_TRUE(t.futures.empty());
 }
 
+// The speed a sensor measures (MeasureVelocity): hand-made cars whose positions advance `pace`
+// m/s while their states say `stated`.
+struct MeasureCase {
+  const char* name;
+  double pace, stated, heading;
+  int step;
+  double speed, direction;  // expected
+};
+void PrintTo(const MeasureCase& c, std::ostream* os) { *os << c.name; }
+
+class MeasureTest : public ::testing::TestWithParam<MeasureCase> {};
+
+TEST_P(MeasureTest, SpeedAndDirection) {
+  const MeasureCase& c = GetParam();
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  xml.DynamicObstacle(31, 4.5, 1.8, Drive({20, 1.75}, c.heading, c.pace, c.stated, 10));
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  // (The file's positions have 10 digits.)
+  const MeasuredVelocity mv = MeasureVelocity(*s.FindObstacle(31), c.step, 0.1);
+  EXPECT_NEAR(mv.speed, c.speed, 1e-6);
+  EXPECT_NEAR(WrapAngle(mv.heading - c.direction), 0, 1e-6);
+  // The row says the same.
+  plan::Telemetry t;
+  Observe(s, c.step, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  ASSERT_NE(Row(t, 31), nullptr);
+  EXPECT_NEAR(Row(t, 31)->vx, c.speed * std::cos(c.direction), 1e-6);
+  EXPECT_NEAR(Row(t, 31)->vy, c.speed * std::sin(c.direction), 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MeasureTest,
+    ::testing::Values(
+        // Positions that follow the stated speed: the stated one.
+        MeasureCase{"Consistent", 20, 20, 0.1, 5, 20, 0.1},
+        // Within max(1 m/s, 30%): still the stated one (noise of recorded positions).
+        MeasureCase{"WithinTheSlack", 25.5, 20, 0, 5, 20, 0},
+        MeasureCase{"SlowWithinOneMetrePerSecond", 2.9, 2, 0, 5, 2, 0},
+        // The highD case: twice the stated speed, measured.
+        MeasureCase{"TwiceTheStated", 40, 20, 0.05, 5, 40, 0.05},
+        MeasureCase{"HalfTheStated", 10, 20, 0, 5, 10, 0},
+        MeasureCase{"StatedZeroButMoving", 5, 0, 0, 5, 5, 0},
+        // Its first step: no previous position, the stated speed.
+        MeasureCase{"FirstStep", 40, 20, 0, 0, 20, 0},
+        // Standing (positions repeat): the stated speed, whatever it says.
+        MeasureCase{"Standing", 0, 3, 0, 5, 3, 0},
+        // Moving sideways or backwards: the motion's direction.
+        MeasureCase{"Reversing", -5, -5, 0, 5, 5, std::numbers::pi},
+        MeasureCase{"ReversingStatedForward", -5, 5, 0, 5, 5, std::numbers::pi}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(MeasureVelocityTest, AMotionOffItsOrientationGivesTheDirection) {
+  // States heading +x, positions moving along +y at 3 m/s (a sideways drift the orientation
+  // does not show): direction +y; drifting 20 degrees off: the orientation.
+  for (const double off : {std::numbers::pi / 2, 0.35}) {
+    ScenarioXml xml;
+    AddStraightRoad(xml);
+    std::vector<StateXml> states = Drive({20, -3}, off, 3, 3, 10);
+    for (StateXml& st : states) st.orientation = 0;
+    xml.DynamicObstacle(31, 4.5, 1.8, states);
+    xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+    const Scenario s = Parse(xml);
+    const MeasuredVelocity mv = MeasureVelocity(*s.FindObstacle(31), 4, 0.1);
+    EXPECT_NEAR(mv.speed, 3, 1e-9) << off;
+    EXPECT_NEAR(mv.heading, off > 1 ? off : 0, 1e-9) << off;
+  }
+}
+
+TEST(MeasureVelocityTest, StaticAndAbsentObstacles) {
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  xml.StaticObstacle(30, 4, 2, {100, -1.75}, 0.1);
+  xml.DynamicObstacle(31, 4.5, 1.8, Drive({20, 1.75}, 0, 10, 10, 5));
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  const MeasuredVelocity parked = MeasureVelocity(*s.FindObstacle(30), 7, 0.1);
+  EXPECT_EQ(parked.speed, 0);
+  EXPECT_DOUBLE_EQ(parked.heading, 0.1);
+  EXPECT_EQ(MeasureVelocity(*s.FindObstacle(31), 6, 0.1).speed, 0);  // gone
+}
+
+TEST(MeasureVelocityTest, RecordedFuturesCarryTheMeasuredSpeeds) {
+  // Positions at twice the stated 10 m/s: every sample after the first step says 20.
+  ScenarioXml xml;
+  AddStraightRoad(xml);
+  xml.DynamicObstacle(31, 4.5, 1.8, Drive({20, 1.75}, 0, 20, 10, 30));
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+  const Scenario s = Parse(xml);
+  plan::Telemetry t;
+  Observe(s, 0, Line(), 10, PredictionMode::kRecorded, &t);
+  const plan::CarFuture* f = Future(t, 31);
+  ASSERT_NE(f, nullptr);
+  ASSERT_EQ(f->v.size(), 31u);
+  EXPECT_NEAR(f->v[0], 10, 1e-9);  // step 0: no previous position
+  for (size_t i = 1; i < f->v.size(); ++i) EXPECT_NEAR(f->v[i], 20, 1e-9) << i;
+  EXPECT_NEAR(Row(t, 31)->vx, 10, 1e-9);
+  Observe(s, 3, Line(), 10, PredictionMode::kRecorded, &t);
+  EXPECT_NEAR(Future(t, 31)->v[0], 20, 1e-9);
+  EXPECT_NEAR(Row(t, 31)->vx, 20, 1e-9);
+}
+
 }  // namespace
 }  // namespace frenetic::commonroad
