@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/observation.h"
 #include "frenetic/commonroad/road_builder.h"
 #include "frenetic/cost/goal_region.h"
 #include "frenetic/plan/telemetry.h"
@@ -24,62 +25,10 @@ constexpr double kLimitMargin = 0.85;
 // Insets of the goal regions the planner aims at (Inset): m along, m across, m/s, rad, and
 // steps of the time window.
 constexpr double kInsetS = 1.0, kInsetD = 0.2, kInsetV = 0.5, kInsetH = 0.02, kTimeInset = 0.5;
-// Recorded futures the planner is given: enough samples for its horizons (6 s and a little).
-constexpr int kFutureSteps = 80;
 constexpr double kMphToMps = 0.44704;
 // The planner's top speed: this share of the vehicle's v_max (the path's speed is checked on its
 // 0.02 s points, which the KS ego tracks to within centimetres per second).
 constexpr double kTopSpeedShare = 0.97;
-
-// An obstacle's footprint at a step: centre, heading, length and width (its shape's bounding
-// box in its own frame).
-struct Footprint {
-  Vec2 centre;
-  double heading = 0, length = 0, width = 0;
-};
-
-Footprint FootprintOf(const Obstacle& o, const State& st) {
-  double x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
-  for (const Shape& sh : o.shape.shapes) {
-    if (sh.kind == Shape::Kind::kCircle) {
-      x0 = std::min(x0, sh.center.x - sh.radius);
-      x1 = std::max(x1, sh.center.x + sh.radius);
-      y0 = std::min(y0, sh.center.y - sh.radius);
-      y1 = std::max(y1, sh.center.y + sh.radius);
-      continue;
-    }
-    for (const Vec2& v : sh.Vertices()) {
-      x0 = std::min(x0, v.x);
-      x1 = std::max(x1, v.x);
-      y0 = std::min(y0, v.y);
-      y1 = std::max(y1, v.y);
-    }
-  }
-  Footprint f;
-  f.heading = st.orientation.value_or(0.0);
-  if (!(x1 > x0) || !(y1 > y0)) {
-    f.centre = st.position;
-    return f;
-  }
-  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-  const double c = std::cos(f.heading), s = std::sin(f.heading);
-  f.centre = {st.position.x + c * cx - s * cy, st.position.y + s * cx + c * cy};
-  f.length = x1 - x0;
-  f.width = y1 - y0;
-  return f;
-}
-
-// An obstacle's speed at a step: its state's, else from its positions a step apart.
-double SpeedAt(const Obstacle& o, int step, double dt) {
-  const std::optional<State> st = o.StateAt(step);
-  if (!st) return 0;
-  if (st->velocity) return *st->velocity;
-  if (o.role == ObstacleRole::kStatic) return 0;
-  const std::optional<State> next = o.StateAt(step + 1), prev = o.StateAt(step - 1);
-  if (next) return Distance(next->position, st->position) / dt;
-  if (prev) return Distance(st->position, prev->position) / dt;
-  return 0;
-}
 
 // The goal states as regions of the road's Frenet frame (times in steps; shifted per cycle).
 struct FrenetGoal {
@@ -453,40 +402,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       t.d = fe.d;
       t.previous_path_x = path_x;
       t.previous_path_y = path_y;
-      t.sensor_fusion.clear();
-      t.futures.clear();
-      for (const Obstacle& o : sc.obstacles) {
-        const std::optional<State> st = o.StateAt(k);
-        if (!st) continue;
-        const Footprint fp = FootprintOf(o, *st);
-        const double v = SpeedAt(o, k, dt);
-        plan::SensorCar row;
-        row.id = o.id;
-        row.x = fp.centre.x;
-        row.y = fp.centre.y;
-        row.vx = v * std::cos(fp.heading);
-        row.vy = v * std::sin(fp.heading);
-        const map::FrenetPoint fo = line.ToFrenet(row.x, row.y, fe.s);
-        row.s = fo.s;
-        row.d = fo.d;
-        row.length = fp.length;
-        row.width = fp.width;
-        t.sensor_fusion.push_back(row);
-        if (options.prediction != PredictionMode::kRecorded) continue;
-        plan::CarFuture fut;
-        fut.id = o.id;
-        fut.dt = dt;
-        for (int q = k; q <= std::min(k + kFutureSteps, o.LastStep()); ++q) {
-          const std::optional<State> sq = o.StateAt(q);
-          if (!sq) break;
-          const Footprint fq = FootprintOf(o, *sq);
-          fut.x.push_back(fq.centre.x);
-          fut.y.push_back(fq.centre.y);
-          fut.v.push_back(SpeedAt(o, q, dt));
-          fut.heading.push_back(fq.heading);
-        }
-        t.futures.push_back(std::move(fut));
-      }
+      Observe(sc, k, line, fe.s, options.prediction, &t);
       t.goals.clear();
       for (const FrenetGoal& g : goals) {
         cost::GoalRegion r = Inset(g.region);

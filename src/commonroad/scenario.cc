@@ -77,9 +77,11 @@ class Reader {
   Status ReadShapeGroup(const xml_node& node, ShapeGroup* out);
   Status ReadValue(const xml_node& node, double* out);
   Status ReadInterval(const xml_node& node, Interval* out);
+  Status ReadStepInterval(const xml_node& node, IntervalI* out);
   Status ReadStateTime(const xml_node& node, int* out);
   Status ReadState(const xml_node& node, bool need_velocity, State* out);
   Status ReadObstacle(const xml_node& node, ObstacleRole role, Obstacle* out);
+  Status ReadOccupancySet(const xml_node& node, Obstacle* out);
   Status ReadGoal(const xml_node& node, GoalState* out);
   Status ReadProblem(const xml_node& node, PlanningProblem* out);
   Status Resolve(Scenario* out);
@@ -128,6 +130,7 @@ Status Reader::ReadRoot(const xml_node& root, Scenario* out) {
     }
   }
   for (Obstacle& o : dynamic) out->obstacles.push_back(std::move(o));
+  for (Obstacle& o : out->obstacles) o.dt = out->dt;
   if (out->lanelets.empty()) return src_.Error(root, "no <lanelet>");
   if (out->problems.empty()) return src_.Error(root, "no <planningProblem>");
   return Status::Ok();
@@ -295,6 +298,20 @@ Status Reader::ReadInterval(const xml_node& node, Interval* out) {
   return Status::Ok();
 }
 
+// A time as steps: an <exact> step or <intervalStart>..<intervalEnd>, integers in
+// [0, kMaxTimeStep].
+Status Reader::ReadStepInterval(const xml_node& node, IntervalI* out) {
+  Interval t;
+  FRENETIC_CR_TRY(ReadInterval(node, &t));
+  if (t.start < 0 || t.end > kMaxTimeStep || t.start != std::floor(t.start) ||
+      t.end != std::floor(t.end)) {
+    return src_.Error(node,
+                      "time steps must be integers in [0, " + std::to_string(kMaxTimeStep) + "]");
+  }
+  *out = IntervalI{static_cast<int>(t.start), static_cast<int>(t.end)};
+  return Status::Ok();
+}
+
 Status Reader::ReadStateTime(const xml_node& node, int* out) {
   xml_node time;
   FRENETIC_CR_TRY(src_.Child(node, "time", &time));
@@ -346,7 +363,11 @@ Status Reader::ReadObstacle(const xml_node& node, ObstacleRole role, Obstacle* o
   FRENETIC_CR_TRY(ReadState(initial, /*need_velocity=*/false, &out->initial));
   if (role == ObstacleRole::kStatic) return Status::Ok();
   if (const xml_node occupancy = node.child("occupancySet")) {
-    return src_.Error(occupancy, "set-based predictions (<occupancySet>) are not supported");
+    if (const xml_node trajectory = node.child("trajectory")) {
+      return src_.Error(trajectory,
+                        "both <trajectory> and <occupancySet> (a prediction is one or the other)");
+    }
+    return ReadOccupancySet(occupancy, out);
   }
   if (const xml_node trajectory = node.child("trajectory")) {
     int expected = out->initial.time_step + 1;
@@ -365,17 +386,31 @@ Status Reader::ReadObstacle(const xml_node& node, ObstacleRole role, Obstacle* o
   return Status::Ok();
 }
 
+// A set-based prediction: <occupancy> elements, each a <shape> (one or more shapes, the scenario's
+// frame) over a <time> after the initial state's.
+Status Reader::ReadOccupancySet(const xml_node& node, Obstacle* out) {
+  out->prediction = ObstaclePrediction::kSetBased;
+  for (const xml_node& n : node.children("occupancy")) {
+    Occupancy& o = out->occupancies.emplace_back();
+    xml_node shape, time;
+    FRENETIC_CR_TRY(src_.Child(n, "shape", &shape));
+    FRENETIC_CR_TRY(ReadShapeGroup(shape, &o.shape));
+    FRENETIC_CR_TRY(src_.Child(n, "time", &time));
+    FRENETIC_CR_TRY(ReadStepInterval(time, &o.time));
+    if (o.time.start <= out->initial.time_step) {
+      return src_.Error(time, "time step " + std::to_string(o.time.start) +
+                                  " is not after the initial state's (" +
+                                  std::to_string(out->initial.time_step) + ")");
+    }
+  }
+  if (out->occupancies.empty()) return src_.Error(node, "no <occupancy>");
+  return Status::Ok();
+}
+
 Status Reader::ReadGoal(const xml_node& node, GoalState* out) {
   out->line = src_.Line(node);
   if (const xml_node time = node.child("time")) {
-    Interval t;
-    FRENETIC_CR_TRY(ReadInterval(time, &t));
-    if (t.start < 0 || t.end > kMaxTimeStep || t.start != std::floor(t.start) ||
-        t.end != std::floor(t.end)) {
-      return src_.Error(time, "time steps must be integers in [0, " +
-                                  std::to_string(kMaxTimeStep) + "]");
-    }
-    out->time = IntervalI{static_cast<int>(t.start), static_cast<int>(t.end)};
+    FRENETIC_CR_TRY(ReadStepInterval(time, &out->time.emplace()));
   }
   if (const xml_node position = node.child("position")) {
     for (const xml_node& n : position.children()) {
@@ -448,7 +483,7 @@ Status Reader::Resolve(Scenario* out) {
 // Scenario::origin: the lanelets' bounding box (the obstacles' and problems' positions when
 // there are no lanelets), and every position moved by minus its centre, rounded to the
 // kilometre, when the box reaches beyond kLocalFrameBeyond. Shapes of obstacles are in their own
-// frames and stay; goal shapes are in the scenario's and move.
+// frames and stay; goal shapes and occupancies are in the scenario's and move.
 void ToLocalFrame(Scenario* sc) {
   double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x;
   double hi_x = -lo_x, hi_y = -lo_x;
@@ -483,6 +518,12 @@ void ToLocalFrame(Scenario* sc) {
   for (Obstacle& ob : sc->obstacles) {
     move(ob.initial.position);
     for (State& st : ob.trajectory) move(st.position);
+    for (Occupancy& occ : ob.occupancies) {
+      for (Shape& shape : occ.shape.shapes) {
+        move(shape.center);
+        for (Vec2& v : shape.points) move(v);
+      }
+    }
   }
   for (PlanningProblem& p : sc->problems) {
     move(p.initial.position);

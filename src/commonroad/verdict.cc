@@ -344,18 +344,18 @@ std::optional<Failure> VerdictChecker::CollisionAt(const KsState& s) const {
   const Vec2 center{s.x, s.y};
   const auto box = BoxCorners(center, s.orientation, p.length, p.width);
   for (const Obstacle& o : scenario_->obstacles) {
-    const std::optional<State> state = o.StateAt(s.time_step);
-    if (!state) continue;
-    const ShapeGroup occupancy =
-        o.shape.Transformed(state->position, state->orientation.value_or(0.0));
-    const bool near = std::any_of(
-        occupancy.shapes.begin(), occupancy.shapes.end(), [&](const Shape& shape) {
+    const std::optional<ShapeGroup> occupancy = o.OccupancyAt(s.time_step);
+    if (!occupancy) continue;
+    const bool near =
+        std::any_of(occupancy->shapes.begin(), occupancy->shapes.end(), [&](const Shape& shape) {
           return Distance(shape.Centroid(), center) <= ego_radius + shape.BoundingRadius();
         });
-    if (near && occupancy.Overlaps(box)) {
+    if (near && occupancy->Overlaps(box)) {
+      const std::optional<State> state = o.StateAt(s.time_step);
+      const Vec2 at = state ? state->position : occupancy->Centroid();
       return Failure{FailureKind::kCollision, s.time_step,
                      "the ego overlaps obstacle " + std::to_string(o.id) + " (" + o.type +
-                         Fmt(") at (%.2f, %.2f)", state->position.x, state->position.y),
+                         Fmt(") at (%.2f, %.2f)", at.x, at.y),
                      o.id};
     }
   }

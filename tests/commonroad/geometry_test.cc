@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 
 #include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/shape.h"
@@ -140,6 +141,88 @@ TEST(ShapeTest, GroupOverlapsWithCirclesAndPolygons) {
   EXPECT_FALSE(g.Overlaps(BoxCorners({23, 3}, 0, 1, 1)));     // the L's notch
   EXPECT_TRUE(g.Overlaps(BoxCorners({20.5, 3}, 0, 1, 1)));
   EXPECT_TRUE(g.Contains({20.5, 0.5}));
+}
+
+// The smallest-area rectangle over every edge direction of the hull, by brute force.
+double BruteForceMinArea(const std::vector<Vec2>& points) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < points.size(); ++i) {
+    for (size_t j = 0; j < points.size(); ++j) {
+      const Vec2 d = points[j] - points[i];
+      if (!(Norm(d) > 1e-9)) continue;
+      const Vec2 u = (1 / Norm(d)) * d, n{-u.y, u.x};
+      double a0 = 1e300, a1 = -1e300, b0 = 1e300, b1 = -1e300;
+      for (const Vec2& p : points) {
+        a0 = std::min(a0, u.x * p.x + u.y * p.y);
+        a1 = std::max(a1, u.x * p.x + u.y * p.y);
+        b0 = std::min(b0, n.x * p.x + n.y * p.y);
+        b1 = std::max(b1, n.x * p.x + n.y * p.y);
+      }
+      best = std::min(best, (a1 - a0) * (b1 - b0));
+    }
+  }
+  return best;
+}
+
+TEST(ShapeTest, BoundingBoxOfARectangleIsItself) {
+  ShapeGroup g;
+  g.shapes = {Shape::Rectangle(6, 2, {10, 5}, 0.4)};
+  for (const double reference : {0.4, 0.3, -2.7}) {
+    const OrientedBox b = g.BoundingBox(reference);
+    EXPECT_NEAR(b.center.x, 10, 1e-9);
+    EXPECT_NEAR(b.center.y, 5, 1e-9);
+    EXPECT_NEAR(b.length, 6, 1e-9);
+    EXPECT_NEAR(b.width, 2, 1e-9);
+    EXPECT_NEAR(WrapAngle(b.heading - reference), 0, kPi / 4) << reference;
+  }
+  // Asked across it, the same rectangle turned a quarter: length 2 along 0.4 + pi / 2.
+  const OrientedBox across = g.BoundingBox(0.4 + kPi / 2);
+  EXPECT_NEAR(across.heading, 0.4 + kPi / 2, 1e-9);
+  EXPECT_NEAR(across.length, 2, 1e-9);
+  EXPECT_NEAR(across.width, 6, 1e-9);
+}
+
+TEST(ShapeTest, BoundingBoxIsTheSmallestOverRandomPointSets) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-10, 10);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<Vec2> points(3 + trial % 20);
+    for (Vec2& p : points) p = {coord(rng), 0.3 * coord(rng)};
+    ShapeGroup g;
+    g.shapes = {Shape::Polygon(points)};
+    const OrientedBox b = g.BoundingBox(0);
+    EXPECT_NEAR(b.length * b.width, BruteForceMinArea(points), 1e-9) << trial;
+    EXPECT_LE(std::abs(b.heading), kPi / 4 + 1e-12) << trial;
+    // Every point inside (to rounding).
+    const Shape box = Shape::Rectangle(b.length + 1e-9, b.width + 1e-9, b.center, b.heading);
+    for (const Vec2& p : points) EXPECT_TRUE(box.Contains(p)) << trial;
+  }
+}
+
+TEST(ShapeTest, BoundingBoxOfCirclesGroupsAndDegenerateSets) {
+  ShapeGroup g;
+  g.shapes = {Shape::Circle(1, {0, 0}), Shape::Circle(1, {10, 0})};
+  const OrientedBox two = g.BoundingBox(0);
+  const double r = 1 / std::cos(kPi / 16);  // the circumscribed 16-gon
+  EXPECT_NEAR(two.center.x, 5, 1e-9);
+  EXPECT_NEAR(two.length, 10 + 2 * r, 1e-9);
+  EXPECT_NEAR(two.width, 2 * r, 1e-9);  // its vertices at +-pi / 2
+  // Collinear points: width 0; one point: size 0 there; nothing (or only NaN): the origin.
+  ShapeGroup flat;
+  flat.shapes = {Shape::Polygon({{0, 0}, {1, 1}, {3, 3}})};
+  const OrientedBox line = flat.BoundingBox(0.7);
+  EXPECT_NEAR(line.length, 3 * std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(line.width, 0, 1e-9);
+  EXPECT_NEAR(line.heading, kPi / 4, 1e-9);
+  ShapeGroup point;
+  point.shapes = {Shape::Polygon({{2, 3}, {2, 3}, {kNaN, 1}})};
+  const OrientedBox dot = point.BoundingBox(0);
+  EXPECT_EQ(dot.center, (Vec2{2, 3}));
+  EXPECT_EQ(dot.length, 0);
+  const OrientedBox none = ShapeGroup{}.BoundingBox(kNaN);
+  EXPECT_EQ(none.center, (Vec2{0, 0}));
+  EXPECT_EQ(none.length, 0);
+  EXPECT_TRUE(std::isfinite(none.heading));
 }
 
 }  // namespace

@@ -388,6 +388,23 @@ TEST(RunnerTest, ConstantVelocityPredictionsStillAvoidACutIn) {
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
 }
 
+TEST(RunnerTest, PassesACarGivenAsASetBasedPrediction) {
+  // A slow car 50 m ahead in the ego's lane, predicted as regions that grow along the lane; the
+  // goal is the left lane. The verdict checks the ego against the regions.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 500);
+  std::vector<testing::OccupancyXml> regions;
+  for (int k = 1; k <= 80; ++k) {
+    regions.push_back({k, k, testing::RectangleXml(4.8 + 0.05 * k, 2.2, {60 + 0.8 * k, -1.75})});
+  }
+  xml.SetBasedObstacle(5, 4.8, 2, {0, {60, -1.75}, 0, 8}, regions)
+      .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, 40, 80)});
+  for (const PredictionMode mode : {PredictionMode::kRecorded, PredictionMode::kConstantVelocity}) {
+    const ProblemRun p = RunOne(xml, mode);
+    EXPECT_TRUE(p.verdict.solved) << ToString(mode) << ": " << p.verdict.Summary();
+  }
+}
+
 TEST(RunnerTest, EverySharedFileRunsAndItsTrajectoriesAreKsTrajectories) {
   const std::filesystem::path dir = std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad";
   if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;

@@ -280,6 +280,14 @@ std::vector<MalformedCase> MalformedCases() {
       "</width></rectangle></shape>\n<initialState>\n<position><point><x>1</x><y>1</y></point>"
       "</position>\n<orientation><exact>0</exact></orientation>\n<time><exact>0</exact></time>\n"
       "</initialState>\n";
+  // The obstacle's set-based prediction: one occupancy of the time and shape given (the end of
+  // the obstacle's element included).
+  const auto occupancy_set = [](const std::string& time,
+                                const std::string& shape =
+                                    "<rectangle><length>4</length><width>2</width></rectangle>") {
+    return "<occupancySet>\n<occupancy>\n<shape>" + shape + "</shape>\n<time>" + time +
+           "</time>\n</occupancy>\n</occupancySet>\n</dynamicObstacle>\n";
+  };
   return {
       {"WrongRoot", Replace(Replace(valid, "<commonRoad ", "<commonroad "), "</commonRoad>", "</commonroad>"), "<commonroad ", "commonroad",
        "root element must be <commonRoad>"},
@@ -364,9 +372,53 @@ std::vector<MalformedCase> MalformedCases() {
                 "<x>1</x><y>1</y></point></position>\n<orientation><exact>0</exact></orientation>"
                 "\n<time><exact>0</exact></time>\n</initialState>\n</staticObstacle>\n"),
        "<staticObstacle id=\"9\">", "staticObstacle 9", "missing <shape>"},
-      {"OccupancySet", WithBody(obstacle_head + "<occupancySet><occupancy/></occupancySet>\n"
-                                                "</dynamicObstacle>\n"),
-       "<occupancySet>", "dynamicObstacle 9/occupancySet", "not supported"},
+      {"EmptyOccupancy",
+       WithBody(obstacle_head + "<occupancySet><occupancy/></occupancySet>\n</dynamicObstacle>\n"),
+       "<occupancySet>", "dynamicObstacle 9/occupancySet/occupancy", "missing <shape>"},
+      {"EmptyOccupancySet",
+       WithBody(obstacle_head + "<occupancySet>\n</occupancySet>\n</dynamicObstacle>\n"),
+       "<occupancySet>", "dynamicObstacle 9/occupancySet", "no <occupancy>"},
+      {"OccupancyWithoutTime",
+       WithBody(obstacle_head + "<occupancySet>\n<occupancy>\n<shape><rectangle><length>4</length>"
+                                "<width>2</width></rectangle></shape>\n</occupancy>\n"
+                                "</occupancySet>\n</dynamicObstacle>\n"),
+       "<occupancy>", "dynamicObstacle 9/occupancySet/occupancy", "missing <time>"},
+      {"OccupancyShapeless",
+       WithBody(obstacle_head + occupancy_set("<exact>1</exact>", "<point/>")), "<shape><point/>",
+       "occupancySet/occupancy/shape", "no <rectangle>, <circle> or <polygon>"},
+      {"OccupancyFlatPolygon",
+       WithBody(obstacle_head +
+                occupancy_set("<exact>1</exact>",
+                              "<polygon><point><x>0</x><y>0</y></point>"
+                              "<point><x>1</x><y>0</y></point><point><x>0</x><y>0</y>"
+                              "</point></polygon>")),
+       "<shape><polygon>", "occupancy/shape/polygon", "three distinct points"},
+      {"OccupancyNaNRadius",
+       WithBody(obstacle_head +
+                occupancy_set("<exact>1</exact>", "<circle><radius>nan</radius></circle>")),
+       "<radius>nan", "occupancy/shape/circle/radius", "not a finite number"},
+      {"OccupancyTimeFraction", WithBody(obstacle_head + occupancy_set("<exact>1.5</exact>")),
+       "<time><exact>1.5", "dynamicObstacle 9/occupancySet/occupancy/time", "integers"},
+      {"OccupancyTimeHuge", WithBody(obstacle_head + occupancy_set("<exact>1e300</exact>")),
+       "<time><exact>1e300", "occupancy/time", "integers in [0, 100000000]"},
+      {"OccupancyTimeReversed",
+       WithBody(obstacle_head +
+                occupancy_set("<intervalStart>5</intervalStart><intervalEnd>2</intervalEnd>")),
+       "<intervalStart>5", "occupancy/time", "intervalStart is after intervalEnd"},
+      {"OccupancyAtTheInitialStep",
+       WithBody(obstacle_head +
+                occupancy_set("<intervalStart>0</intervalStart><intervalEnd>2</intervalEnd>")),
+       "<intervalStart>0", "occupancy/time", "time step 0 is not after the initial state's (0)"},
+      {"OccupancyTimeMissingEnd",
+       WithBody(obstacle_head + occupancy_set("<intervalStart>1</intervalStart>")),
+       "<time><intervalStart>1", "occupancy/time", "missing <intervalEnd>"},
+      {"TrajectoryAndOccupancySet",
+       WithBody(obstacle_head +
+                "<trajectory>\n<state>\n<position><point><x>1</x><y>1</y></point>"
+                "</position>\n<orientation><exact>0</exact></orientation>\n<time>"
+                "<exact>1</exact></time>\n</state>\n</trajectory>\n" +
+                occupancy_set("<exact>2</exact>")),
+       "<trajectory>", "dynamicObstacle 9/trajectory", "both <trajectory> and <occupancySet>"},
       {"TrajectoryGap",
        WithBody(obstacle_head + "<trajectory>\n<state>\n<position><point><x>1</x><y>1</y></point>"
                                 "</position>\n<orientation><exact>0</exact></orientation>\n<time>"
@@ -434,7 +486,22 @@ TEST(ScenarioReaderTest, EmptyAndNonXmlInputAreErrors) {
 // form; it never crashes (the sanitizer build runs this too).
 void FuzzOne(const std::string& text, const std::string& what) {
   const StatusOr<Scenario> s = ParseScenario(text, "fuzz.xml");
-  if (s.ok()) return;
+  if (s.ok()) {
+    // What was read can be asked for at any step.
+    for (const Obstacle& o : s->obstacles) {
+      for (int k = o.initial.time_step - 1; k <= std::min(o.LastStep(), o.initial.time_step + 12);
+           ++k) {
+        const std::optional<State> st = o.StateAt(k);
+        const std::optional<ShapeGroup> occupied = o.OccupancyAt(k);
+        EXPECT_EQ(st.has_value(), occupied.has_value())
+            << what << ": obstacle " << o.id << " step " << k;
+        if (st && st->velocity) {
+          EXPECT_TRUE(std::isfinite(*st->velocity)) << what;
+        }
+      }
+    }
+    return;
+  }
   // "fuzz.xml:<line>: <something>", one line.
   const std::string& m = s.message();
   const std::string_view prefix = "fuzz.xml:";
@@ -479,6 +546,27 @@ void Fuzz(const std::string& base, int truncations, int mutations, uint32_t seed
 
 TEST(ScenarioReaderFuzzTest, HandMadeFileTruncatedAndMutated) {
   Fuzz(StraightScenario(), 400, 600, 1);
+}
+
+TEST(ScenarioReaderFuzzTest, SetBasedFileTruncatedAndMutated) {
+  ScenarioXml xml("ZAM_SetBased-1_1_S-1");
+  AddStraightRoad(xml);
+  xml.SetBasedObstacle(40, 4, 2, {0, {20, -1.75}, 0, 10},
+                       {{1, 1, testing::RectangleXml(5, 2, {21.5, -1.75}, 0.1)},
+                        {2, 4, testing::PolygonXml({{20, -3}, {27, -3}, {27, 0}, {20, 0}})},
+                        {4, 4, testing::CircleXml(1, {27, 1.75})}});
+  xml.Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(5, 10)});
+  Fuzz(xml.Str(), 300, 600, 3);
+}
+
+TEST(ScenarioReaderFuzzTest, RealSetBasedFileTruncatedAndMutated) {
+  const std::string path =
+      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+  std::ifstream in(path);
+  if (!in) GTEST_SKIP() << path << " is absent";
+  std::stringstream text;
+  text << in.rdbuf();
+  Fuzz(text.str(), 100, 200, 4);
 }
 
 TEST(ScenarioReaderFuzzTest, RealFileTruncatedAndMutated) {

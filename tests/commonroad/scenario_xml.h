@@ -1,6 +1,7 @@
-// Builds small CommonRoad 2020a scenario files in the tests (straight, two-way, curved and lane-drop roads,
-// obstacles, planning problems with goals by lanelet, rectangle or time only), one element per
-// line so that a test can name the line an error must point at.
+// Builds small CommonRoad 2020a scenario files in the tests (straight, two-way, curved and
+// lane-drop roads, obstacles with trajectories or set-based predictions, planning problems with
+// goals by lanelet, rectangle or time only), one element per line so that a test can name the line
+// an error must point at.
 #pragma once
 
 #include <algorithm>
@@ -48,6 +49,30 @@ struct StateXml {
   int time = 0;
   Vec2 position;
   double orientation = 0, velocity = 0;
+};
+
+// Shapes as XML fragments (for an <occupancy>'s <shape>, say).
+inline std::string RectangleXml(double length, double width, Vec2 center = {},
+                                double orientation = 0) {
+  return "<rectangle><length>" + Num(length) + "</length><width>" + Num(width) +
+         "</width><orientation>" + Num(orientation) + "</orientation><center><x>" + Num(center.x) +
+         "</x><y>" + Num(center.y) + "</y></center></rectangle>";
+}
+inline std::string CircleXml(double radius, Vec2 center) {
+  return "<circle><radius>" + Num(radius) + "</radius><center><x>" + Num(center.x) + "</x><y>" +
+         Num(center.y) + "</y></center></circle>";
+}
+inline std::string PolygonXml(const std::vector<Vec2>& points) {
+  std::string s = "<polygon>";
+  for (Vec2 p : points) s += PointXml(p);
+  return s + "</polygon>";
+}
+
+// One occupancy of a set-based prediction: steps start..end (an <exact> one when equal), shapes
+// as XML fragments.
+struct OccupancyXml {
+  int start = 1, end = 1;
+  std::string shapes;
 };
 
 // Goal states as XML fragments.
@@ -130,6 +155,24 @@ class ScenarioXml {
       s += "</trajectory>\n";
     }
     body_ += s + "</dynamicObstacle>\n";
+    return *this;
+  }
+
+  // A car with a set-based prediction: its initial state, then an <occupancySet>, one element
+  // per line.
+  ScenarioXml& SetBasedObstacle(int id, double length, double width, const StateXml& initial,
+                                const std::vector<OccupancyXml>& occupancies) {
+    std::string s = "<dynamicObstacle id=\"" + std::to_string(id) + "\">\n<type>car</type>\n" +
+                    RectangleShape(length, width) + InitialState(initial) + "<occupancySet>\n";
+    for (const OccupancyXml& o : occupancies) {
+      s += "<occupancy>\n<shape>" + o.shapes + "</shape>\n<time>";
+      s += o.start == o.end
+               ? "<exact>" + std::to_string(o.start) + "</exact>"
+               : "<intervalStart>" + std::to_string(o.start) + "</intervalStart><intervalEnd>" +
+                     std::to_string(o.end) + "</intervalEnd>";
+      s += "</time>\n</occupancy>\n";
+    }
+    body_ += s + "</occupancySet>\n</dynamicObstacle>\n";
     return *this;
   }
 

@@ -1,7 +1,8 @@
 // A CommonRoad scenario (format 2020a) and its reader.
 //
 // The reader keeps what a motion-planning benchmark needs: the lanelet network, traffic signs (for
-// speed limits), static and dynamic obstacles with their trajectories, and the planning problems.
+// speed limits), static and dynamic obstacles with their trajectories or set-based predictions
+// (<occupancySet>), and the planning problems.
 // Elements it does not know (location, scenarioTags' contents, trafficLight, intersection, signal
 // states, ...) are ignored.
 //
@@ -11,8 +12,11 @@
 // infinite, a length or radius not positive, a bound with fewer than two points, a polygon with
 // fewer than three, duplicate ids within lanelets, obstacles, problems or signs, a reference
 // (predecessor, successor, adjacent, traffic sign, goal lanelet) to an id that does not exist,
-// trajectory time steps that are not consecutive after the initial state's, and set-based
-// predictions (<occupancySet>, not supported). Nothing in the input makes the reader crash.
+// trajectory time steps that are not consecutive after the initial state's, an obstacle with both
+// a <trajectory> and an <occupancySet>, an <occupancySet> without <occupancy>, an occupancy
+// without <shape> or <time>, and an occupancy's time (an exact step or an interval of steps) that
+// is not integers within [0, 10^8] or does not lie after the initial state's. Nothing in the input
+// makes the reader crash.
 #pragma once
 
 #include <string>

@@ -11,6 +11,13 @@
 
 namespace frenetic::commonroad {
 
+// An oriented rectangle: centre, heading (rad, counter-clockwise from +x, along `length`), length
+// and width (m).
+struct OrientedBox {
+  Vec2 center;
+  double heading = 0, length = 0, width = 0;
+};
+
 struct Shape {
   enum class Kind { kRectangle, kCircle, kPolygon };
   Kind kind = Kind::kRectangle;
@@ -48,6 +55,12 @@ struct ShapeGroup {
   bool Overlaps(std::span<const Vec2> polygon) const;
   // The mean of the members' centroids (the origin when empty).
   Vec2 Centroid() const;
+  // The smallest-area rectangle that holds every member (a circle by its circumscribed 16-gon),
+  // heading along whichever of its four side directions lies nearest `reference_heading` (rad),
+  // its length along that heading. Collinear members give a width of 0, one point a box of
+  // size 0 there; an empty group (or one without a finite vertex) a box of size 0 at the origin.
+  // Non-finite vertices are ignored. O(n log n) in the vertex count.
+  OrientedBox BoundingBox(double reference_heading) const;
 };
 
 }  // namespace frenetic::commonroad

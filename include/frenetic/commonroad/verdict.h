@@ -11,9 +11,11 @@
 //    its interval; position inside one of its shapes, or inside one of its lanelets' polygons;
 //    velocity in its interval; orientation in its interval modulo 2 pi; absent parts always met).
 //    The state's (x, y) is the tested point (GoalRegion.is_reached uses the state's position).
-//  - collision: the ego's l x w box centred on (x, y) along psi overlaps an obstacle's shape at
-//    the same step: a dynamic obstacle at its recorded state there (none before its initial step or
-//    after its trajectory's end), a static one at every step. Touching counts.
+//  - collision: the ego's l x w box centred on (x, y) along psi overlaps what an obstacle
+//    occupies at the same step (Obstacle::OccupancyAt): a trajectory-based dynamic obstacle's shape
+//    at its recorded state there (none before its initial step or after its trajectory's end), a
+//    set-based one's occupancies covering the step (its shape at its initial state at the initial
+//    step), a static one's shape at every step. Touching counts.
 //  - road: the ego's box lies inside the union of all lanelets, both directions, the network's
 //    ends closed (RoadArea, with options.road_tolerance and options.open_end_margin).
 //  - infeasible at start: the problem's initial state itself collides (its box overlaps an
