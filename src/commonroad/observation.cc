@@ -138,6 +138,8 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     plan::CarFuture& fut = out->futures[futures++];
     fut.id = o.id;
     fut.dt = dt;
+    fut.start = 0;
+    fut.length = fut.width = 0;
     fut.x.clear();
     fut.y.clear();
     fut.v.clear();
@@ -154,6 +156,39 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
       fut.heading.push_back(vq.heading);
       prev = sq;
     }
+  }
+  // Recorded: the obstacles to come (not there yet, there within kComingSteps), from their
+  // first step on.
+  for (const Obstacle& o : sc.obstacles) {
+    if (mode != PredictionMode::kRecorded) break;
+    const int first = o.initial.time_step;
+    if (o.role != ObstacleRole::kDynamic || first <= step || first > step + kComingSteps) continue;
+    if (futures == out->futures.size()) out->futures.emplace_back();
+    plan::CarFuture& fut = out->futures[futures++];
+    fut.id = o.id;
+    fut.dt = dt;
+    fut.start = (first - step) * dt;
+    fut.x.clear();
+    fut.y.clear();
+    fut.v.clear();
+    fut.heading.clear();
+    std::optional<State> prev;
+    for (int q = first; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
+      const std::optional<State> sq = o.StateAt(q);
+      if (!sq) break;
+      const Footprint fq = FootprintWith(o, q, *sq);
+      if (q == first) {
+        fut.length = fq.length;
+        fut.width = fq.width;
+      }
+      const MeasuredVelocity vq = Measure(StatedSpeed(o, q, *sq, dt), fq.heading, *sq, prev, dt);
+      fut.x.push_back(fq.centre.x);
+      fut.y.push_back(fq.centre.y);
+      fut.v.push_back(vq.speed);
+      fut.heading.push_back(vq.heading);
+      prev = sq;
+    }
+    if (fut.x.empty()) --futures;
   }
   out->futures.resize(futures);
 }

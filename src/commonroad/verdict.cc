@@ -378,7 +378,57 @@ std::optional<Failure> VerdictChecker::StartFailure(const PlanningProblem& probl
   s.y = problem.initial.position.y;
   s.orientation = problem.initial.orientation.value_or(0.0);
   if (std::optional<Failure> f = CollisionAt(s)) return f;
-  return OffRoadAt(s);
+  if (std::optional<Failure> f = OffRoadAt(s)) return f;
+  return UnavoidableCollision(problem);
+}
+
+std::optional<Failure> VerdictChecker::UnavoidableCollision(const PlanningProblem& problem) const {
+  const VehicleParams& p = vehicle_;
+  const double dt = scenario_->dt;
+  const double v0 = problem.initial.velocity.value_or(0.0);
+  const double psi0 = problem.initial.orientation.value_or(0.0);
+  const double delta0 = std::abs(problem.initial.steering_angle.value_or(0.0));
+  const double steer_rate = std::max(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
+  const double steer_max = std::max(std::abs(p.steering_min), std::abs(p.steering_max));
+  const double half_l = 0.5 * p.length, half_w = 0.5 * p.width;
+  const Vec2 along{std::cos(psi0), std::sin(psi0)}, across{-along.y, along.x};
+  for (int k = 1; k <= kUnavoidableSteps; ++k) {
+    const double t = k * dt;
+    // The rear axle's path length (signed) within [x_lo, x_hi], its heading within +-dpsi of
+    // the initial one (the yaw rate v tan(delta) / l, delta growing at most at the steering
+    // rate); the centre, b ahead of the rear axle, turns with it.
+    const double x_lo = v0 * t - 0.5 * p.a_max * t * t;
+    const double x_hi = v0 * t + 0.5 * p.a_max * t * t;
+    const double v_abs = std::max(std::abs(v0) + p.a_max * t, 0.0);
+    const double dpsi =
+        v_abs * std::tan(std::min(delta0 + steer_rate * t, steer_max)) / p.Wheelbase() * t;
+    if (!(dpsi < 0.5)) break;
+    const double reach = std::max(std::abs(x_lo), std::abs(x_hi));
+    const double lateral = (reach + p.b) * std::sin(dpsi) + kReachSlack;
+    const double lo = (x_lo >= 0 ? x_lo * std::cos(dpsi) : x_lo) - p.b * (1 - std::cos(dpsi)) -
+                      kReachSlack;
+    const double hi = x_hi + kReachSlack;
+    // Every box of a centre in [lo, hi] x [-lateral, lateral] (initial frame) turned by up to
+    // dpsi covers this rectangle (the inscribed one of a turned box, a' = a cos - w sin).
+    const double a = half_l * std::cos(dpsi) - half_w * std::sin(dpsi);
+    const double w = half_w * std::cos(dpsi) - half_l * std::sin(dpsi);
+    const double core_lo = hi - a, core_hi = lo + a, core_w = w - lateral;
+    if (!(core_hi > core_lo) || !(core_w > 0)) break;
+    const double mid = 0.5 * (core_lo + core_hi);
+    const Vec2 centre{problem.initial.position.x + mid * along.x,
+                      problem.initial.position.y + mid * along.y};
+    const auto core = BoxCorners(centre, psi0, core_hi - core_lo, 2 * core_w);
+    const int step = problem.initial.time_step + k;
+    for (const Obstacle& o : scenario_->obstacles) {
+      const std::optional<ShapeGroup> occupancy = o.OccupancyAt(step);
+      if (!occupancy || !occupancy->Overlaps(core)) continue;
+      return Failure{FailureKind::kCollision, step,
+                     "every state the vehicle can reach at step " + std::to_string(step) +
+                         " overlaps obstacle " + std::to_string(o.id) + " (" + o.type + ")",
+                     o.id};
+    }
+  }
+  return std::nullopt;
 }
 
 Verdict CheckTrajectory(const Scenario& scenario, const PlanningProblem& problem,

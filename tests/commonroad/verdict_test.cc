@@ -264,26 +264,62 @@ TEST(VerdictTest, FollowingACurvedLaneSolvesIt) {
 }
 
 TEST(VerdictTest, AStartOnAnObstacleIsInfeasibleAtStart) {
-  // A parked car 3 m ahead of the start overlaps the ego's 4.5 m box at step 0; 6 m ahead it
-  // does not (and the run into it later is the trajectory's own collision).
-  for (const double gap : {3.0, 6.0}) {
+  // The ego at 20 m/s, a parked car ahead in its lane, its centre `gap` m ahead of the ego's:
+  //  - 3 m: the boxes overlap at step 0;
+  //  - 6 m: 1.75 m between them; at full braking (11.5 m/s^2) the ego still moves 1.94 m in the
+  //    0.1 s to step 1, and no steering moves it aside in that time: unavoidable at step 1;
+  //  - 40 m: braking stops it in 17.4 m, so no collision is certain (the constant-speed run
+  //    into it later is the trajectory's own collision).
+  struct Case {
+    double gap;
+    int infeasible_step;  // -1: none
+  };
+  for (const Case& c : {Case{3.0, 0}, Case{6.0, 1}, Case{40.0, -1}}) {
     ScenarioXml xml;
     AddStraightRoad(xml, 300)
-        .StaticObstacle(9, 4.0, 1.8, {10 + gap, -1.75}, 0)
+        .StaticObstacle(9, 4.0, 1.8, {10 + c.gap, -1.75}, 0)
         .Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
     const Scenario s = Parse(xml);
     const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 20));
     EXPECT_FALSE(v.solved);
     ASSERT_NE(v.Find(FailureKind::kCollision), nullptr) << v.Summary();
-    if (gap < 4) {
-      ASSERT_TRUE(v.infeasible_at_start.has_value()) << v.Summary();
+    if (c.infeasible_step >= 0) {
+      ASSERT_TRUE(v.infeasible_at_start.has_value()) << c.gap << ": " << v.Summary();
       EXPECT_EQ(v.infeasible_at_start->kind, FailureKind::kCollision);
       EXPECT_EQ(v.infeasible_at_start->obstacle_id, 9);
-      EXPECT_EQ(v.Find(FailureKind::kCollision)->step, 0);
-      EXPECT_THAT(v.Summary(), HasSubstr("infeasible at start: collision at step 0"));
+      EXPECT_EQ(v.infeasible_at_start->step, c.infeasible_step) << c.gap;
+      EXPECT_THAT(v.Summary(), HasSubstr("infeasible at start: collision at step " +
+                                         std::to_string(c.infeasible_step)));
     } else {
-      EXPECT_FALSE(v.infeasible_at_start.has_value()) << v.Summary();
+      EXPECT_FALSE(v.infeasible_at_start.has_value()) << c.gap << ": " << v.Summary();
       EXPECT_GT(v.Find(FailureKind::kCollision)->step, 0);
+    }
+  }
+}
+
+TEST(VerdictTest, ACarFromBehindThatHitsAtOnceIsUnavoidable) {
+  // A car 7 m behind (centre to centre: 2.5 m between the bumpers) in the ego's lane closes at
+  // 40 m/s: it is into the ego's box at step 1 whatever the ego does. The same car in the next
+  // lane (3.5 m over) passes by, and the same car 60 m back arrives after 1.5 s, when the ego can
+  // be elsewhere: neither is certain.
+  struct Case {
+    double behind, y;
+    bool unavoidable;
+  };
+  for (const Case& c : {Case{7, -1.75, true}, Case{7, 1.75, false}, Case{60, -1.75, false}}) {
+    std::vector<testing::StateXml> car;
+    for (int k = 0; k <= 30; ++k) car.push_back({k, {10 - c.behind + 60.0 * 0.1 * k, c.y}, 0.0, 60});
+    ScenarioXml xml;
+    AddStraightRoad(xml, 300)
+        .DynamicObstacle(9, 4.5, 1.8, car)
+        .Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 20)});
+    const Scenario s = Parse(xml);
+    const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 20));
+    EXPECT_EQ(v.infeasible_at_start.has_value(), c.unavoidable)
+        << c.behind << " m behind at y " << c.y << ": " << v.Summary();
+    if (c.unavoidable) {
+      EXPECT_EQ(v.infeasible_at_start->step, 1);
+      EXPECT_THAT(v.infeasible_at_start->detail, HasSubstr("every state the vehicle can reach"));
     }
   }
 }

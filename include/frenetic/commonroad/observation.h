@@ -23,6 +23,9 @@ namespace frenetic::commonroad {
 // Samples of a recorded future (the one at the present included: kFutureSteps + 1 at most):
 // enough for the planner's horizons (6 s and a little at 0.1 s).
 inline constexpr int kFutureSteps = 80;
+// Steps ahead within which an obstacle not there yet is told as a car to come (recorded mode):
+// the planner's check horizon and a little.
+inline constexpr int kComingSteps = 60;
 
 // An obstacle's footprint at a step: centre, heading (rad), length and width (m). For a state of
 // the obstacle: the bounding box of its shape in its own frame, placed at the state (the box
@@ -74,7 +77,9 @@ MeasuredVelocity MeasureVelocity(const Obstacle& o, int step, double dt);
 // order (its footprint, FootprintAt, and the velocity a sensor measures, MeasureVelocity), and, in
 // recorded mode, out->futures with each one's future from `step` on (footprint centre and
 // MeasureVelocity's speed and direction every dt, up to kFutureSteps ahead, to the last step it
-// exists); constant velocity: futures empty. Both are cleared first, their storage reused. A row's
+// exists), then one for each dynamic obstacle that comes within kComingSteps (a car entering
+// the map later: CarFuture::start its first step's time from now, its footprint there, its
+// samples from then on, to kFutureSteps after `step`); constant velocity: futures empty. Both are cleared first, their storage reused. A row's
 // s/d is its centre projected on `line`, the search started at `ego_s` (the ego's s). Never fails.
 void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, double ego_s,
              PredictionMode mode, plan::Telemetry* out);

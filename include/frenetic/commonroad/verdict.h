@@ -19,8 +19,10 @@
 //  - road: the ego's box lies inside the union of all lanelets, both directions, the network's
 //    ends closed (RoadArea, with options.road_tolerance and options.open_end_margin).
 //  - infeasible at start: the problem's initial state itself collides (its box overlaps an
-//    obstacle at the initial step) or lies off the road; no trajectory can solve it (it starts
-//    there), so the problem is reported apart, not as a planner's failure.
+//    obstacle at the initial step) or lies off the road, or a collision within the first
+//    kUnavoidableSteps steps cannot be avoided (an obstacle overlaps every box the vehicle can
+//    reach then: UnavoidableCollision); no trajectory can solve it (it starts there), so the
+//    problem is reported apart, not as a planner's failure.
 //  - kinematic limits, per state: steering angle in [steering_min, steering_max], velocity in
 //    [v_min, v_max]; per step k -> k+1 with the input reconstructed from the two states
 //    (steering rate = (delta_{k+1} - delta_k) / dt, acceleration = (v_{k+1} - v_k) / dt, both
@@ -85,7 +87,8 @@ struct Verdict {
   // The first failure of each kind, in the order of FailureKind.
   std::vector<Failure> failures;
   // Set when the initial state already fails a collision or road check (then the same failure
-  // is among `failures` at the initial step): the problem has no solution.
+  // is among `failures` at the initial step), or a collision soon after it cannot be avoided
+  // (VerdictChecker::UnavoidableCollision): the problem has no solution.
   std::optional<Failure> infeasible_at_start;
 
   const Failure* Find(FailureKind kind) const;
@@ -93,6 +96,11 @@ struct Verdict {
   // "infeasible at start: collision at step 0 (...)".
   std::string Summary() const;
 };
+
+// Steps after the initial one that VerdictChecker::UnavoidableCollision looks at.
+inline constexpr int kUnavoidableSteps = 10;
+// m of slack on the reach's bounds (rounding in the recorded states).
+inline constexpr double kReachSlack = 0.01;
 
 struct VerdictOptions {
   double road_tolerance = RoadArea::kDefaultTolerance;  // m, see RoadArea
@@ -124,9 +132,16 @@ class VerdictChecker {
   // fails: bad trajectories give kTrajectory failures.
   Verdict Check(const PlanningProblem& problem, std::span<const KsState> trajectory) const;
   // The problem's initial state (at its time step, with its orientation, else 0) checked for
-  // collision and road as a trajectory's state is: the failure when it fails (the problem is
-  // infeasible at start), else nothing.
+  // collision and road as a trajectory's state is, then UnavoidableCollision: the failure when
+  // one is found (the problem is infeasible at start), else nothing.
   std::optional<Failure> StartFailure(const PlanningProblem& problem) const;
+  // A collision no trajectory from the initial state avoids, at one of the kUnavoidableSteps
+  // steps after it: an obstacle that overlaps, at that step, the rectangle every box the
+  // vehicle can reach then covers. The reach is over-approximated (acceleration within
+  // +-a_max, the heading's change within what the steering rate and angle allow, the centre
+  // within the path those bound), so a collision found here is certain; the rectangle vanishes
+  // within a few steps at road speeds, and later collisions are never found. nullopt: none.
+  std::optional<Failure> UnavoidableCollision(const PlanningProblem& problem) const;
 
   const RoadArea& road() const { return road_; }
 
