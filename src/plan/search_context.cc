@@ -120,6 +120,20 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
       kmin = std::min(kmin, k);
     }
   }
+  if (cfg.curve_prefilter) {
+    // Each bin's largest |kappa|, from its two ends and its middle (the line's curvature
+    // changes over tens of metres).
+    ws.kappa_s0 = start.s - Workspace::kEdgeBehind;
+    const double h = 0.5 * Workspace::kEdgeBin;
+    double prev = std::abs(line.At(ws.kappa_s0).kappa);
+    for (int b = 0; b < static_cast<int>(ws.abs_kappa.size()); ++b) {
+      const double x = ws.kappa_s0 + b * Workspace::kEdgeBin;
+      const double mid = std::abs(line.At(x + h).kappa), next = std::abs(line.At(x + 2 * h).kappa);
+      ws.abs_kappa[b] = Finite(mid) && Finite(next) && Finite(prev) ? std::max({prev, mid, next}) : 0.0;
+      prev = next;
+    }
+    ws.max_abs_d = std::max(std::abs(ws.road_left), std::abs(ws.road_right));
+  }
   for (int l = 0; l < cfg.num_lanes; ++l) {
     c.lane_center[l] = ws.lane_center[l];
     const double d = ws.lane_center[l];

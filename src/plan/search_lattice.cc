@@ -65,6 +65,27 @@ void Lattice::AddLon(const LonTraj& l) {
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
                 &ws_.lon_sdd[i * n]);
   ws_.lon_near_have[i] = 0;  // its masks: when first needed (Scorer::InputFor)
+  if (cfg_.curve_prefilter && TooFastForTheCurve(i)) ws_.lon.pop_back();
+}
+
+bool Lattice::TooFastForTheCurve(int i) const {
+  // On a path at offset d the XY curvature is kappa / (1 - kappa d) and the XY speed
+  // s' (1 - kappa d): the lateral acceleration s'^2 kappa (1 - kappa d) is at least
+  // s'^2 |kappa| (1 - |kappa| max |d|) for any lateral move within the road. The XY check
+  // measures the total acceleration (the lateral one and the forward one) on 0.2 s means: a
+  // lateral one kCurveSlack above the limit at a sample fails it. From the second sample on
+  // (the first is the present state), within the check horizon.
+  const int n = ws_.n_samples;
+  const double limit = (1 + kCurveSlack) * cfg_.max_accel;
+  const int bins = static_cast<int>(ws_.abs_kappa.size());
+  for (int k = 1; k < n && k * cfg_.score_dt <= cfg_.check_horizon + 1e-9; ++k) {
+    const double v = ws_.lon_sd[i * n + k];
+    const int b = static_cast<int>(std::floor((ws_.lon_s[i * n + k] - ws_.kappa_s0) / Workspace::kEdgeBin));
+    if (b < 0 || b >= bins) continue;
+    const double kappa = ws_.abs_kappa[b];
+    if (v * v * kappa * std::max(0.0, 1 - kappa * ws_.max_abs_d) > limit) return true;
+  }
+  return false;
 }
 
 void Lattice::AddLat(const LatTraj& l) {

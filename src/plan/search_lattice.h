@@ -74,6 +74,10 @@ class Lattice {
   void AddPasses();
   int Leader(int lane) const;
   int Alongside(int lane) const;
+  // Settings::curve_prefilter: whether lon bundle i's v^2 kappa along the line rules out every
+  // candidate of it (the XY check would reject them all).
+  bool TooFastForTheCurve(int i) const;
+  static constexpr double kCurveSlack = 0.15;
 
   const Settings& cfg_;
   const Predictor& predictor_;

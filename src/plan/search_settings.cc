@@ -74,6 +74,7 @@ Settings::Settings(const PlannerConfig& c) {
   margin_behind = c.value("check.margin_behind");
   headway_min = c.value("check.headway_min");
   clear_enough = c.value("check.clear_enough");
+  curve_prefilter = c.int_value("check.curve_prefilter") != 0;
   behind_time = c.value("check.behind_time");
   followers_react = c.int_value("prediction.followers_react") != 0;
   refine = c.int_value("refine.enabled") != 0;

@@ -67,6 +67,9 @@ struct Settings {
   double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
   double headway_min, behind_time;
   double clear_enough;  // m (check.clear_enough; 0: off)
+  // check.curve_prefilter: longitudinal trajectories whose v^2 kappa along the line clearly
+  // exceeds limits.max_accel are not candidates (Lattice::AddLon).
+  bool curve_prefilter;
   bool followers_react;  // a car right behind brakes for the ego (prediction.followers_react)
   bool refine;
   int refine_iterations;

@@ -49,6 +49,7 @@ Workspace::Workspace(const Settings& cfg) {
                                   kEdgeBehind + kEdgeAhead) / kEdgeBin)) + 2;
   edge_lo.assign(edge_bins, 0.0);
   edge_hi.assign(edge_bins, 0.0);
+  abs_kappa.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
   collision_step = std::max(1, static_cast<int>(std::lround(cfg.collision_dt / kTickSeconds)));

@@ -94,6 +94,12 @@ struct Workspace {
   static constexpr double kEdgeBin = 2.0, kEdgeBehind = 10.0, kEdgeAhead = 20.0;  // m
   double edge_s0 = 0;
   std::vector<double> edge_lo, edge_hi;
+  // The line's largest |kappa| (1/m) over each kEdgeBin m from kappa_s0 (the edges' reach),
+  // and the largest |d| of a lane border at the start (m): the lattice's curve prefilter
+  // (Settings::curve_prefilter; filled only with it).
+  double kappa_s0 = 0;
+  std::vector<double> abs_kappa;
+  double max_abs_d = 0;
   cost::CostContext ctx;
   // The goals of this cycle (Telemetry::goals), times relative to the start state.
   cost::GoalRegion goals[cost::kMaxGoalRegions];

@@ -56,6 +56,42 @@ TEST(SearchLatticeTest, ReachableSpeedFollowsTheVehiclesAccelerationRule) {
   EXPECT_NEAR(ReachableSpeed(ks2, 9.0, 2.0, 6.0), v, 1e-3);
 }
 
+TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
+  REQUIRE_UDACITY_MAP();
+  // kS lies on a gentle bend: at 20 m/s with a total acceleration limit of 0.5 m/s^2, many
+  // longitudinal trajectories ask more than the bend allows. With the prefilter none of those
+  // that are left does (at the samples within the check horizon, by the same bound); without it
+  // they are there.
+  auto with = [](int on) {
+    PlannerConfig c = testing::DefaultConfig();
+    EXPECT_TRUE(c.Set("check.curve_prefilter", on).ok());
+    return c;
+  };
+  Stages off(with(0)), on(with(1));
+  off.cfg.max_accel = on.cfg.max_accel = 0.5;  // below the config's range: a test-only limit
+  PrepareCentred(off, 20);
+  PrepareCentred(on, 20);
+  off.lattice.Generate();
+  on.lattice.Generate();
+  EXPECT_LT(on.ws.lon.size(), off.ws.lon.size());
+  ASSERT_GT(on.ws.lon.size(), 0u);
+  const Workspace& ws = on.ws;
+  const int n = ws.n_samples;
+  int near_limit = 0;
+  for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
+    for (int k = 1; k < n && k * on.cfg.score_dt <= on.cfg.check_horizon + 1e-9; ++k) {
+      const double s = ws.lon_s[i * n + k], v = ws.lon_sd[i * n + k];
+      const int b = static_cast<int>(std::floor((s - ws.kappa_s0) / Workspace::kEdgeBin));
+      ASSERT_TRUE(b >= 0 && b < static_cast<int>(ws.abs_kappa.size()));
+      const double kappa = ws.abs_kappa[b];
+      const double a = v * v * kappa * std::max(0.0, 1 - kappa * ws.max_abs_d);
+      EXPECT_LE(a, 1.15 * 0.5 + 1e-9) << "lon " << i << " sample " << k;
+      near_limit += a > 0.5;
+    }
+  }
+  EXPECT_GT(near_limit, 0) << "the bound kept some within its slack";
+}
+
 TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   REQUIRE_UDACITY_MAP();
   Stages st(GridOnly());
