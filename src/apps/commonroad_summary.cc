@@ -22,10 +22,14 @@ std::string Family(std::string_view benchmark_id) {
 
 std::string FirstFailure(const ProblemReport& p) {
   if (!p.road_error.empty()) return "road";
+  // The goal is judged at the trajectory's last state: a miss there is the reason only when
+  // nothing else failed (a run ends at its first collision or departure from the road).
   const cr::Failure* first = nullptr;
   for (const cr::Failure& f : p.verdict.failures) {
+    if (f.kind == cr::FailureKind::kGoal) continue;
     if (first == nullptr || f.step < first->step) first = &f;
   }
+  if (first == nullptr) first = p.verdict.Find(cr::FailureKind::kGoal);
   return first != nullptr ? cr::ToString(first->kind) : "unknown";
 }
 

@@ -22,7 +22,9 @@ namespace frenetic::apps::commonroad_cli {
 std::string Family(std::string_view benchmark_id);
 
 // Why an unsolved problem failed, in one word: "road" when no road was built, else the kind of
-// its earliest failure (by step; at the same step, the verdict's order of kinds).
+// its earliest failure other than the goal (by step; at the same step, the verdict's order of
+// kinds), else "goal" (a goal miss is judged at the trajectory's last state, where a run that
+// collided or left the road ended).
 std::string FirstFailure(const ProblemReport& p);
 
 // What the summary says besides the reports: the run's settings.

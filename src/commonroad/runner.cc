@@ -456,6 +456,12 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       path_x.assign(res.x.begin() + std::min<size_t>(ticks, res.x.size()), res.x.end());
       path_y.assign(res.y.begin() + std::min<size_t>(ticks, res.y.size()), res.y.end());
       run.trajectory.push_back(ego);
+      // A collision or a box off the road fails the problem whatever follows: the run ends.
+      if (checker.CollisionAt(ego)) {
+        run.stop_reason = "collision";
+      } else if (checker.OffRoadAt(ego)) {
+        run.stop_reason = "off_road";
+      }
       std::string why;
       for (int q = 0; q < static_cast<int>(plan::Reject::kCount); ++q) {
         if (res.summary.rejections[q] > 0) {
@@ -470,6 +476,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                     ego.velocity, ego.steering_angle, cyc.tracking_error);
       run.cycles.push_back(cyc);
       run.computation_s += cyc.plan_ms / 1000.0;
+      if (run.stop_reason != "time") break;
     }
     if (run.stop_reason == "time") {
       bool met = false;

@@ -80,11 +80,14 @@ FileReport File(std::string id, std::vector<ProblemReport> problems) {
   return f;
 }
 
-TEST(CommonRoadSummaryTest, FirstFailureIsTheEarliestThenTheVerdictsOrder) {
+TEST(CommonRoadSummaryTest, FirstFailureIsTheEarliestThenTheVerdictsOrderTheGoalLast) {
   using K = cr::FailureKind;
   EXPECT_EQ(FirstFailure(Failed({Fail(K::kGoal, 49), Fail(K::kCollision, 12)})), "collision");
   EXPECT_EQ(FirstFailure(Failed({Fail(K::kCollision, 12), Fail(K::kOffRoad, 12)})), "collision");
-  EXPECT_EQ(FirstFailure(Failed({Fail(K::kGoal, 30), Fail(K::kOffRoad, 31)})), "goal");
+  // A run ends at its collision: the goal's miss is judged at that same last step.
+  EXPECT_EQ(FirstFailure(Failed({Fail(K::kGoal, 30), Fail(K::kCollision, 30)})), "collision");
+  EXPECT_EQ(FirstFailure(Failed({Fail(K::kGoal, 30), Fail(K::kOffRoad, 31)})), "off_road");
+  EXPECT_EQ(FirstFailure(Failed({Fail(K::kGoal, 30)})), "goal");
   ProblemReport no_road = Failed({Fail(K::kTrajectory, 0)});
   no_road.road_error = "no lanelet under the ego";
   EXPECT_EQ(FirstFailure(no_road), "road");

@@ -335,6 +335,28 @@ TEST(RunnerTest, ARunEndsOnceEveryGoalRegionIsBehind) {
   EXPECT_GT(p.trajectory.back().x, 44.0);
 }
 
+TEST(RunnerTest, ARunEndsAtItsFirstCollision) {
+  // Both lanes have a car 40 m behind at 45 m/s, the ego at 20 m/s: nothing it can do keeps it
+  // clear of both for 2 s. The run ends at the step the verdict finds the collision at (the
+  // problem is failed), not at the goal window's end (10 s).
+  ScenarioXml xml;
+  AddStraightRoad(xml, 600);
+  for (const auto& [id, y] : {std::pair{7, -1.75}, std::pair{8, 1.75}}) {
+    std::vector<testing::StateXml> car;
+    for (int k = 0; k <= 100; ++k) car.push_back({k, {-20 + 45.0 * 0.1 * k, y}, 0.0, 45});
+    xml.DynamicObstacle(id, 4.5, 1.8, car);
+  }
+  xml.Problem(1, {20, -1.75}, 0, 20, {GoalTimeOnlyXml(100, 100)});
+  const ProblemRun p = RunOne(xml);
+  ASSERT_FALSE(p.verdict.infeasible_at_start.has_value()) << p.verdict.Summary();
+  const Failure* hit = p.verdict.Find(FailureKind::kCollision);
+  ASSERT_NE(hit, nullptr) << p.verdict.Summary();
+  EXPECT_EQ(p.stop_reason, "collision");
+  EXPECT_EQ(p.trajectory.back().time_step, hit->step);
+  EXPECT_EQ(static_cast<int>(p.cycles.size()), hit->step);
+  EXPECT_LT(hit->step, 40);
+}
+
 TEST(RunnerTest, AProblemInfeasibleAtStartIsNotPlanned) {
   // Three starts no trajectory can leave from: off the road beside it, across the road's closed
   // start, and on a parked car. Each is reported infeasible at start with the failure at the

@@ -17,7 +17,8 @@
 // inputs within the vehicle's limits), so the trajectory is a KS trajectory by construction.
 // The run ends at the first step that meets a goal state, after the last goal time window (or,
 // for goals without one, the scenario's last recorded step), once the ego has driven past every
-// goal region, or after kMaxSteps.
+// goal region, at the first step its box overlaps an obstacle or leaves the road (the verdict's
+// own checks: the problem is failed then), or after kMaxSteps.
 #pragma once
 
 #include <functional>
@@ -88,8 +89,9 @@ struct ProblemRun {
   std::vector<KsState> trajectory;
   std::vector<RunCycle> cycles;
   // "goal"; "time" (the last goal window ended); "goal_passed" (the ego drove past every goal
-  // region: none can be met any more, the planner never reverses); "infeasible_at_start"
-  // (nothing planned).
+  // region: none can be met any more, the planner never reverses); "collision" or "off_road"
+  // (the ego's box overlapped an obstacle or left the road: the problem is failed);
+  // "infeasible_at_start" (nothing planned).
   std::string stop_reason;
   Verdict verdict;
   double computation_s = 0;  // planning time of the whole run (0 without timing)

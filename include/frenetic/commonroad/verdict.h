@@ -145,11 +145,11 @@ class VerdictChecker {
 
   const RoadArea& road() const { return road_; }
 
- private:
-  // The collision and road failures of one state (collision first), each when it fails.
+  // The collision and road failures of one state as Check finds them, each when it fails.
   std::optional<Failure> CollisionAt(const KsState& s) const;
   std::optional<Failure> OffRoadAt(const KsState& s) const;
 
+ private:
   const Scenario* scenario_;
   VehicleParams vehicle_;
   VerdictOptions options_;
