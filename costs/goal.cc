@@ -9,7 +9,9 @@
 // it), at most `cap`. Between samples each quantity is taken linear in time, so each term is convex and
 // piecewise linear and their sum is least at a window end, a sample or where a term crosses an
 // interval's end: the minimum over those is exact (for h, of its linear interpolation).
-// About 25 samples and a few crossings per candidate and goal: cheap enough for every candidate.
+// About 25 samples and a few crossings per candidate and goal: Expensive() (the scorer evaluates
+// it for a candidate only when the other terms' bound leaves it a chance), as it is the dearest
+// of the terms that read every sample on a problem with a goal far ahead.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -81,6 +83,7 @@ class GoalCost : public CostTerm {
   }
 
   bool Sampled() const override { return true; }
+  bool Expensive() const override { return true; }
 
  private:
   // The candidate at time t (s after the start): sampled, then straight on. h is its heading's

@@ -91,12 +91,9 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
       continue;
     }
     if (rest_.empty()) return -1;
+    // By the bounds as they are (any lower bound gives the same answer): the cheap tests
+    // first, the bound completed (Advance) only for a candidate that passes them.
     const int c = rest_.front().second;
-    if (!scorer_.BoundComplete(c)) {
-      rest_.front().first = scorer_.Bound(c);
-      SiftDownTop(rest_.begin(), rest_.end(), later);
-      continue;
-    }
     std::pop_heap(rest_.begin(), rest_.end(), later);
     rest_.pop_back();
     if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=

@@ -439,7 +439,10 @@ class SearchPlanner : public Planner {
       }
       if (rest_.empty()) return -1;  // every candidate collides or breaks a limit
       const int c = rest_.front().second;
-      if (!scorer_.BoundComplete(c)) {
+      // A coarse bound is completed before the collision test (the tests then come in a
+      // better order), unless nothing passed last cycle: then mostly every candidate collides,
+      // and the ones that do need no complete bound (any lower bound gives the same answer).
+      if (!none_passed_last_ && !scorer_.BoundComplete(c)) {
         rest_.front().first = scorer_.Bound(c);
         search::SiftDownTop(rest_.begin(), rest_.end(), later);
         continue;
