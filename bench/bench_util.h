@@ -268,18 +268,20 @@ class Replay {
 // are loaded; `scenes` outlives the run).
 void RegisterPlanBenchmarks(const std::vector<Scene>& scenes);
 void RegisterStageBenchmarks(const std::vector<Scene>& scenes);
-// BM_PlanCommonRoad/<scenario id> per US-101 file and BM_PlanCommonRoadSet/US101 over all of
-// them (plan_bench.cc); nothing, with a note on stderr, without the shared files.
+// BM_PlanCommonRoad/<scenario id> per US-101 file, BM_PlanCommonRoadSet/US101 over all of them
+// and BM_PlanCommonRoadSet/highD over the highD problems (plan_bench.cc); nothing, with a note on
+// stderr, without the shared files.
 void RegisterCommonRoadBenchmarks();
 
-// CommonRoad scenes (commonroad_scenes.cc). The scenario files of the US-101 examples present in
-// the shared directory ($FRENETIC_SHARED_DIR, else the build's FRENETIC_SHARED_DIR) under
-// commonroad/: none when it is absent.
-std::vector<std::string> CommonRoadSceneFiles();
+// CommonRoad scenes (commonroad_scenes.cc). The scenario files of a family present in the shared
+// directory ($FRENETIC_SHARED_DIR, else the build's FRENETIC_SHARED_DIR) under commonroad/:
+// "US101", the three US-101 examples; "highD", every highD/*.cr.xml (sorted). None when absent.
+std::vector<std::string> CommonRoadSceneFiles(const std::string& family = "US101");
 // The scene of one such file: every cycle of its first planning problem's closed-loop run
 // (commonroad::RunScenario as `frenetic commonroad` runs it: config/planner.yaml +
 // config/commonroad.yaml, KS2, recorded predictions, the deadlines pinned), as the planner was
-// given it. Captured on first use and kept (the run takes a few seconds).
+// given it. Captured on first use and kept (the run takes a few seconds). A problem infeasible
+// at start, or one whose run ends at its first step, gives a scene with fewer than 2 messages.
 StatusOr<const Scene*> CommonRoadScene(const std::string& path);
 
 // CPU time of the calling thread, s (what a cycle costs whatever else the machine runs).

@@ -4,6 +4,7 @@
 // does, and hands out every cycle's planner input (RunOptions::on_cycle): the telemetry (ego,
 // previous path, sensor rows, recorded futures, goals), the road built from the lanelets, and
 // the problem's configuration. BM_PlanCommonRoad replays them like the Udacity scenes.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -51,23 +52,27 @@ StatusOr<Scene> Capture(const std::string& path) {
     scene.messages.push_back(in.telemetry);
   };
   const commonroad::ScenarioRun run = commonroad::RunScenario(*scenario, *config, options);
-  if (scene.messages.size() < 2) {
-    return Status::Error(path + ": the run planned " + std::to_string(scene.messages.size()) +
-                         " cycle(s)" +
-                         (run.problems.empty() || run.problems[0].road.ok()
-                              ? std::string()
-                              : ": " + run.problems[0].road.message()));
-  }
+  if (!run.problems.empty() && !run.problems[0].road.ok()) return run.problems[0].road;
   return scene;
 }
 
 }  // namespace
 
-std::vector<std::string> CommonRoadSceneFiles() {
+std::vector<std::string> CommonRoadSceneFiles(const std::string& family) {
   std::vector<std::string> out;
+  std::error_code ec;
+  if (family == "highD") {
+    const std::filesystem::path dir = SharedDir() + "/commonroad/highD";
+    if (!std::filesystem::is_directory(dir, ec)) return out;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.size() > 7 && name.ends_with(".cr.xml")) out.push_back(e.path().string());
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
   for (const char* id : {"USA_US101-10_1_T-1", "USA_US101-10_3_T-1", "USA_US101-10_4_T-1"}) {
     const std::string path = SharedDir() + "/commonroad/" + id + ".xml";
-    std::error_code ec;
     if (std::filesystem::exists(path, ec)) out.push_back(path);
   }
   return out;
