@@ -125,6 +125,19 @@ async function checkPage(name, kind) {
   const plotIds = await page.$$eval("#plots canvas", (cs) => cs.map((c) => c.id));
   check(kind.plots.every((id) => plotIds.includes(id)) && !kind.noPlots.some((id) => plotIds.includes(id)),
         `${name}: plots present: ${plotIds.join(", ")}`);
+  // Grid lines at round values (1, 2 or 5 times a power of ten, and their multiples).
+  const ticks = Object.fromEntries(await page.$$eval("#plots canvas",
+                                                      (cs) => cs.map((c) => [c.id, c.getAttribute("data-ticks")])));
+  const round = (labels) => {
+    const v = labels.split(" ").map(Number), step = v[1] - v[0];
+    const m = step / 10 ** Math.floor(Math.log10(step) + 1e-9);
+    return v.length >= 2 && [1, 2, 5].some((x) => Math.abs(m - x) < 1e-6) &&
+           v.every((x, i) => Math.abs(x / step - Math.round(x / step)) < 1e-6 && Math.abs(x - v[0] - i * step) < step * 1e-6);
+  };
+  check(Object.values(ticks).every(round), `${name}: every plot's grid at round values (${JSON.stringify(ticks)})`);
+  for (const [id, labels] of Object.entries(kind.ticks)) {
+    check(ticks[id] === labels, `${name}: ${id} reads ${labels} (${ticks[id]})`);
+  }
   const tiles = await page.$$eval(".tile", (ts) => ts.map((t) => t.textContent));
   check(kind.tiles.every((k) => tiles.some((t) => t.startsWith(k))) &&
         !kind.noTiles.some((k) => tiles.some((t) => t.startsWith(k))), `${name}: the tiles of its world`);
@@ -182,6 +195,7 @@ try {
     commonroad: false, incidents: "No incident", summary: [],
     plots: ["plot-speed", "plot-acc", "plot-jerk", "plot-lane", "plot-gap", "plot-headway", "plot-ms", "plot-cost"],
     noPlots: [], tiles: ["max speed", "max acc", "max jerk"], noTiles: [],
+    ticks: { "plot-speed": "0 20 40 60", "plot-lane": "0 1 2" },
   });
   // The planner's speed cap, no simulator acceleration or jerk; the verdict's failure as its
   // incident; the road's lanes, goal regions and cars of their own sizes.
@@ -191,6 +205,7 @@ try {
               "collision at step 200: with obstacle 3"],
     plots: ["plot-speed", "plot-lane", "plot-gap", "plot-headway", "plot-ms", "plot-cost"],
     noPlots: ["plot-acc", "plot-jerk"], tiles: ["max speed", "collision"], noTiles: ["max acc", "max jerk"],
+    ticks: { "plot-speed": "0 20 40 60 80 100", "plot-lane": "0 1 2" },  // not 23.1 / 46.3...
   });
   // --- a drive with a collision ---
   {

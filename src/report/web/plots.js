@@ -36,7 +36,7 @@ function buildPlots() {
     { id: "lane", title: "lane (0 = left)", unit: "",
       series: [series("lane", E.lane.map((v) => v >= 0 ? v : null), "#0e9384", true),
                series("winner's target", E.winner_lane.map((v) => v >= 0 ? v : null), "#f79009", true)],
-      lo: -0.5, hi: H.lanes - 0.5, invert: true },
+      lo: -0.5, hi: H.lanes - 0.5, invert: true, integer: true },
     { id: "gap", title: "gap to the car ahead", unit: "m", series: [series("gap", E.gap, "#475467")],
       lo: 0, robust: true },
     { id: "headway", title: "time headway", unit: "s",
@@ -50,7 +50,7 @@ function buildPlots() {
   if (D.rejections.some((r) => r.count.some((n) => n > 0))) {
     specs.push({ id: "rejections", title: "rejected candidates per cycle, by reason", unit: "",
                  series: D.rejections.map((r, i) => series(r.name, r.count, PALETTE[(i + 3) % PALETTE.length])),
-                 lo: 0 });
+                 lo: 0, integer: true });
   }
   const root = $("plots");
   for (const spec of specs) {
@@ -79,6 +79,11 @@ function buildPlots() {
       }
       for (const [v] of spec.limits || []) hi = Math.max(hi, v * 1.15);
       if (!(hi > spec.lo)) hi = spec.lo + 1;
+      // Up to the next round value, which the top grid line then labels.
+      plot.step = tickStep(spec.lo, hi, spec.integer);
+      hi = Math.ceil(hi / plot.step - 1e-9) * plot.step;
+    } else {
+      plot.step = tickStep(spec.lo, hi, spec.integer);
     }
     plot.lo = spec.lo; plot.hi = hi;
     c.addEventListener("click", (ev) => {
@@ -121,16 +126,18 @@ function renderLayer(plot) {
   g.fillStyle = "#667085";
   g.strokeStyle = "#eaecf0";
   g.lineWidth = 1;
-  // Horizontal grid with labels.
-  const ticks = plot.spec.id === "lane" ? Array.from({ length: H.lanes }, (_, i) => i)
-                                        : [0, 0.25, 0.5, 0.75, 1].map((u) => plot.lo + u * (plot.hi - plot.lo));
+  // Horizontal grid with labels, at round values.
+  const digits = stepDigits(plot.step);
+  const labels = [];
   g.textAlign = "right";
   g.textBaseline = "middle";
-  for (const v of ticks) {
+  for (const v of ticks(plot.lo, plot.hi, plot.step)) {
     const y = plotY(plot, v);
     g.beginPath(); g.moveTo(PAD_L * dpr, y); g.lineTo(c.width - PAD_R * dpr, y); g.stroke();
-    g.fillText(fmt(v), (PAD_L - 4) * dpr, y);
+    labels.push(fmt(v, digits));
+    g.fillText(labels[labels.length - 1], (PAD_L - 4) * dpr, y);
   }
+  c.setAttribute("data-ticks", labels.join(" "));  // for tests
   // Time labels.
   g.textAlign = "center";
   g.textBaseline = "bottom";
@@ -203,11 +210,25 @@ function renderLayer(plot) {
   plot.layer = layer;
   plot.canvas.setAttribute("data-incidents", String(D.incidents.length));
 }
+// The smallest round step (1, 2 or 5 times a power of ten) of at least `raw`.
 function niceStep(raw) {
   const p = Math.pow(10, Math.floor(Math.log10(Math.max(raw, 1e-9))));
   for (const m of [1, 2, 5, 10]) if (m * p >= raw) return m * p;
   return 10 * p;
 }
+// The round step that cuts [lo, hi] into at most 5 intervals (at least 1 for counts and lanes).
+function tickStep(lo, hi, integer) {
+  const step = niceStep((hi - lo) / 5);
+  return integer ? Math.max(1, step) : step;
+}
+// The multiples of `step` in [lo, hi].
+function ticks(lo, hi, step) {
+  const out = [];
+  for (let i = Math.ceil(lo / step - 1e-9); i * step <= hi + step * 1e-9; ++i) out.push(i * step);
+  return out;
+}
+// Digits after the point that a multiple of `step` needs.
+function stepDigits(step) { return Math.max(0, Math.ceil(-Math.log10(step) - 1e-9)); }
 function drawPlot(plot) {
   if (!plot.layer) renderLayer(plot);
   const g = plot.ctx, c = plot.canvas, k = state.k;
@@ -225,5 +246,6 @@ function drawPlot(plot) {
   }
   c.setAttribute("data-cursor-x", String(x));
   plot.readout.textContent = plot.spec.series.map((s) =>
-      (plot.spec.series.length > 1 ? s.name + " " : "") + fmt(s.values[k])).join("  ");
+      (plot.spec.series.length > 1 ? s.name + " " : "") +
+      fmt(s.values[k], plot.spec.integer ? 0 : undefined)).join("  ");
 }
