@@ -57,6 +57,7 @@ function drawReplay() {
     ctx.stroke(road.center);
     ctx.strokeStyle = "#ffffff";
     ctx.stroke(road.edge);
+    if (road.ends) ctx.stroke(road.ends);
     ctx.lineWidth = 1.5 * px * dpr;
     ctx.setLineDash([3, 6]);  // m: like road markings
     for (const p of road.lanes) ctx.stroke(p);

@@ -26,7 +26,8 @@ function linePath(xs, ys) {
   if (closed) p.closePath();
   return p;
 }
-const road = { surface: null, center: null, lanes: [], edge: null };
+// surface: filled; center and edge: solid lines; lanes: dashed lines; ends: solid lines across.
+const road = { surface: null, center: null, lanes: [], edge: null, ends: null };
 if (CX.length > 1) {
   const outer = offsetLine(H.lanes * H.lane_width);
   // Centre line forward and the outer edge backward: one polygon whose non-zero winding
@@ -44,11 +45,13 @@ const GOALS = [];
 if (COMMONROAD) {
   // Each lane's borders as recorded (lanes may begin, end, widen and bend apart): the leftmost
   // lane's left border solid yellow, the rightmost's right border solid white, every border
-  // dashed. Goal regions as outlines.
+  // dashed, and a solid line across each lane where it begins and ends, so that the road's end
+  // shows where the network ends. Goal regions as outlines.
   if (Array.isArray(D.road) && D.road.length) {
     road.surface = new Path2D();
     road.center = new Path2D();
     road.edge = new Path2D();
+    road.ends = new Path2D();
     D.road.forEach((l, i) => {
       const n = Math.min(l.lx.length, l.ly.length, l.rx.length, l.ry.length);
       if (n < 2) return;
@@ -59,6 +62,10 @@ if (COMMONROAD) {
       road.lanes.push(left, right);
       if (i === 0) road.center.addPath(left);
       if (i === D.road.length - 1) road.edge.addPath(right);
+      for (const p of [0, n - 1]) {
+        road.ends.moveTo(l.lx[p], l.ly[p]);
+        road.ends.lineTo(l.rx[p], l.ry[p]);
+      }
     });
   }
   for (const g of (Array.isArray(D.goals) ? D.goals : [])) {
