@@ -5,11 +5,9 @@
 
 namespace frenetic::report::internal {
 
-// report.html with report.css and report.js inlined; "@FRENETIC_DATA@" marks where the data goes.
-// report.js's CommonRoad parts (lines between "//@commonroad" and "//@end", or "//@else" whose
-// lines up to "//@end" stand for them in a drive's page) are left out of PageTemplateText and
-// kept in CommonRoadPageTemplateText; the marker lines are in neither.
+// report.html with report.css and the script's parts (report.cmake's order) inlined;
+// "@FRENETIC_DATA@" marks where the data goes. One page for drives and CommonRoad runs: the
+// script tells them apart by the data's header (world "commonroad").
 std::string_view PageTemplateText();
-std::string_view CommonRoadPageTemplateText();
 
 }  // namespace frenetic::report::internal

@@ -156,7 +156,8 @@ std::string PageDataJson(const RunData& run, std::string_view source) {
   o.Key("car_length").Fixed(h.car_length, 3);
   o.Key("car_width").Fixed(h.car_width, 3);
   o.Key("config").Json(h.config_json);
-  // A CommonRoad run's fields; a drive's page has none of them (and stays as it was).
+  // A CommonRoad run's fields (world "commonroad" switches the page's script to its parts); a
+  // drive's data has none of them (and stays as it was).
   if (!h.world.empty()) {
     o.Key("world").String(h.world);
     o.Key("problem").Int(h.problem);
@@ -295,11 +296,6 @@ std::string PageDataJson(const RunData& run, std::string_view source) {
 
 std::string_view PageTemplate() { return internal::PageTemplateText(); }
 
-std::string_view PageTemplateFor(const RunData& run) {
-  return run.header.world == "commonroad" ? internal::CommonRoadPageTemplateText()
-                                          : internal::PageTemplateText();
-}
-
 std::string RenderPage(const RunData& run, std::string_view source) {
   std::string data = PageDataJson(run, source);
   // '<' occurs only inside JSON strings, where \u003c means the same: no "</script>" or "<!--"
@@ -313,7 +309,7 @@ std::string RenderPage(const RunData& run, std::string_view source) {
       escaped += c;
     }
   }
-  const std::string_view page = PageTemplateFor(run);
+  const std::string_view page = PageTemplate();
   const size_t at = page.find(kDataPlaceholder);
   FRENETIC_CHECK(at != std::string_view::npos);  // report.cmake refuses a template without it
   std::string out;

@@ -1,28 +1,22 @@
 #include "frenetic/report/record.h"
 
-#include <zlib.h>
-
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <exception>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
-#include <set>
-#include <streambuf>
 #include <utility>
+
+#include "report/candidate_sampler.h"
+#include "report/gzip_stream.h"
 
 namespace frenetic::report {
 namespace {
 
 using json = nlohmann::json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Cycles before an incident whose candidates are kept with it: the decision that led to an
-// incident is usually made a few cycles earlier.
-constexpr int kCyclesBeforeIncident = 5;
 // A candidate's path is drawn as a polyline; more points than this add bytes, not insight.
 constexpr int kMaxCandidatePoints = 40;
 
@@ -56,74 +50,10 @@ std::vector<double> Numbers(const json* a) {
   return out;
 }
 
-// The text of a gzip-compressed record (`drive --record run.jsonl.gz`), inflated as it is read.
-// Concatenated gzip members read as one text. Data that ends early or is corrupt ends the text
-// there; error() then says why.
-class GzipStreambuf : public std::streambuf {
- public:
-  explicit GzipStreambuf(std::istream& in) : in_(in), in_buf_(256 << 10), out_buf_(256 << 10) {
-    // 15 window bits + 32: a gzip (or zlib) header, detected.
-    if (inflateInit2(&zs_, 15 + 32) != Z_OK) {
-      error_ = "cannot start inflating";
-      done_ = true;
-    }
-  }
-  ~GzipStreambuf() override { inflateEnd(&zs_); }
-  GzipStreambuf(const GzipStreambuf&) = delete;
-  GzipStreambuf& operator=(const GzipStreambuf&) = delete;
-
-  const std::string& error() const { return error_; }
-
- protected:
-  int_type underflow() override {
-    if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
-    while (!done_) {
-      if (zs_.avail_in == 0) {
-        in_.read(in_buf_.data(), static_cast<std::streamsize>(in_buf_.size()));
-        const auto n = static_cast<uInt>(in_.gcount());
-        if (n == 0) {
-          if (!member_ended_) error_ = "the compressed data ends early (the drive was cut short?)";
-          done_ = true;
-          break;
-        }
-        zs_.next_in = reinterpret_cast<Bytef*>(in_buf_.data());
-        zs_.avail_in = n;
-      }
-      if (member_ended_) {  // another gzip member follows
-        inflateReset(&zs_);
-        member_ended_ = false;
-      }
-      zs_.next_out = reinterpret_cast<Bytef*>(out_buf_.data());
-      zs_.avail_out = static_cast<uInt>(out_buf_.size());
-      const int rc = inflate(&zs_, Z_NO_FLUSH);
-      const std::size_t produced = out_buf_.size() - zs_.avail_out;
-      if (rc == Z_STREAM_END) {
-        member_ended_ = true;
-      } else if (rc != Z_OK && rc != Z_BUF_ERROR) {
-        error_ =
-            std::string("corrupt compressed data (") + (zs_.msg ? zs_.msg : "zlib error") + ")";
-        done_ = true;
-      }
-      if (produced > 0) {
-        setg(out_buf_.data(), out_buf_.data(), out_buf_.data() + produced);
-        return traits_type::to_int_type(*gptr());
-      }
-    }
-    return traits_type::eof();
-  }
-
- private:
-  std::istream& in_;
-  std::vector<char> in_buf_, out_buf_;
-  z_stream zs_{};
-  bool member_ended_ = false, done_ = false;
-  std::string error_;
-};
-
 class Reader {
  public:
   Reader(std::string_view source, const ReadOptions& options, const GzipStreambuf* gzip)
-      : source_(source), options_(options), gzip_(gzip) {}
+      : source_(source), options_(options), gzip_(gzip), sampler_(options.max_candidate_cycles) {}
 
   StatusOr<RunData> Read(std::istream& in) {
     std::string line;
@@ -179,7 +109,7 @@ class Reader {
     }
     if (!have_header_) return Status::Error(std::string(source_) + ": record has no header line");
     if (run_.size() == 0) return Status::Error(std::string(source_) + ": no usable exchange");
-    for (auto& [exchange, cycle] : kept_) run_.candidate_cycles.push_back(std::move(cycle));
+    run_.candidate_cycles = sampler_.Take();
     run_.path_offset.push_back(static_cast<int>(run_.path_x.size()));
     run_.traffic_offset.push_back(static_cast<int>(run_.traffic_id.size()));
     return std::move(run_);
@@ -471,15 +401,14 @@ class Reader {
     return out;
   }
 
-  // Keeps candidates for a bounded set of cycles while streaming: every stride-th cycle (the
-  // stride doubles whenever the budget is exceeded, so the kept cycles stay evenly spread
-  // whatever the run's length), plus pinned cycles around incidents and lane decisions.
+  // The cycle's candidates (the first max_candidates listed, and the winner), offered to the
+  // sampler with what may pin them: an incident at this exchange, a change of the winner's lane.
   void ReadCandidates(const json* list, int k) {
     const bool incident = std::exchange(incident_now_, false);
     const bool lane_change = k > 0 && run_.winner_lane[k] != run_.winner_lane[k - 1] &&
                              run_.winner_lane[k] >= 0 && run_.winner_lane[k - 1] >= 0;
     if (list == nullptr || !list->is_array() || list->empty()) {
-      if (incident) PinRecent();
+      sampler_.AddWithoutCandidates(incident);
       return;
     }
     CycleCandidates cycle;
@@ -493,53 +422,16 @@ class Reader {
         cycle.candidates.push_back(ReadCandidate(c));
       }
     }
-    // Incidents and lane decisions each have their own budget, so a run full of lane changes
-    // cannot crowd out the cycles that explain an incident.
-    const bool pin_lane = lane_change && !incident && lane_pins_ < options_.max_candidate_cycles;
-    if (pin_lane && pinned_.insert(k).second) ++lane_pins_;
-    if (pinned_.count(k) != 0 || k % stride_ == 0) kept_[k] = cycle;
-    recent_.push_back(std::move(cycle));
-    if (static_cast<int>(recent_.size()) > kCyclesBeforeIncident + 1) recent_.pop_front();
-    if (incident) PinRecent();
-    Thin();
-  }
-
-  void PinRecent() {
-    // Newest first: the incident's own cycle matters most.
-    for (auto it = recent_.rbegin(); it != recent_.rend(); ++it) {
-      const CycleCandidates& c = *it;
-      if (incident_pins_ >= options_.max_candidate_cycles) break;
-      if (pinned_.insert(c.exchange).second) {
-        ++incident_pins_;
-        kept_[c.exchange] = c;
-      }
-    }
-  }
-
-  void Thin() {
-    while (static_cast<int>(kept_.size() - pinned_.size()) > options_.max_candidate_cycles) {
-      stride_ *= 2;
-      for (auto it = kept_.begin(); it != kept_.end();) {
-        if (it->first % stride_ != 0 && pinned_.count(it->first) == 0) {
-          it = kept_.erase(it);
-        } else {
-          ++it;
-        }
-      }
-    }
+    sampler_.Add(std::move(cycle), incident, lane_change);
   }
 
   std::string_view source_;
   ReadOptions options_;
   const GzipStreambuf* gzip_;  // the decompressor of a gzip record, else null
+  CandidateSampler sampler_;
   RunData run_;
   bool have_header_ = false;
-  bool incident_now_ = false;
-  int stride_ = 1;
-  int lane_pins_ = 0, incident_pins_ = 0;
-  std::map<int, CycleCandidates> kept_;
-  std::set<int> pinned_;
-  std::deque<CycleCandidates> recent_;
+  bool incident_now_ = false;  // an incident was read at the exchange being read
 };
 
 }  // namespace

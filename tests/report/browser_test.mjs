@@ -114,56 +114,99 @@ async function incidentMarks(page) {
   });
 }
 
-try {
-  // --- a short drive ---
-  {
-    const { page, errors } = await open("run.html");
-    const pixels = await drawnPixels(page);
-    check(pixels.n > pixels.total * 0.02, `replay canvas has drawn (${pixels.n} of ${pixels.total} pixels not background)`);
-    const plotIds = await page.$$eval("#plots canvas", (cs) => cs.map((c) => c.id));
-    check(["plot-speed", "plot-acc", "plot-jerk", "plot-lane", "plot-gap", "plot-headway", "plot-ms", "plot-cost"]
-              .every((id) => plotIds.includes(id)), `plots present: ${plotIds.join(", ")}`);
-    const cursor = () => page.$$eval("#plots canvas", (cs) => cs.map((c) => Number(c.getAttribute("data-cursor-x"))));
-    const before = await cursor();
-    const frameBefore = await page.$eval("#replay", (c) => c.toDataURL());
-    const n = await page.evaluate(() => window.freneticReport.data.n);
-    await page.locator("#slider").fill(String(Math.floor(n / 2)));
-    const after = await cursor();
-    check(after.every((x, i) => x > before[i] + 50), `slider moves every plot's cursor (${before[0]} -> ${after[0]})`);
-    check((await page.$eval("#replay", (c) => c.toDataURL())) !== frameBefore, "slider redraws the replay");
-    check((await page.textContent("#clock")).includes(`${Math.floor(n / 2) + 1} / ${n}`), "clock follows the slider");
-    // Zoom changes the replay.
-    const frameZoom = await page.$eval("#replay", (c) => c.toDataURL());
-    await page.click("#zoom-out");
-    check((await page.$eval("#replay", (c) => c.toDataURL())) !== frameZoom, "zoom button redraws the replay");
-    // Click a cycle on the speed plot: its cost table appears.
-    const box = await page.locator("#plot-speed").boundingBox();
-    await page.mouse.click(box.x + box.width * 0.75, box.y + box.height / 2);
-    const rows = await page.$$eval("#cost-table tr", (trs) => trs.map((tr) => tr.textContent));
-    check(rows.length >= 6, `clicking the plot shows a cost table (${rows.length} rows)`);
-    check(rows.some((r) => r.includes("winner")) && rows.some((r) => r.startsWith("lane_change")),
-          "the table shows the winner and the cost terms");
-    check((await page.textContent("#details h2")).includes("Cycle"), "the details name the cycle");
-    const k = await page.evaluate(() => window.freneticReport.state.k);
-    check(Math.abs(k - Math.floor(n * 0.75)) <= n * 0.03, `the click selects the cycle under the mouse (${k})`);
-    check((await page.$$("#rejection-table td")).length >= 5, "rejection counts by reason");
-    // The details button works too, on the current cycle.
-    await page.locator("#slider").fill("8");
-    await page.click("#details-button");
-    check((await page.textContent("#details h2")).includes("Cycle 8 "), "details button shows the current cycle");
-    check((await page.textContent("#details")).includes("rejected: "), "cycle 8's rejected best candidate is listed with its reason");
-    // Play advances time.
-    await page.locator("#slider").fill("0");
-    await page.click("#play");
-    await page.waitForFunction(() => window.freneticReport.state.k > 5, null, { timeout: 10000 });
-    await page.click("#play");
-    check(true, "play advances the replay");
-    await page.locator("#slider").fill("120");
-    await page.screenshot({ path: path.join(args.out, "report.png"), fullPage: true });
-    check((await page.textContent("#incidents")).includes("No incident"), "header says no incident");
-    check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
-    await page.close();
+// The checks every page passes, a drive's or a CommonRoad run's (one template, one path here);
+// `kind` holds what differs: the plots and tiles of the run's world, its incidents.
+async function checkPage(name, kind) {
+  const { page, errors } = await open(name);
+  check((await page.evaluate(() => window.freneticReport.commonroad)) === kind.commonroad,
+        `${name}: the page takes the run for ${kind.commonroad ? "a CommonRoad run" : "a drive"}`);
+  const pixels = await drawnPixels(page);
+  check(pixels.n > pixels.total * 0.02, `${name}: replay canvas has drawn (${pixels.n} of ${pixels.total} pixels not background)`);
+  const plotIds = await page.$$eval("#plots canvas", (cs) => cs.map((c) => c.id));
+  check(kind.plots.every((id) => plotIds.includes(id)) && !kind.noPlots.some((id) => plotIds.includes(id)),
+        `${name}: plots present: ${plotIds.join(", ")}`);
+  // Grid lines at round values (1, 2 or 5 times a power of ten, and their multiples).
+  const ticks = Object.fromEntries(await page.$$eval("#plots canvas",
+                                                      (cs) => cs.map((c) => [c.id, c.getAttribute("data-ticks")])));
+  const round = (labels) => {
+    const v = labels.split(" ").map(Number), step = v[1] - v[0];
+    const m = step / 10 ** Math.floor(Math.log10(step) + 1e-9);
+    return v.length >= 2 && [1, 2, 5].some((x) => Math.abs(m - x) < 1e-6) &&
+           v.every((x, i) => Math.abs(x / step - Math.round(x / step)) < 1e-6 && Math.abs(x - v[0] - i * step) < step * 1e-6);
+  };
+  check(Object.values(ticks).every(round), `${name}: every plot's grid at round values (${JSON.stringify(ticks)})`);
+  for (const [id, labels] of Object.entries(kind.ticks)) {
+    check(ticks[id] === labels, `${name}: ${id} reads ${labels} (${ticks[id]})`);
   }
+  const tiles = await page.$$eval(".tile", (ts) => ts.map((t) => t.textContent));
+  check(kind.tiles.every((k) => tiles.some((t) => t.startsWith(k))) &&
+        !kind.noTiles.some((k) => tiles.some((t) => t.startsWith(k))), `${name}: the tiles of its world`);
+  const cursor = () => page.$$eval("#plots canvas", (cs) => cs.map((c) => Number(c.getAttribute("data-cursor-x"))));
+  const before = await cursor();
+  const frameBefore = await page.$eval("#replay", (c) => c.toDataURL());
+  const n = await page.evaluate(() => window.freneticReport.data.n);
+  await page.locator("#slider").fill(String(Math.floor(n / 2)));
+  const after = await cursor();
+  check(after.every((x, i) => x > before[i] + 50), `${name}: slider moves every plot's cursor (${before[0]} -> ${after[0]})`);
+  check((await page.$eval("#replay", (c) => c.toDataURL())) !== frameBefore, `${name}: slider redraws the replay`);
+  check((await page.textContent("#clock")).includes(`${Math.floor(n / 2) + 1} / ${n}`), `${name}: clock follows the slider`);
+  // Zoom changes the replay.
+  const frameZoom = await page.$eval("#replay", (c) => c.toDataURL());
+  await page.click("#zoom-out");
+  check((await page.$eval("#replay", (c) => c.toDataURL())) !== frameZoom, `${name}: zoom button redraws the replay`);
+  // Click a cycle on the speed plot: its cost table appears.
+  const box = await page.locator("#plot-speed").boundingBox();
+  await page.mouse.click(box.x + box.width * 0.75, box.y + box.height / 2);
+  const rows = await page.$$eval("#cost-table tr", (trs) => trs.map((tr) => tr.textContent));
+  check(rows.length >= 6, `${name}: clicking the plot shows a cost table (${rows.length} rows)`);
+  check(rows.some((r) => r.includes("winner")) && rows.some((r) => r.startsWith("lane_change")),
+        `${name}: the table shows the winner and the cost terms`);
+  check((await page.textContent("#details h2")).includes("Cycle"), `${name}: the details name the cycle`);
+  const k = await page.evaluate(() => window.freneticReport.state.k);
+  check(Math.abs(k - Math.floor(n * 0.75)) <= n * 0.03, `${name}: the click selects the cycle under the mouse (${k})`);
+  check((await page.$$("#rejection-table td")).length >= 5, `${name}: rejection counts by reason`);
+  // The details button works too, on the current cycle.
+  await page.locator("#slider").fill("8");
+  await page.click("#details-button");
+  check((await page.textContent("#details h2")).includes("Cycle 8 "), `${name}: details button shows the current cycle`);
+  check((await page.textContent("#details")).includes("rejected: "), `${name}: cycle 8's rejected best candidate is listed with its reason`);
+  // Play advances time.
+  await page.locator("#slider").fill("0");
+  await page.click("#play");
+  await page.waitForFunction(() => window.freneticReport.state.k > 5, null, { timeout: 10000 });
+  await page.click("#play");
+  check(true, `${name}: play advances the replay`);
+  await page.locator("#slider").fill("120");
+  await page.screenshot({ path: path.join(args.out, name.replace(".html", ".png")), fullPage: true });
+  const incidentText = (await page.textContent("#incidents")).trim();
+  check(incidentText.includes(kind.incidents), `${name}: header lists its incidents (${incidentText})`);
+  for (const line of kind.summary) {
+    check((await page.textContent("#summary")).includes(line), `${name}: the summary says "${line}"`);
+  }
+  check((await page.textContent("#replay-legend")).includes("goal region") === kind.commonroad,
+        `${name}: goal regions in the legend only for a CommonRoad run`);
+  check(errors.length === 0, `${name}: no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
+  await page.close();
+}
+
+try {
+  // --- a short drive, and a CommonRoad run on the same cycles ---
+  await checkPage("run.html", {
+    commonroad: false, incidents: "No incident", summary: [],
+    plots: ["plot-speed", "plot-acc", "plot-jerk", "plot-lane", "plot-gap", "plot-headway", "plot-ms", "plot-cost"],
+    noPlots: [], tiles: ["max speed", "max acc", "max jerk"], noTiles: [],
+    ticks: { "plot-speed": "0 20 40 60", "plot-lane": "0 1 2" },
+  });
+  // The planner's speed cap, no simulator acceleration or jerk; the verdict's failure as its
+  // incident; the road's lanes, goal regions and cars of their own sizes.
+  await checkPage("commonroad.html", {
+    commonroad: true, incidents: "collision at 20.0 s",
+    summary: ["CommonRoad synthetic, planning problem 1", "NOT solved (stopped by collision)",
+              "collision at step 200: with obstacle 3"],
+    plots: ["plot-speed", "plot-lane", "plot-gap", "plot-headway", "plot-ms", "plot-cost"],
+    noPlots: ["plot-acc", "plot-jerk"], tiles: ["max speed", "collision"], noTiles: ["max acc", "max jerk"],
+    ticks: { "plot-speed": "0 20 40 60 80 100", "plot-lane": "0 1 2" },  // not 23.1 / 46.3...
+  });
   // --- a drive with a collision ---
   {
     const { page, errors } = await open("incident.html");
@@ -182,18 +225,6 @@ try {
     check((await page.textContent("#details")).includes("incident: collision"), "clicking it opens the cycle's details");
     check((await page.evaluate(() => window.freneticReport.state.k)) === 150, "and moves the replay to it");
     await page.screenshot({ path: path.join(args.out, "incident.png"), fullPage: true });
-    check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
-    await page.close();
-  }
-  // --- a CommonRoad run: the planner's speed cap, no simulator acceleration or jerk ---
-  {
-    const { page, errors } = await open("commonroad.html");
-    const plotIds = await page.$$eval("#plots canvas", (cs) => cs.map((c) => c.id));
-    check(plotIds.includes("plot-speed") && !plotIds.includes("plot-acc") && !plotIds.includes("plot-jerk"),
-          `CommonRoad plots: ${plotIds.join(", ")}`);
-    const allTiles = await page.$$eval(".tile", (ts) => ts.map((t) => t.textContent));
-    check(!allTiles.some((t) => t.startsWith("max acc") || t.startsWith("max jerk")),
-          "no simulator acceleration or jerk tiles on a CommonRoad page");
     check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
     await page.close();
   }

@@ -24,7 +24,10 @@ struct SyntheticOptions {
   // plan_ms {p50, p99, max}, miles) instead of the names of the record's spec.
   bool simulator_footer = false;
   int candidates = 6;           // per cycle
-  // A CommonRoad run's header (world, problem, the planner's speed cap in its config).
+  // A CommonRoad run's record: its header (world, problem, the planner's speed cap in its
+  // config, the road's lanes over kSyntheticRoadEnd m of the loop instead of the centre line,
+  // a goal region), cars of their own sizes and its verdict (a collision at exchange
+  // kSyntheticFailureAt) in the footer.
   bool commonroad = false;
   std::uint64_t seed = 7;
 };
@@ -32,6 +35,8 @@ struct SyntheticOptions {
 inline constexpr double kSyntheticRadius = 250.0;  // m, radius of the loop's centre line
 inline constexpr double kSyntheticDt = 0.1;        // s between exchanges
 inline constexpr int kSyntheticLaneChangeAt = 100; // the winner goes from lane 1 to lane 0 here
+inline constexpr double kSyntheticRoadEnd = 800.0;  // m: a CommonRoad record's road ends here
+inline constexpr int kSyntheticFailureAt = 200;     // a CommonRoad record's verdict: a collision
 
 // Position on the loop: the road runs counter-clockwise, so d (to the right) points outward.
 inline void SyntheticXY(double s, double d, double* x, double* y, double* yaw) {
@@ -68,6 +73,30 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
     header["prediction"] = "recorded";
     header["vehicle"] = "KS2";
     header["config"]["limits"] = {{"max_speed_mph", 80.5}};
+    header["centerline"] = json::array();
+    json lanes = json::array();
+    for (int l = 0; l < 3; ++l) {
+      json lx = json::array(), ly = json::array(), rx = json::array(), ry = json::array();
+      for (double s = 0; s <= kSyntheticRoadEnd; s += 10) {
+        double x, y, yaw;
+        SyntheticXY(s, 4 * l, &x, &y, &yaw);
+        lx.push_back(x);
+        ly.push_back(y);
+        SyntheticXY(s, 4 * l + 4, &x, &y, &yaw);
+        rx.push_back(x);
+        ry.push_back(y);
+      }
+      lanes.push_back({{"left", {{"x", lx}, {"y", ly}}}, {"right", {{"x", rx}, {"y", ry}}}});
+    }
+    header["road"] = {{"lanes", lanes}};
+    json gx = json::array(), gy = json::array();
+    for (const auto& [s, d] : {std::pair{700.0, 0.0}, {740.0, 0.0}, {740.0, 12.0}, {700.0, 12.0}}) {
+      double x, y, yaw;
+      SyntheticXY(s, d, &x, &y, &yaw);
+      gx.push_back(x);
+      gy.push_back(y);
+    }
+    header["goals"] = json::array({{{"x", gx}, {"y", gy}, {"steps", {250, 350}}}});
   }
   out += header.dump() + "\n";
 
@@ -98,6 +127,11 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
       SyntheticXY(car_s[c], car_d[c], &cx, &cy, &cyaw);
       fusion.push_back({static_cast<int>(c), cx, cy, car_v[c] * std::cos(cyaw),
                         car_v[c] * std::sin(cyaw), std::fmod(car_s[c], max_s), car_d[c]});
+      if (options.commonroad) {  // length, width, heading (deg)
+        for (double v : {4.0 + 0.4 * c, 1.8, cyaw * 180 / std::numbers::pi}) {
+          fusion.back().push_back(v);
+        }
+      }
       const double ahead = car_s[c] - ego_s;
       if (std::abs(car_d[c] - ego_d) < 2 && ahead > 0 && (gap < 0 || ahead < gap)) gap = ahead;
     }
@@ -216,6 +250,16 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
                               "plan_ms_max"}) {
         r.erase(key);
       }
+    }
+    if (options.commonroad) {  // the verdict, in the shape `frenetic commonroad --record` writes
+      json& r = footer["report"];
+      r["solved"] = false;
+      r["goal_step"] = nullptr;
+      r["stop_reason"] = "collision";
+      r["failures"] = json::array({{{"kind", "collision"}, {"step", kSyntheticFailureAt},
+                                    {"detail", "with obstacle 3"}, {"obstacle", 3}}});
+      r["incidents"] = {{"collision", 1}};
+      r.erase("incidents_total");
     }
     out += footer.dump() + "\n";
   }

@@ -21,12 +21,10 @@ std::string PageDataJson(const RunData& run, std::string_view source);
 std::string RenderPage(const RunData& run, std::string_view source);
 
 // The page's assets as built into the library (for tests): the HTML template with its style and
-// script inlined and one data placeholder left. PageTemplate is a drive's page;
-// PageTemplateFor(run) the one `run` is drawn with: a CommonRoad run's (header world
-// "commonroad") has the script's CommonRoad parts (the road's lanes, goal regions, cars of their
-// own sizes, the verdict), which a drive's page leaves out.
+// script inlined and one data placeholder left. One template for every run: the script draws a
+// CommonRoad run's parts (the road's lanes, goal regions, cars of their own sizes, the verdict,
+// the planner's speed cap) when the data's header says world "commonroad", a drive's otherwise.
 std::string_view PageTemplate();
-std::string_view PageTemplateFor(const RunData& run);
 
 // Writes `content` to `path` (replacing it); an error names the path when it cannot be written.
 Status WriteFile(const std::string& path, std::string_view content);
