@@ -16,6 +16,7 @@
 #include "frenetic/commonroad/cost.h"
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
+#include "frenetic/commonroad/solution.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/sim/episode.h"
@@ -382,6 +383,8 @@ StatusOr<std::unique_ptr<Evaluator>> Evaluator::Create(const Suite& suite, int j
       }
       Impl::CommonRoadSet& set = impl->cr_sets[k];
       for (const std::string& f : *files) {
+        // A solution file beside the scenarios (highD's recorded human) is no scenario.
+        if (commonroad::PeekRootElement(f) == "CommonRoadSolution") continue;
         auto sc = commonroad::LoadScenario(f);
         if (!sc.ok()) {
           return Status::Error(suite.source + ": '" + sets[k].first + "': " + sc.message());

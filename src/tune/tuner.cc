@@ -293,12 +293,21 @@ StatusOr<TuneResult> Tune(const Suite& suite, const TuneOptions& options, Evalua
   result.best_evaluation = search.best_index();
   result.evaluations = search.done();
   result.replayed = search.replayed();
-  const std::vector<double> tuned_values = search.Values(result.best_x);
+  std::vector<double> tuned_values = search.Values(result.best_x);
+  result.tuned_train = search.best();
+  // The search never beat the start configuration: the start stays (a tuner returns nothing
+  // worse than what it was given).
+  result.start_kept = start_train->objective <= search.best().objective;
+  if (result.start_kept) {
+    tuned_values = start_values;
+    result.best_x = x0;
+    result.best_evaluation = 0;
+    result.tuned_train = *start_train;
+  }
   for (std::size_t i = 0; i < suite.params.size(); ++i) {
     result.params.push_back({suite.params[i].key, start_values[i], tuned_values[i]});
   }
   result.start_train = *start_train;
-  result.tuned_train = search.best();
   result.commonroad = suite.kind == SuiteKind::kCommonRoad;
   if (result.commonroad) result.cost_function = suite.commonroad.cost_function;
   result.has_holdout = evaluator.episodes(SeedSet::kHoldout) > 0;
@@ -326,6 +335,7 @@ nlohmann::json TuneResult::ToJson() const {
   return {{"evaluations", evaluations},
           {"replayed", replayed},
           {"best_evaluation", best_evaluation},
+          {"start_kept", start_kept},
           {"best_x", best_x},
           {"params", params_j},
           {"train", {{"default", start_train.ToJson()}, {"tuned", tuned_train.ToJson()}}},
@@ -371,6 +381,7 @@ std::string TuneResult::ToTable() const {
     row("held-out", "default", start_holdout);
     row("held-out", "tuned", tuned_holdout);
   }
+  if (start_kept) os << "no search point beat the start: it is kept\n";
   os << "(" << evaluations << " evaluations, best #" << best_evaluation;
   if (replayed > 0) os << ", " << replayed << " replayed from the log";
   os << ")\n";

@@ -116,7 +116,10 @@ struct TuneResult {
   std::vector<double> best_x;      // the best point in [0, 1]^n
   int evaluations = 0;             // search evaluations (budget)
   int replayed = 0;                // of them, answered from the resume log
-  int best_evaluation = -1;        // index of the best search evaluation
+  int best_evaluation = -1;        // index of the best search evaluation (0: the start's)
+  // No search point beat the start configuration on the training set: the tuned values are the
+  // start's (best_x its point in the box, tuned_train its metrics).
+  bool start_kept = false;
   Metrics start_train, tuned_train, start_holdout, tuned_holdout;
   bool has_holdout = true;         // false: a CommonRoad suite without `holdout` (not evaluated)
   bool commonroad = false;         // the metrics are a CommonRoad suite's
