@@ -168,10 +168,16 @@ class SearchPlanner : public Planner {
       if (ego_ok) {
         const double hint = continuity_.have_plan() ? continuity_.plan_s(0) : t.s;
         const map::FrenetPoint f = line_->ToFrenet(t.x, t.y, hint);
-        const double heading = line_->At(f.s).heading;
-        const double rel = t.yaw - heading;
+        const map::RefSample c = line_->At(f.s);
+        const double rel = t.yaw - c.heading;
         const double v = std::max(t.speed, 0.0);
-        start = {f.s, v * std::cos(rel), 0.0, f.d, -v * std::sin(rel), 0.0};
+        // The measured speed is the XY one: on a path at offset d the XY speed is
+        // s' (1 + kappa d) (d to the right, kappa positive to the left), so on a bend's outer
+        // lane s' is below it. Taking s' as the XY speed started every candidate there a few
+        // percent too fast, over the speed limit near it (a previous path not ours, on a bend).
+        const double stretch = 1.0 + c.kappa * f.d;
+        const double along = std::isfinite(stretch) && stretch > 0.5 ? 1.0 / stretch : 1.0;
+        start = {f.s, v * std::cos(rel) * along, 0.0, f.d, -v * std::sin(rel), 0.0};
       } else {
         start = {0.0, 0.0, 0.0, ws_.lane_center[std::min(1, cfg_.num_lanes - 1)], 0.0, 0.0};
       }
