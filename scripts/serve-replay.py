@@ -24,11 +24,18 @@ import websockets
 
 
 def exchanges(path):
-    opener = gzip.open if path.endswith(".gz") else open
+    # gzip by its magic bytes, not the name (an older build wrote plain text to a .gz name).
+    with open(path, "rb") as f:
+        gzipped = f.read(2) == b"\x1f\x8b"
+    opener = gzip.open if gzipped else open
     with opener(path, "rt") as f:
-        for line in f:
-            row = json.loads(line)
-            if row.get("type") == "exchange" and isinstance(row.get("telemetry"), dict):
+        for n, line in enumerate(f, 1):
+            try:
+                row = json.loads(line)
+            except ValueError as e:
+                raise SystemExit("serve-replay: %s:%d: not a JSON line (%s)" % (path, n, e))
+            if isinstance(row, dict) and row.get("type") == "exchange" and isinstance(
+                    row.get("telemetry"), dict):
                 yield row["telemetry"]
 
 
