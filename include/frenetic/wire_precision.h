@@ -15,18 +15,14 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <numbers>
 #include <span>
 #include <vector>
 
 #include "frenetic/plan/telemetry.h"
+#include "frenetic/units.h"
 
 namespace frenetic::wire {
 
-// The simulator reports speed as |v| (m/s) times this factor (§3.3).
-inline constexpr double kMpsToMph = 2.23693629;
-inline constexpr double kDegToRad = std::numbers::pi / 180.0;
-inline constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 inline constexpr int kTelemetryDigits = 7;  // significant digits of .NET float.ToString()
 inline constexpr int kControlDigits = 10;   // far below the float32 resolution the sim keeps
 // Room for any number either formatter writes ("-1.234567e-38", "-1.797693135e+308").
@@ -122,14 +118,14 @@ inline double AsControlNumber(double value) {
 // Heading in the simulator's unit: degrees counter-clockwise from +x in [0, 360); 0 when it is
 // not finite or would print as 360. `yaw` in rad.
 inline double YawToDegrees(double yaw) {
-  double deg = std::fmod(yaw * kRadToDeg, 360.0);
+  double deg = std::fmod(yaw * units::kRadToDeg, 360.0);
   if (deg < 0) deg += 360.0;
   if (!std::isfinite(deg) || static_cast<float>(deg) >= 360.0f) deg = 0;
   return deg;
 }
-inline double YawFromDegrees(double deg) { return deg * kDegToRad; }
-inline double SpeedToMph(double mps) { return mps * kMpsToMph; }
-inline double SpeedFromMph(double mph) { return mph / kMpsToMph; }
+inline double YawFromDegrees(double deg) { return deg * units::kDegToRad; }
+inline double SpeedToMph(double mps) { return mps * units::kSimMpsToMph; }
+inline double SpeedFromMph(double mph) { return mph / units::kSimMpsToMph; }
 
 // The telemetry as a planner receives it over the wire, i.e. what net::ParseFrame makes of
 // net::FormatTelemetryFrame(in), without the text: every number through AsTelemetryNumber (yaw

@@ -21,6 +21,7 @@
 #include "frenetic/sim/record.h"
 #include "frenetic/sim/scenario.h"
 #include "frenetic/sim/world.h"
+#include "frenetic/units.h"
 
 namespace frenetic::apps {
 namespace {
@@ -211,9 +212,8 @@ int Drive(const DriveArgs& a) {
     options.progress = [](const sim::Episode& ep) {
       if (ep.exchanges() % 50 != 0 && !ep.done()) return;
       const sim::Simulator& s = ep.sim();
-      std::fprintf(stderr, "\r%8.1f m  %6.1f s  %5.1f mph  %d incidents   ",
-                   s.monitor().distance(), s.time(), s.ego().speed() * sim::kMpsToMph,
-                   s.monitor().total());
+      std::fprintf(stderr, "\r%8.1f m  %6.1f s  %5.1f mph  %d incidents   ", s.monitor().distance(),
+                   s.time(), s.ego().speed() * units::kSimMpsToMph, s.monitor().total());
       if (ep.done()) std::fprintf(stderr, "\n");
     };
   }

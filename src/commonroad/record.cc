@@ -13,6 +13,7 @@
 
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/sim/record.h"
+#include "frenetic/units.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -21,8 +22,6 @@ using nlohmann::json;
 
 constexpr double kBorderStep = 2.0;  // m between the points of a lane border
 constexpr int kCirclePoints = 24;    // a goal circle's outline
-constexpr double kMpsToMph = 1.0 / 0.44704;
-constexpr double kDegrees = 180.0 / std::numbers::pi;
 // The planning thread waits for the queued lines to be written every this many cycles (fewer
 // than sim::RecordWriter's batch, which wakes its thread): the writer's thread, and the replica
 // planning on it, then works only while the planner waits between cycles, never beside it, so
@@ -260,7 +259,7 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
       const plan::SensorCar& c = r.car;
       rows.push_back({c.id, Round(c.x, 3), Round(c.y, 3), Round(c.vx, 3), Round(c.vy, 3),
                       Round(c.s, 3), Round(c.d, 3), Round(c.length, 3), Round(c.width, 3),
-                      Round(r.heading * kDegrees, 2)});
+                      Round(r.heading * units::kRadToDeg, 2)});
     }
     json px = json::array(), py = json::array();
     for (double v : path_x) px.push_back(Round(v, 3));
@@ -272,14 +271,15 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
                     {"telemetry",
                      {{"x", Round(x, 4)},
                       {"y", Round(y, 4)},
-                      {"yaw", Round(yaw * kDegrees, 4)},
-                      {"speed", Round(speed * kMpsToMph, 4)},
+                      {"yaw", Round(yaw * units::kRadToDeg, 4)},
+                      {"speed", Round(speed * units::kMpsToMph, 4)},
                       {"s", Round(s, 4)},
                       {"d", Round(d, 4)},
                       {"sensor_fusion", std::move(rows)}}},
                     {"path", {{"x", std::move(px)}, {"y", std::move(py)}}},
                     {"plan", sim::PlanJson(status, summary, summary.ms_total, scale, candidates)},
-                    {"metrics", {{"speed_mph", Round(speed * kMpsToMph, 4)}, {"lane", lane}}},
+                    {"metrics",
+                     {{"speed_mph", Round(speed * units::kMpsToMph, 4)}, {"lane", lane}}},
                     {"incidents", json::array()}};
     *line += e.dump();
   });
@@ -329,8 +329,8 @@ void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun&
       {"steps", static_cast<int>(run.cycles.size())},
       {"distance_m", Round(distance, 3)},
       {"sim_seconds", Round(seconds, 6)},
-      {"avg_speed_mph", Round(seconds > 0 ? distance / seconds * kMpsToMph : 0.0, 3)},
-      {"max_speed_mph", Round(max_speed * kMpsToMph, 3)},
+      {"avg_speed_mph", Round(seconds > 0 ? distance / seconds * units::kMpsToMph : 0.0, 3)},
+      {"max_speed_mph", Round(max_speed * units::kMpsToMph, 3)},
       {"plan_ms",
        {{"p50", Round(Percentile(ms, 0.5), 4)},
         {"p99", Round(Percentile(ms, 0.99), 4)},

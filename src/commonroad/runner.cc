@@ -14,6 +14,7 @@
 #include "frenetic/commonroad/road_builder.h"
 #include "frenetic/cost/goal_region.h"
 #include "frenetic/plan/telemetry.h"
+#include "frenetic/units.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -25,7 +26,6 @@ constexpr double kLimitMargin = 0.85;
 // Insets of the goal regions the planner aims at (Inset): m along, m across, m/s, rad, and
 // steps of the time window.
 constexpr double kInsetS = 1.0, kInsetD = 0.2, kInsetV = 0.5, kInsetH = 0.02, kTimeInset = 0.5;
-constexpr double kMphToMps = 0.44704;
 // The planner's top speed: this share of the vehicle's v_max (the path's speed is checked on its
 // 0.02 s points, which the KS ego tracks to within centimetres per second).
 constexpr double kTopSpeedShare = 0.97;
@@ -284,7 +284,7 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig c, const Vehi
                                                PredictionMode /*prediction*/) {
   c.PinDeadlines();
   const std::pair<const char*, double> values[] = {
-      {"limits.max_speed_mph", kTopSpeedShare * vp.v_max / kMphToMps},
+      {"limits.max_speed_mph", kTopSpeedShare * vp.v_max / units::kMphToMps},
       {"check.ego_length", vp.length},
       {"check.ego_width", vp.width},
       {"vehicle.wheelbase", vp.Wheelbase()},

@@ -9,13 +9,13 @@
 
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
+#include "frenetic/units.h"
 #include "plan/predictor_options.h"
 #include "plan/search_planner.h"
 
 namespace frenetic::plan {
 namespace {
 
-constexpr double kMphToMps = 0.44704;
 
 bool Finite(double v) { return std::isfinite(v); }
 
@@ -28,8 +28,8 @@ class BaselinePlanner : public Planner {
     follow_distance_ = config.value("baseline.follow_distance");
     ahead_free_ = config.value("baseline.ahead_free");
     behind_free_ = config.value("baseline.behind_free");
-    step_ = config.value("baseline.speed_step_mph") * kMphToMps;
-    max_speed_ = config.value("baseline.max_speed_mph") * kMphToMps;
+    step_ = config.value("baseline.speed_step_mph") * units::kMphToMps;
+    max_speed_ = config.value("baseline.max_speed_mph") * units::kMphToMps;
     points_ = std::max(kMinPathPoints, config.int_value("baseline.path_points"));
     lane_width_ = config.value("road.lane_width");
     num_lanes_ = config.int_value("road.num_lanes");

@@ -1,13 +1,15 @@
 #include "frenetic/plan/planner_config.h"
 
-#include <yaml-cpp/yaml.h>
-
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "frenetic/check.h"
 #include "frenetic/cost/cost_registry.h"
+#include "frenetic/yaml/strict_reader.h"
 
 namespace frenetic::plan {
 namespace {
@@ -235,100 +237,109 @@ Status PlannerConfig::Validate() const {
   return Status::Ok();
 }
 
+namespace {
+
+// What a file laid out as planner.yaml sets, in document order.
+struct Layout {
+  std::vector<std::pair<std::string, double>> values;  // dotted keys, range-checked
+  std::vector<std::string> terms;                      // the `costs` entries
+  std::optional<std::string> refine_algorithm;
+};
+
+const PlannerConfig::Param* FindIn(const std::vector<PlannerConfig::Param>& declared,
+                                   std::string_view key) {
+  for (const PlannerConfig::Param& p : declared) {
+    if (p.key == key) return &p;
+  }
+  return nullptr;
+}
+
+// Whether `name` is a section of plain keys (`weights.*` and `costs.*` are set under `costs`).
+bool IsSection(const std::vector<PlannerConfig::Param>& declared, const std::string& name) {
+  if (name == "weights" || name == "costs") return false;
+  for (const PlannerConfig::Param& p : declared) {
+    if (p.key.size() > name.size() && p.key.compare(0, name.size(), name) == 0 &&
+        p.key[name.size()] == '.') {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Reads the document: top-level keys (budget_ms), sections of keys, and `costs` of terms with
+// their weight and parameters. A declared key is read as a number within its range; any other
+// key is left unread, for Finish() to name.
+void ReadLayout(yaml::MapReader& r, const std::vector<PlannerConfig::Param>& declared,
+                Layout* out) {
+  auto read = [&](yaml::MapReader& m, const std::string& k, const std::string& key) {
+    const PlannerConfig::Param* p = FindIn(declared, key);
+    if (p == nullptr) return;
+    double v = 0;
+    if (m.Read(k, &v, p->lo, p->hi)) out->values.emplace_back(key, v);
+  };
+  for (const std::string& name : r.Keys()) {
+    if (!r.ok()) return;
+    if (name == "costs") {
+      yaml::MapReader costs = r.Sub(name);
+      for (const std::string& term : costs.Keys()) {
+        if (!cost::CostRegistry::Global().Contains(term)) {
+          return r.Error("unknown cost term '" + term + "'");
+        }
+        out->terms.push_back(term);
+        yaml::MapReader t = costs.Sub(term);
+        for (const std::string& k : t.Keys()) {
+          read(t, k, k == "weight" ? "weights." + term : "costs." + term + "." + k);
+        }
+        t.Finish();
+      }
+      costs.Finish();
+    } else if (IsSection(declared, name)) {
+      yaml::MapReader section = r.Sub(name);
+      for (const std::string& k : section.Keys()) {
+        const std::string key = name + "." + k;
+        if (key == "refine.algorithm") {
+          std::string algorithm;
+          if (section.Read(k, &algorithm)) out->refine_algorithm = algorithm;
+        } else {
+          read(section, k, key);
+        }
+      }
+      section.Finish();
+    } else if (name.find('.') == std::string::npos) {
+      read(r, name, name);
+    }
+  }
+  r.Finish();
+}
+
+}  // namespace
+
 StatusOr<PlannerConfig> PlannerConfig::Parse(std::string_view yaml, std::string_view source) {
   PlannerConfig c = Defaults();
   c.source_ = std::string(source);
-  const std::string src = c.source_;
-  auto err = [&](const std::string& m) { return Status::Error(src + ": " + m); };
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml));
-  } catch (const YAML::Exception& e) {
-    return err(std::string("YAML error: ") + e.what());
-  }
-  if (!root.IsMap()) return err("expected a mapping at the top level");
-  auto number = [&](const YAML::Node& node, const std::string& key) -> StatusOr<double> {
-    if (!node.IsScalar()) return err("'" + key + "' must be a number");
-    try {
-      return node.as<double>();
-    } catch (const YAML::Exception&) {
-      return err("'" + key + "' must be a number, got '" + node.Scalar() + "'");
-    }
-  };
-  std::vector<std::string> order;
-  bool saw_costs = false;
-  for (const auto& section : root) {
-    const std::string name = section.first.as<std::string>();
-    if (name == "costs") {
-      saw_costs = true;
-      if (!section.second.IsMap()) return err("'costs' must be a mapping of term names");
-      for (const auto& term : section.second) {
-        const std::string tname = term.first.as<std::string>();
-        if (!cost::CostRegistry::Global().Contains(tname)) {
-          return err("unknown cost term '" + tname + "'");
-        }
-        for (const std::string& o : order) {
-          if (o == tname) return err("cost term '" + tname + "' listed twice");
-        }
-        order.push_back(tname);
-        if (!term.second.IsMap() || !term.second["weight"]) {
-          return err("cost term '" + tname + "' has no weight (key 'costs." + tname + ".weight')");
-        }
-        for (const auto& kv : term.second) {
-          const std::string k = kv.first.as<std::string>();
-          const std::string key =
-              k == "weight" ? "weights." + tname : "costs." + tname + "." + k;
-          if (c.Find(key) == nullptr) return err("unknown key 'costs." + tname + "." + k + "'");
-          auto v = number(kv.second, key);
-          if (!v.ok()) return v.status();
-          Param* p = c.Find(key);
-          if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
-            return err("'" + key + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " +
-                       Fmt(p->hi) + "]");
-          }
-          p->value = *v;
-        }
-      }
-      continue;
-    }
-    if (section.second.IsScalar()) {
-      if (c.Find(name) == nullptr) return err("unknown key '" + name + "'");
-      auto v = number(section.second, name);
-      if (!v.ok()) return v.status();
-      Param* p = c.Find(name);
-      if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
-        return err("'" + name + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " + Fmt(p->hi) + "]");
-      }
-      p->value = *v;
-      continue;
-    }
-    if (!section.second.IsMap()) return err("unknown section '" + name + "'");
-    for (const auto& kv : section.second) {
-      const std::string key = name + "." + kv.first.as<std::string>();
-      if (key == "refine.algorithm") {
-        if (!kv.second.IsScalar()) return err("'refine.algorithm' must be a name");
-        c.refine_algorithm_ = kv.second.Scalar();
-        continue;
-      }
-      Param* p = c.Find(key);
-      if (p == nullptr || key.rfind("weights.", 0) == 0 || key.rfind("costs.", 0) == 0) {
-        return err("unknown key '" + key + "'");
-      }
-      auto v = number(kv.second, key);
-      if (!v.ok()) return v.status();
-      if (!std::isfinite(*v) || *v < p->lo || *v > p->hi) {
-        return err("'" + key + "' = " + Fmt(*v) + " outside [" + Fmt(p->lo) + ", " + Fmt(p->hi) + "]");
-      }
-      p->value = *v;
+  auto err = [&](const std::string& m) { return Status::Error(c.source_ + ": " + m); };
+  auto root = yaml::Load(yaml, c.source_);
+  if (!root.ok()) return root.status();
+  yaml::MapReader r(*root, c.source_);
+  Layout layout;
+  ReadLayout(r, c.params_, &layout);
+  if (!r.ok()) return r.status();
+  if (!r.Has("costs")) return err("missing section 'costs' (every cost term needs a weight)");
+  for (const auto& [key, v] : layout.values) c.Find(key)->value = v;
+  if (layout.refine_algorithm) c.refine_algorithm_ = *layout.refine_algorithm;
+  for (const std::string& name : layout.terms) {
+    bool weighted = false;
+    for (const auto& [key, v] : layout.values) weighted = weighted || key == "weights." + name;
+    if (!weighted) {
+      return err("cost term '" + name + "' has no weight (key 'costs." + name + ".weight')");
     }
   }
-  if (!saw_costs) return err("missing section 'costs' (every cost term needs a weight)");
   for (const std::string& name : cost::CostRegistry::Global().Names()) {
-    bool listed = false;
-    for (const std::string& o : order) listed = listed || o == name;
-    if (!listed) return err("missing weight of cost term '" + name + "' (key 'costs." + name + ".weight')");
+    if (std::find(layout.terms.begin(), layout.terms.end(), name) == layout.terms.end()) {
+      return err("missing weight of cost term '" + name + "' (key 'costs." + name + ".weight')");
+    }
   }
-  c.cost_order_ = order;
+  c.cost_order_ = layout.terms;
   Status s = c.Validate();
   if (!s.ok()) return s;
   return c;
@@ -336,52 +347,17 @@ StatusOr<PlannerConfig> PlannerConfig::Parse(std::string_view yaml, std::string_
 
 Status PlannerConfig::Overlay(std::string_view yaml, std::string_view source) {
   const std::string src(source);
-  auto err = [&](const std::string& m) { return Status::Error(src + ": " + m); };
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml));
-  } catch (const YAML::Exception& e) {
-    return err(std::string("YAML error: ") + e.what());
-  }
-  if (root.IsNull()) return Status::Ok();  // nothing to change
-  if (!root.IsMap()) return err("expected a mapping at the top level");
-  // Flattened to dotted keys first, so that an error changes nothing.
-  std::vector<std::pair<std::string, YAML::Node>> items;
-  for (const auto& section : root) {
-    const std::string name = section.first.as<std::string>();
-    if (section.second.IsScalar()) {
-      items.emplace_back(name, section.second);
-      continue;
-    }
-    if (!section.second.IsMap()) return err("'" + name + "' must be a mapping or a number");
-    for (const auto& kv : section.second) {
-      const std::string k = kv.first.as<std::string>();
-      if (name != "costs") {
-        items.emplace_back(name + "." + k, kv.second);
-        continue;
-      }
-      if (!kv.second.IsMap()) return err("'costs." + k + "' must be a mapping");
-      for (const auto& p : kv.second) {
-        const std::string pk = p.first.as<std::string>();
-        items.emplace_back(pk == "weight" ? "weights." + k : "costs." + k + "." + pk, p.second);
-      }
-    }
-  }
+  auto root = yaml::Load(yaml, src);
+  if (!root.ok()) return root.status();
+  yaml::MapReader r(*root, src);
+  Layout layout;
+  ReadLayout(r, params_, &layout);
+  if (!r.ok()) return r.status();
+  // Set one by one in the file's order, on a copy, so that an error changes nothing.
   PlannerConfig next = *this;
   next.source_ = src;
-  for (const auto& [key, node] : items) {
-    if (key == "refine.algorithm") {
-      if (!node.IsScalar()) return err("'refine.algorithm' must be a name");
-      next.refine_algorithm_ = node.Scalar();
-      continue;
-    }
-    if (next.Find(key) == nullptr) return err("unknown key '" + key + "'");
-    double v = 0;
-    try {
-      v = node.as<double>();
-    } catch (const YAML::Exception&) {
-      return err("'" + key + "' must be a number");
-    }
+  if (layout.refine_algorithm) next.refine_algorithm_ = *layout.refine_algorithm;
+  for (const auto& [key, v] : layout.values) {
     if (Status st = next.Set(key, v); !st.ok()) return st;
   }
   next.source_ = source_;

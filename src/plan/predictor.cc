@@ -8,10 +8,11 @@
 #include <memory>
 #include <utility>
 
+#include "frenetic/units.h"
+
 namespace frenetic::plan {
 namespace {
 
-constexpr double kMphPerMps = 2.2369362920544;
 // m: a reading this far from where the previous one predicted it is another car (a respawn
 // teleports an id, udacity-sim.md §8.2): its acceleration is not estimated.
 constexpr double kRespawnJump = 15.0;
@@ -24,7 +25,7 @@ constexpr double kFutureStep = 0.2;
 constexpr double kMaxCarAccel = 8.0;
 // The traffic's lane-change rule (udacity-sim.md §8.5): faster than 15 mph, and no car within
 // 20 m in s in the target lane.
-constexpr double kGhostMinSpeed = 15.0 / kMphPerMps;  // m/s
+constexpr double kGhostMinSpeed = 15.0 / units::kMpsToMph13;  // m/s
 constexpr double kGhostClear = 20.0;                   // m
 constexpr double kGhostLeaderReach = 40.0;  // m: a leader this close ahead is what it brakes for
 constexpr double kGhostOnset = 1.0;         // s: the rule holds this long before the car moves
@@ -200,8 +201,8 @@ class TrafficPredictor : public Predictor {
       if (IsSpawnGlitch(m, f.s, v, now)) {
         // The spawn glitch reports the speed in mph as if it were m/s for one message: undo
         // the unit slip.
-        v = std::min(v / kMphPerMps, options_.max_speed);
-        v_d /= kMphPerMps;
+        v = std::min(v / units::kMpsToMph13, options_.max_speed);
+        v_d /= units::kMpsToMph13;
       } else {
         car.a_s = Acceleration(m, f.s, v, now);
         Remember(m, row.id, f.s, v, now);

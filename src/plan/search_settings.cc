@@ -4,17 +4,17 @@
 #include <limits>
 
 #include "frenetic/cost/cost_term.h"
+#include "frenetic/units.h"
 
 namespace frenetic::plan::search {
 namespace {
 
-constexpr double kMphToMps = 0.44704;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
 Settings::Settings(const PlannerConfig& c) {
-  max_speed = c.value("limits.max_speed_mph") * kMphToMps;
+  max_speed = c.value("limits.max_speed_mph") * units::kMphToMps;
   max_accel = c.value("limits.max_accel");
   max_jerk = c.value("limits.max_jerk");
   d_min = c.value("limits.d_min");

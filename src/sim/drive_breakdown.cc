@@ -4,10 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "frenetic/units.h"
+
 namespace frenetic::sim {
 namespace {
 
-constexpr double kMpsToMph = 2.23693629;
 // m: a car that moves from ahead to behind (or back) by less than this in one tick was passed;
 // a larger jump is a respawn or the s wrap.
 constexpr double kPassReach = 50.0;
@@ -18,11 +19,11 @@ int LaneOfD(double d) { return d >= 0 && d < 12 ? static_cast<int>(d / 4.0) : -1
 }  // namespace
 
 double LapBreakdown::avg_speed_mph() const {
-  return seconds > 0 ? distance_m / seconds * kMpsToMph : 0;
+  return seconds > 0 ? distance_m / seconds * units::kSimMpsToMph : 0;
 }
 
 double LapBreakdown::at_limit_mph() const {
-  return at_limit_s > 0 ? at_limit_m / at_limit_s * kMpsToMph : 0;
+  return at_limit_s > 0 ? at_limit_m / at_limit_s * units::kSimMpsToMph : 0;
 }
 
 void LapBreakdown::Add(const LapBreakdown& o) {
@@ -68,7 +69,7 @@ void DriveBreakdown::Update(double dt, const EgoView& ego, int ego_lane, bool la
   b.distance_m = distance_m - lap * lap_length;
   if (lane_changed) ++b.lane_changes;
 
-  const bool at_limit = ego.speed * kMpsToMph >= opt_.at_limit_mph;
+  const bool at_limit = ego.speed * units::kSimMpsToMph >= opt_.at_limit_mph;
   if (at_limit) {
     b.at_limit_s += dt;
     b.at_limit_m += ego.speed * dt;

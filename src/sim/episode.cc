@@ -14,6 +14,7 @@
 #include "frenetic/net/protocol.h"
 #include "frenetic/sim/incident_recorder.h"
 #include "frenetic/sim/record.h"
+#include "frenetic/units.h"
 #include "frenetic/wire_precision.h"
 
 namespace frenetic::sim {
@@ -43,12 +44,12 @@ DriveReport MakeReport(const Episode& ep, std::string_view planner,
   r.distance_m = m.distance();
   r.sim_seconds = sim.time();
   r.exchanges = ep.exchanges();
-  r.avg_speed_mph = r.sim_seconds > 0 ? r.distance_m / r.sim_seconds * kMpsToMph : 0;
-  r.miles_to_first_incident = m.distance_to_first_incident() / kMetersPerMile;
+  r.avg_speed_mph = r.sim_seconds > 0 ? r.distance_m / r.sim_seconds * units::kSimMpsToMph : 0;
+  r.miles_to_first_incident = m.distance_to_first_incident() / units::kMetersPerMile;
   r.best_miles_without_incident = m.best_miles();
   r.incidents_by_kind = m.counts();
   r.incidents = m.total();
-  r.max_speed_mph = m.max_speed() * kMpsToMph;
+  r.max_speed_mph = m.max_speed() * units::kSimMpsToMph;
   r.max_acc = m.max_acc();
   r.max_jerk = m.max_abs_jerk();
   r.mean_squared_jerk = m.jerk_samples() > 0 ? m.sum_sq_jerk() / m.jerk_samples() : 0;
@@ -87,7 +88,8 @@ Episode::Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits)
       // A stream of its own, so the latency draws do not shift the traffic's random numbers.
       latency_rng_(sim_->seed() ^ 0x9E3779B97F4A7C15ULL) {
   if (limits_.laps > 0) target_distance_ = limits_.laps * sim_->world().track.max_s;
-  if (limits_.miles > 0) target_distance_ = std::min(target_distance_, limits_.miles * kMetersPerMile);
+  if (limits_.miles > 0)
+    target_distance_ = std::min(target_distance_, limits_.miles * units::kMetersPerMile);
   telemetry_.previous_path_x.reserve(256);
   telemetry_.previous_path_y.reserve(256);
   sim_->GetTelemetry(&telemetry_);
@@ -302,7 +304,7 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
       if (options.progress) {
         run.progress = [&, w, exchanges = 0](const Episode& ep) mutable {
           if (++exchanges % 256 != 0) return;
-          report_progress(w, ep.sim().monitor().distance() / kMetersPerMile, nullptr);
+          report_progress(w, ep.sim().monitor().distance() / units::kMetersPerMile, nullptr);
         };
       }
       results[i] = RunEpisode(world, scenario, first_seed + i, limits, **planner, run);

@@ -9,20 +9,18 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <sstream>
 
 #include "frenetic/net/protocol.h"
 #include "frenetic/sim/ego.h"
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 namespace {
 
 using nlohmann::json;
 
-constexpr double kMph = 2.23693629;  // the simulator's m/s -> mph factor
 constexpr std::size_t kMaxFailures = 5;
-constexpr double kRad = 180.0 / std::numbers::pi;
 // Slack on "digits" tolerances for the decimal -> double parse of the recorded text.
 constexpr double kDigitSlack = 1e-6;
 
@@ -286,8 +284,8 @@ CheckReport CheckProtocol(std::span<const Recording> recordings, plan::Planner& 
       cmp(t.d, m.d);
       cmp(t.end_path_s, m.end_path_s);
       cmp(t.end_path_d, m.end_path_d);
-      cmp(t.speed * kMph, m.speed_mph);
-      cmp(std::remainder(t.yaw * kRad - m.yaw_deg, 360.0), 0.0);
+      cmp(t.speed * units::kSimMpsToMph, m.speed_mph);
+      cmp(std::remainder(t.yaw * units::kRadToDeg - m.yaw_deg, 360.0), 0.0);
       bool same_shape = t.previous_path_x.size() == m.path_x.size() &&
                         t.previous_path_y.size() == m.path_y.size() &&
                         t.sensor_fusion.size() == m.sensor_fusion.size();
@@ -511,8 +509,8 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
       std::string path_why, pos_why, speed_why, yaw_why;
       for (long l_old = 0; l_old < c; ++l_old) {
         ++splits;
-        std::unique_ptr<EgoModel> ego = model(static_cast<float>(m.x), static_cast<float>(m.y),
-                                              m.yaw_deg / kRad);
+        std::unique_ptr<EgoModel> ego =
+            model(static_cast<float>(m.x), static_cast<float>(m.y), m.yaw_deg / units::kRadToDeg);
         ego->ApplyPath(m.path_x, m.path_y);
         for (long i = 0; i < l_old; ++i) ego->Tick();
         ego->ApplyPath(reply.x, reply.y);
@@ -549,7 +547,7 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
 
         if (!from_rest) {
           // Unity: the rigidbody's speed times the factor, in float.
-          const double mph = ego->speed() * static_cast<float>(kMph);
+          const double mph = ego->speed() * static_cast<float>(units::kSimMpsToMph);
           const double ws = DigitsOff(mph, n.speed_mph);
           speed.worst = std::max(speed.worst, ws);
           if (ws > 0.5 + kDigitSlack) ++speed_not_exact;
@@ -560,11 +558,13 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
           }
         }
         if (c >= 2) {
-          const double wy = std::abs(std::remainder(ego->yaw() * kRad - n.yaw_deg, 360.0));
+          const double wy =
+              std::abs(std::remainder(ego->yaw() * units::kRadToDeg - n.yaw_deg, 360.0));
           yaw.worst = std::max(yaw.worst, wy);
           if (!(wy <= yaw.tolerance)) {
-            if (yaw_ok) yaw_why = Fmt("l_old %ld: %.4f deg, recorded %.4f", l_old,
-                                      ego->yaw() * kRad, n.yaw_deg);
+            if (yaw_ok)
+              yaw_why = Fmt("l_old %ld: %.4f deg, recorded %.4f", l_old,
+                            ego->yaw() * units::kRadToDeg, n.yaw_deg);
             yaw_ok = false;
           }
         }

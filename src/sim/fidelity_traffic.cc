@@ -15,6 +15,7 @@
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/episode.h"
 #include "frenetic/sim/fidelity.h"
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 namespace {
@@ -190,7 +191,7 @@ EgoProfile RecordingEgoProfile(const Recording& recording) {
     time += samples[k].dt;
     if (k > 0 && !(time > p.t.back())) continue;  // keep t increasing
     p.t.push_back(time);
-    p.speed.push_back(recording.messages[k].speed_mph * 0.44704);
+    p.speed.push_back(recording.messages[k].speed_mph * units::kMphToMps);
     p.d.push_back(recording.messages[k].d);
   }
   return p;
@@ -284,7 +285,7 @@ std::vector<TrafficSample> RecordingTrafficSamples(const Recording& recording) {
     const RecordedMessage& m = recording.messages[k];
     TrafficSample& t = out[k];
     t.ego_s = m.s;
-    t.ego_speed = m.speed_mph * 0.44704;
+    t.ego_speed = m.speed_mph * units::kMphToMps;
     t.cars = m.sensor_fusion;
     if (k == 0) continue;
     // Points consumed since the previous message: the previous reply's length minus what is

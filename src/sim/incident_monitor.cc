@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "frenetic/units.h"
+
 namespace frenetic::sim {
 namespace {
 
 constexpr double kTick = 0.02;
-constexpr double kMph = 2.23693629;
 // The simulator's own miles conversion (§7.6).
 constexpr double kCounterMetersPerMile = 1609.34;
 
@@ -140,7 +141,7 @@ void IncidentMonitor::Update(const TickSample& sample, double t) {
     }
   }
 
-  const double mph = speed * kMph;
+  const double mph = speed * units::kSimMpsToMph;
   Raise(IncidentKind::kSpeed, mph > options_.speed_limit_mph, sample, t, mph);
   Raise(IncidentKind::kAcceleration, last_acc_ >= options_.acc_limit, sample, t, last_acc_);
   Raise(IncidentKind::kJerk, std::abs(last_jerk_) >= options_.jerk_limit, sample, t, last_jerk_);

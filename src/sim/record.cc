@@ -19,6 +19,7 @@
 #include <cstring>
 
 #include "frenetic/net/protocol.h"
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 namespace {
@@ -137,7 +138,7 @@ struct Metrics {
 Metrics MetricsOf(const Simulator& sim, int l_old, int l_new) {
   const IncidentMonitor& m = sim.monitor();
   const LeaderGap lead = sim.leader();
-  return {sim.ego().speed() * kMpsToMph,
+  return {sim.ego().speed() * units::kSimMpsToMph,
           m.last_acc(),
           m.last_acc_t(),
           m.last_acc_n(),

@@ -1,117 +1,15 @@
 #include "frenetic/sim/scenario.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <set>
 #include <sstream>
+
+#include "frenetic/yaml/strict_reader.h"
 
 namespace frenetic::sim {
 namespace {
-
-// Reads the keys of one YAML map, remembering which were asked for, so that the rest can be
-// reported as unknown. yaml-cpp throws on bad conversions; they are caught here, at the edge,
-// and turned into a message that names the file and the key.
-class MapReader {
- public:
-  MapReader(const YAML::Node& node, std::string prefix, std::string source, Status* status)
-      : node_(node), prefix_(std::move(prefix)), source_(std::move(source)), status_(status) {
-    if (node_ && !node_.IsNull() && !node_.IsMap()) {
-      Fail(prefix_.empty() ? "the document" : prefix_.substr(0, prefix_.size() - 1),
-           "must be a map");
-    }
-  }
-
-  template <typename T>
-  void Read(const char* key, T* out) {
-    known_.insert(key);
-    if (!status_->ok() || !node_ || !node_.IsMap()) return;
-    const YAML::Node v = node_[key];
-    if (!v) return;
-    try {
-      if (!v.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
-      *out = v.as<T>();
-      if constexpr (std::is_floating_point_v<T>) {
-        if (!std::isfinite(*out)) throw YAML::Exception(YAML::Mark(), "not finite");
-      }
-    } catch (const YAML::Exception&) {
-      Fail(prefix_ + key, std::string("is not a valid ") + TypeName<T>());
-    }
-  }
-
-  // A [lo, hi] pair of numbers.
-  void ReadRange(const char* key, double* lo, double* hi) {
-    known_.insert(key);
-    if (!status_->ok() || !node_ || !node_.IsMap()) return;
-    const YAML::Node v = node_[key];
-    if (!v) return;
-    try {
-      if (!v.IsSequence() || v.size() != 2) throw YAML::Exception(YAML::Mark(), "pair");
-      double a = v[0].as<double>(), b = v[1].as<double>();
-      if (!std::isfinite(a) || !std::isfinite(b)) throw YAML::Exception(YAML::Mark(), "finite");
-      *lo = a;
-      *hi = b;
-    } catch (const YAML::Exception&) {
-      Fail(prefix_ + key, "must be a pair of numbers [min, max]");
-    }
-  }
-  void ReadRange(const char* key, int* lo, int* hi) {
-    double a = *lo, b = *hi;
-    ReadRange(key, &a, &b);
-    if (status_->ok() && (a != std::floor(a) || b != std::floor(b))) {
-      Fail(prefix_ + key, "must be a pair of integers [min, max]");
-    }
-    *lo = static_cast<int>(a);
-    *hi = static_cast<int>(b);
-  }
-
-  MapReader Sub(const char* key) {
-    known_.insert(key);
-    YAML::Node child;
-    if (node_ && node_.IsMap()) child = node_[key];
-    return MapReader(child, prefix_ + key + ".", source_, status_);
-  }
-  void MarkKnown(const char* key) { known_.insert(key); }
-  bool Has(const char* key) const { return node_ && node_.IsMap() && node_[key]; }
-  const YAML::Node& node() const { return node_; }
-
-  // Reports the first key that was not asked for.
-  void Finish() {
-    if (!status_->ok() || !node_ || !node_.IsMap()) return;
-    for (const auto& kv : node_) {
-      std::string key;
-      try {
-        key = kv.first.as<std::string>();
-      } catch (const YAML::Exception&) {
-        key = "?";
-      }
-      if (!known_.count(key)) {
-        *status_ = Status::Error(source_ + ": unknown key '" + prefix_ + key + "'");
-        return;
-      }
-    }
-  }
-  void Fail(const std::string& key, const std::string& what) {
-    if (status_->ok()) *status_ = Status::Error(source_ + ": '" + key + "' " + what);
-  }
-
- private:
-  template <typename T>
-  static const char* TypeName() {
-    if constexpr (std::is_same_v<T, bool>) return "boolean";
-    if constexpr (std::is_integral_v<T>) return "integer";
-    if constexpr (std::is_floating_point_v<T>) return "number";
-    return "string";
-  }
-
-  YAML::Node node_;
-  std::string prefix_, source_;
-  Status* status_;
-  std::set<std::string> known_;
-};
 
 Status Check(bool ok, const std::string& what) {
   return ok ? Status::Ok() : Status::Error(what);
@@ -280,22 +178,16 @@ StatusOr<Scenario> LoadBase(const std::string& base, const std::string& source, 
 }
 
 StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, BaseChain* chain) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::Exception& e) {
-    return Status::Error(source + ": YAML error at line " + std::to_string(e.mark.line + 1) +
-                         ": " + e.msg);
-  }
+  auto root = yaml::Load(yaml_text, source);
+  if (!root.ok()) return root.status();
   Scenario sc;
-  Status st;
-  MapReader r(root, "", source, &st);
+  yaml::MapReader r(*root, source);
   // `base: NAME or FILE` loads that scenario first; this file's keys then override its values
   // (key by key, maps merged); name, description and source are this file's.
   if (r.Has("base")) {
     std::string base;
     r.Read("base", &base);
-    if (!st.ok()) return st;
+    if (!r.ok()) return r.status();
     chain->push_back(CanonicalPath(source));
     auto loaded = LoadBase(base, source, chain);
     chain->pop_back();
@@ -311,20 +203,19 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
   r.Read("seed", &sc.seed);
 
   {
-    MapReader car = r.Sub("car");
+    yaml::MapReader car = r.Sub("car");
     car.Read("length", &sc.car_length);
     car.Read("width", &sc.car_width);
     car.Finish();
   }
   if (r.Has("start")) {
-    const YAML::Node node = root["start"];
-    if (node.IsScalar()) {
-      r.MarkKnown("start");
-      std::string v = node.as<std::string>();
+    if (r.Child("start").IsScalar()) {
+      std::string v;
+      r.Read("start", &v);
       if (v != "auto") r.Fail("start", "must be 'auto' or a map with x, y or s, lane/d");
       sc.start = StartPose();
     } else {
-      MapReader start = r.Sub("start");
+      yaml::MapReader start = r.Sub("start");
       StartPose& p = sc.start;
       bool has_xy = start.Has("x") || start.Has("y");
       bool has_s = start.Has("s");
@@ -343,7 +234,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
       if (start.Has("lane")) {
         int lane = 1;
         start.Read("lane", &lane);
-        if (st.ok() && (lane < 0 || lane > 2)) start.Fail("start.lane", "must be 0, 1 or 2");
+        if (start.ok() && (lane < 0 || lane > 2)) start.Fail("start.lane", "must be 0, 1 or 2");
         if (start.Has("d")) start.Fail("start", "has both lane and d");
         p.d = 2 + 4 * lane;
       } else {
@@ -356,46 +247,46 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
     r.Sub("start");
   }
   {
-    MapReader t = r.Sub("timing");
+    yaml::MapReader t = r.Sub("timing");
     std::string mode = ToString(sc.timing.mode);
     t.Read("mode", &mode);
-    if (st.ok()) {
+    if (t.ok()) {
       auto m = ParseTimingMode(mode);
       if (!m.ok()) t.Fail("timing.mode", "'" + mode + "' is not lockstep, fixed or random");
       else sc.timing.mode = *m;
     }
     t.Read("l_old", &sc.timing.l_old);
     t.Read("l_new", &sc.timing.l_new);
-    t.ReadRange("l_old_range", &sc.timing.l_old_min, &sc.timing.l_old_max);
-    t.ReadRange("l_new_range", &sc.timing.l_new_min, &sc.timing.l_new_max);
+    t.ReadPair("l_old_range", &sc.timing.l_old_min, &sc.timing.l_old_max);
+    t.ReadPair("l_new_range", &sc.timing.l_new_min, &sc.timing.l_new_max);
     t.Finish();
   }
   {
     TrafficOptions& o = sc.traffic;
-    MapReader t = r.Sub("traffic");
+    yaml::MapReader t = r.Sub("traffic");
     t.Read("cars", &o.cars);
     t.Read("respawn_distance", &o.respawn_distance);
-    t.ReadRange("batch", &o.batch_min, &o.batch_max);
-    t.ReadRange("period_frames", &o.period_min_frames, &o.period_max_frames);
+    t.ReadPair("batch", &o.batch_min, &o.batch_max);
+    t.ReadPair("period_frames", &o.period_min_frames, &o.period_max_frames);
     t.Read("frame_rate", &o.frame_rate);
     t.Read("spawn_retries", &o.spawn_retries);
     t.Read("spawn_clearance", &o.spawn_clearance);
-    t.ReadRange("behind_offsets", &o.behind_offset_min, &o.behind_offset_max);
-    t.ReadRange("ahead_offsets", &o.ahead_offset_min, &o.ahead_offset_max);
-    t.ReadRange("behind_speed_mph", &o.behind_speed_min_mph, &o.behind_speed_max_mph);
-    t.ReadRange("ahead_speed_mph", &o.ahead_speed_min_mph, &o.ahead_speed_max_mph);
+    t.ReadPair("behind_offsets", &o.behind_offset_min, &o.behind_offset_max);
+    t.ReadPair("ahead_offsets", &o.ahead_offset_min, &o.ahead_offset_max);
+    t.ReadPair("behind_speed_mph", &o.behind_speed_min_mph, &o.behind_speed_max_mph);
+    t.ReadPair("ahead_speed_mph", &o.ahead_speed_min_mph, &o.ahead_speed_max_mph);
     t.Read("max_accel", &o.max_accel);
     t.Read("throttle_gain", &o.throttle_gain);
     t.Read("drag", &o.drag);
     t.Read("linear_drag", &o.linear_drag);
     t.Read("brake_decel", &o.brake_decel);
-    t.ReadRange("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
+    t.ReadPair("brake_gap", &o.brake_gap_min, &o.brake_gap_max);
     t.Read("brake_delay", &o.brake_delay);
     t.Read("brake_release_delay", &o.brake_release_delay);
     t.Read("brake_to_leader_mph", &o.brake_to_leader_mph);
     t.Read("follow_lateral", &o.follow_lateral);
-    t.ReadRange("wander", &o.wander_min, &o.wander_max);
-    t.ReadRange("wander_period", &o.wander_period_min, &o.wander_period_max);
+    t.ReadPair("wander", &o.wander_min, &o.wander_max);
+    t.ReadPair("wander_period", &o.wander_period_min, &o.wander_period_max);
     t.Read("throttle_wander", &o.throttle_wander);
     t.Read("lane_changes", &o.lane_changes);
     t.Read("lane_change_gap", &o.lane_change_gap);
@@ -410,15 +301,15 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
     t.Read("seam_glitch_window", &o.seam_glitch_window);
     t.Read("event_cooldown", &o.event_cooldown);
     {
-      MapReader c = t.Sub("cut_in");
+      yaml::MapReader c = t.Sub("cut_in");
       c.Read("rate", &o.cut_in_rate);
-      c.ReadRange("gap", &o.cut_in_min_gap, &o.cut_in_max_gap);
+      c.ReadPair("gap", &o.cut_in_min_gap, &o.cut_in_max_gap);
       c.Read("duration", &o.cut_in_duration);
       c.Read("max_closing", &o.cut_in_max_closing);
       c.Finish();
     }
     {
-      MapReader h = t.Sub("hard_brake");
+      yaml::MapReader h = t.Sub("hard_brake");
       h.Read("rate", &o.hard_brake_rate);
       h.Read("decel", &o.hard_brake_decel);
       h.Read("duration", &o.hard_brake_duration);
@@ -426,7 +317,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
       h.Finish();
     }
     {
-      MapReader b = t.Sub("blockade");
+      yaml::MapReader b = t.Sub("blockade");
       b.Read("enabled", &o.blockade);
       b.Read("distance", &o.blockade_distance);
       b.Read("speed", &o.blockade_speed);
@@ -437,7 +328,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
   }
   {
     IncidentOptions& o = sc.incidents;
-    MapReader i = r.Sub("incidents");
+    yaml::MapReader i = r.Sub("incidents");
     i.Read("speed_limit_mph", &o.speed_limit_mph);
     i.Read("acc_limit", &o.acc_limit);
     i.Read("jerk_limit", &o.jerk_limit);
@@ -447,7 +338,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
     i.Finish();
   }
   r.Finish();
-  if (!st.ok()) return st;
+  if (!r.ok()) return r.status();
   if (!r.Has("name")) sc.name = std::filesystem::path(source).stem().string();
   if (Status s = sc.Validate(); !s.ok()) return s;
   return sc;

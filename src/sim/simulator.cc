@@ -2,13 +2,13 @@
 
 #include <cmath>
 #include <limits>
-#include <numbers>
+
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDeg = std::numbers::pi / 180.0;
 // The real start pose (§4.3) and its s, used on other maps as the start s of the middle lane.
 constexpr double kUdacityStartX = 909.48, kUdacityStartY = 1128.67, kUdacityStartS = 124.8336;
 
@@ -46,7 +46,7 @@ StatusOr<std::unique_ptr<Simulator>> Simulator::Create(std::shared_ptr<const Wor
     case StartPose::Kind::kXY:
       x = p.x;
       y = p.y;
-      yaw = p.yaw_deg * kDeg;
+      yaw = p.yaw_deg * units::kDegToRad;
       break;
     case StartPose::Kind::kFrenet:
       on_line(p.s < 0 ? world->line->length() + p.s : p.s, p.d);
@@ -95,11 +95,11 @@ void Simulator::GetTelemetry(plan::Telemetry* out) const {
   out->x = ego_.x();
   out->y = ego_.y();
   // Degrees in [0, 360) as a float, as the simulator has them, then back to radians.
-  float deg = static_cast<float>(ego_.yaw() / kDeg);
+  float deg = static_cast<float>(ego_.yaw() / units::kDegToRad);
   deg = std::fmod(deg, 360.0f);
   if (deg < 0) deg += 360.0f;
   if (deg >= 360.0f) deg = 0;
-  out->yaw = deg * kDeg;
+  out->yaw = deg * units::kDegToRad;
   out->speed = ego_.speed();
   out->s = chord_s_;
   out->d = chord_d_;

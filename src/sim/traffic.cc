@@ -5,11 +5,12 @@
 #include <limits>
 #include <numbers>
 
+#include "frenetic/units.h"
+
 namespace frenetic::sim {
 namespace {
 
 constexpr double kDt = 0.02;
-constexpr double kMph = 2.23693629;
 constexpr double kLookahead = 150.0;  // m, how far a car looks for a leader
 constexpr std::size_t kMaxSamples = 2'000'000;
 
@@ -65,9 +66,9 @@ Traffic::Traffic(std::shared_ptr<const World> world, const TrafficOptions& optio
       c.spawned = true;
       c.lane = lane;
       c.s = world_->line->WrapS(ego.s + o_.blockade_distance);
-      c.top_speed = (o_.ahead_speed_max_mph - (o_.ahead_speed_max_mph - o_.ahead_speed_min_mph) *
-                                                  Uniform(0, 1)) /
-                    kMph;
+      c.top_speed = (o_.ahead_speed_max_mph -
+                     (o_.ahead_speed_max_mph - o_.ahead_speed_min_mph) * Uniform(0, 1)) /
+                    units::kSimMpsToMph;
       c.slow_left = o_.blockade_seconds;
       c.slow_speed = o_.blockade_speed;
       c.v = std::min(c.top_speed, c.slow_speed);
@@ -158,7 +159,7 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
     car.queued = false;
     car.lane = lane;
     car.s = s;
-    car.top_speed = top_mph / kMph;
+    car.top_speed = top_mph / units::kSimMpsToMph;
     car.v = car.top_speed;
     car.accel = 0;
     car.changing = false;
@@ -232,7 +233,7 @@ bool Traffic::LaneClear(const TrafficCar& car, int lane, const EgoView& ego) con
 }
 
 void Traffic::LaneChangeRule(TrafficCar& c, const EgoView& ego, std::int64_t tick) {
-  if (c.v * kMph <= o_.lane_change_min_mph) return;
+  if (c.v * units::kSimMpsToMph <= o_.lane_change_min_mph) return;
   if (tick - c.last_change_tick < o_.lane_change_spacing_ticks) return;
   const double length = world_->line->length();
   auto next = std::upper_bound(wp_s_sorted_.begin(), wp_s_sorted_.end(), c.s);
@@ -287,7 +288,8 @@ void Traffic::HarderEvents(const EgoView& ego, std::int64_t tick) {
     double best_gap = std::numeric_limits<double>::infinity();
     for (TrafficCar& c : cars_) {
       if (!c.spawned || c.changing || std::abs(c.lane - ego_lane) != 1) continue;
-      if (c.v * kMph <= o_.lane_change_min_mph || c.v < ego.speed - o_.cut_in_max_closing) {
+      if (c.v * units::kSimMpsToMph <= o_.lane_change_min_mph ||
+          c.v < ego.speed - o_.cut_in_max_closing) {
         continue;
       }
       const double gap = line.DiffS(c.s, ego.s) - car_length_;
@@ -334,7 +336,7 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
         leader_v = ego.speed;
       }
     }
-    const double top_mph = c.top_speed * kMph;
+    const double top_mph = c.top_speed * units::kSimMpsToMph;
     // The source's trigger distance mixes mph and m/s (§8.3); clamped to the observed 10-20 m.
     double h = std::clamp(10.0 * (top_mph - leader_v) / 20.0, o_.brake_gap_min, o_.brake_gap_max);
     // [GUESS] Unity's full brake plus handbrake stops in time behind a steady leader: never
@@ -364,17 +366,18 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
       a = -o_.hard_brake_decel;
     } else if (c.blocked && !o_.brake_to_leader_mph) {
       a = -o_.brake_decel;
-    } else if (c.blocked && c.v * kMph > c.leader_v) {
+    } else if (c.blocked && c.v * units::kSimMpsToMph > c.leader_v) {
       // §8.3: the desired speed is the leader's m/s number read as mph, with a brake gain of 1
       // per mph: full brake more than 1 mph above it (brake_decel is the recorded total).
-      a = -o_.brake_decel * std::min(c.v * kMph - c.leader_v, 1.0);
+      a = -o_.brake_decel * std::min(c.v * units::kSimMpsToMph - c.leader_v, 1.0);
     } else {
       const double wander =
           1.0 - o_.throttle_wander * (0.5 + 0.5 * std::sin(c.throttle_w * time_ + c.throttle_p));
       // Free: toward the top speed. Blocked below the wrong-unit target: gently up to it.
-      const double target_mph = c.blocked ? c.leader_v : desired * kMph;
+      const double target_mph = c.blocked ? c.leader_v : desired * units::kSimMpsToMph;
       const double throttle =
-          std::clamp(o_.throttle_gain * (target_mph - c.v * kMph), -1.0, 1.0) * wander;
+          std::clamp(o_.throttle_gain * (target_mph - c.v * units::kSimMpsToMph), -1.0, 1.0) *
+          wander;
       a = throttle >= 0 ? throttle * o_.max_accel : throttle * o_.brake_decel;
       a -= o_.drag * c.v * c.v + o_.linear_drag * c.v;
     }
@@ -450,7 +453,7 @@ void Traffic::FillSensorFusion(std::vector<plan::SensorCar>* rows) const {
       r.vx = r.vy = 0;
     } else if (c.spawn_quirk) {
       // §8.6: forward x top speed with the mph number taken as m/s.
-      const double f = c.top_speed * kMph;
+      const double f = c.top_speed * units::kSimMpsToMph;
       r.vx = static_cast<float>(std::cos(c.heading) * f);
       r.vy = static_cast<float>(std::sin(c.heading) * f);
     } else {

@@ -1,7 +1,5 @@
 #include "frenetic/tune/suite.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +8,7 @@
 #include <sstream>
 
 #include "frenetic/commonroad/setup.h"
+#include "frenetic/yaml/strict_reader.h"
 
 namespace frenetic::tune {
 namespace {
@@ -17,61 +16,6 @@ namespace {
 namespace fs = std::filesystem;
 
 double Clamp01(double x) { return std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0); }
-
-// Walks the YAML tree and records the first error with the file and the dotted key. yaml-cpp
-// throws on bad conversions; they are caught here, at the edge, and become a message.
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
-
-  bool ok() const { return status_.ok(); }
-  const Status& status() const { return status_; }
-  void Fail(const std::string& key, const std::string& what) {
-    if (status_.ok()) status_ = Status::Error(source_ + ": '" + key + "' " + what);
-  }
-
-  // Every key of `node` (a map) must be in `known`.
-  void CheckKeys(const YAML::Node& node, const std::string& prefix,
-                 std::initializer_list<const char*> known) {
-    if (!node.IsMap()) return Fail(prefix.empty() ? "<document>" : prefix, "must be a map");
-    for (const auto& kv : node) {
-      const std::string k = kv.first.Scalar();
-      if (std::none_of(known.begin(), known.end(), [&](const char* n) { return k == n; })) {
-        return Fail(prefix.empty() ? k : prefix + "." + k, "is an unknown key");
-      }
-    }
-  }
-
-  template <typename T>
-  void Scalar(const YAML::Node& node, const std::string& key, T* out) {
-    if (!ok() || !node) return;
-    try {
-      if (!node.IsScalar()) throw YAML::Exception(YAML::Mark(), "not a scalar");
-      *out = node.as<T>();
-      if constexpr (std::is_floating_point_v<T>) {
-        if (!std::isfinite(*out)) throw YAML::Exception(YAML::Mark(), "not finite");
-      }
-    } catch (const YAML::Exception&) {
-      Fail(key, "has a value of the wrong type");
-    }
-  }
-
-  template <typename T>
-  void List(const YAML::Node& node, const std::string& key, std::vector<T>* out) {
-    if (!ok() || !node) return;
-    if (!node.IsSequence()) return Fail(key, "must be a list");
-    out->clear();
-    for (std::size_t i = 0; i < node.size(); ++i) {
-      T v{};
-      Scalar(node[i], key + "[" + std::to_string(i) + "]", &v);
-      out->push_back(v);
-    }
-  }
-
- private:
-  std::string source_;
-  Status status_;
-};
 
 std::string Resolve(const std::string& path, const std::string& base_dir) {
   if (path.empty() || base_dir.empty() || fs::path(path).is_absolute()) return path;
@@ -114,15 +58,16 @@ bool IsOneOf(const std::string& key, std::initializer_list<const char*> keys) {
 }
 
 // A path or a list of paths, each resolved against base_dir.
-void PathList(Reader& r, const YAML::Node& node, const std::string& key,
-              const std::string& base_dir, std::vector<std::string>* out) {
-  if (!r.ok() || !node) return;
+void PathList(yaml::MapReader& r, const char* key, const std::string& base_dir,
+              std::vector<std::string>* out) {
+  const YAML::Node node = r.Child(key);
+  if (!r.ok() || !node.IsDefined()) return;
   if (node.IsScalar()) {
     std::string one;
-    r.Scalar(node, key, &one);
+    r.Read(key, &one);
     out->assign(1, one);
   } else if (node.IsSequence()) {
-    r.List(node, key, out);
+    r.ReadList(key, out);
   } else {
     return r.Fail(key, "must be a path or a list of paths");
   }
@@ -133,129 +78,107 @@ void PathList(Reader& r, const YAML::Node& node, const std::string& key,
 }
 
 // The keys both kinds of suite have: start_config, start_set, params, search.
-void ParseCommon(Reader& r, const YAML::Node& root, const std::string& base_dir, Suite* suite) {
-  r.Scalar(root["start_config"], "start_config", &suite->start_config);
+void ParseCommon(yaml::MapReader& r, const std::string& base_dir, Suite* suite) {
+  r.Read("start_config", &suite->start_config);
   suite->start_config = Resolve(suite->start_config, base_dir);
 
-  if (const YAML::Node set = root["start_set"]; set && r.ok()) {
-    if (!set.IsMap()) {
-      r.Fail("start_set", "must be a map of planner keys to values");
-    } else {
-      for (const auto& kv : set) {
-        const std::string key = kv.first.Scalar();
-        double v = 0;
-        r.Scalar(kv.second, "start_set." + key, &v);
-        suite->start_set.emplace_back(key, v);
-      }
-    }
+  yaml::MapReader set = r.Sub("start_set");  // planner keys to values
+  for (const std::string& key : set.Keys()) {
+    double v = 0;
+    if (set.Read(key, &v)) suite->start_set.emplace_back(key, v);
   }
 
-  if (const YAML::Node params = root["params"]; params && r.ok()) {
-    if (!params.IsMap()) {
-      r.Fail("params", "must be a map of planner keys to {lo, hi, scale}");
-    } else {
-      for (const auto& kv : params) {
-        TunedParam p;
-        p.key = kv.first.Scalar();
-        const std::string prefix = "params." + p.key;
-        r.CheckKeys(kv.second, prefix, {"lo", "hi", "scale"});
-        if (!r.ok()) break;
-        if (!kv.second["lo"] || !kv.second["hi"]) {
-          r.Fail(prefix, "needs lo and hi");
-          break;
-        }
-        r.Scalar(kv.second["lo"], prefix + ".lo", &p.lo);
-        r.Scalar(kv.second["hi"], prefix + ".hi", &p.hi);
-        std::string scale = "linear";
-        r.Scalar(kv.second["scale"], prefix + ".scale", &scale);
-        if (scale != "linear" && scale != "log") r.Fail(prefix + ".scale", "must be linear or log");
-        p.log_scale = scale == "log";
-        if (r.ok() && !(p.lo < p.hi)) r.Fail(prefix, "needs lo < hi");
-        if (r.ok() && p.log_scale && p.lo <= 0) r.Fail(prefix, "on a log scale needs lo > 0");
-        suite->params.push_back(p);
-      }
-    }
+  yaml::MapReader params = r.Sub("params");  // planner keys to {lo, hi, scale}
+  for (const std::string& key : params.Keys()) {
+    if (!r.ok()) break;
+    TunedParam p;
+    p.key = key;
+    yaml::MapReader one = params.Sub(key);
+    const bool bounded = one.Has("lo") && one.Has("hi");
+    one.Read("lo", &p.lo);
+    one.Read("hi", &p.hi);
+    std::string scale = "linear";
+    one.Read("scale", &scale);
+    one.Finish();
+    const std::string name = params.Name(key);
+    if (r.ok() && !bounded) r.Fail(name, "needs lo and hi");
+    if (r.ok() && scale != "linear" && scale != "log")
+      r.Fail(name + ".scale", "must be linear or log");
+    p.log_scale = scale == "log";
+    if (r.ok() && !(p.lo < p.hi)) r.Fail(name, "needs lo < hi");
+    if (r.ok() && p.log_scale && p.lo <= 0) r.Fail(name, "on a log scale needs lo > 0");
+    suite->params.push_back(p);
   }
 
-  if (const YAML::Node s = root["search"]; s && r.ok()) {
-    r.CheckKeys(s, "search",
-                {"global", "local", "budget", "global_fraction", "initial_step", "seed"});
-    SearchOptions& o = suite->search;
-    r.Scalar(s["global"], "search.global", &o.global_algorithm);
-    r.Scalar(s["local"], "search.local", &o.local_algorithm);
-    r.Scalar(s["budget"], "search.budget", &o.budget);
-    r.Scalar(s["global_fraction"], "search.global_fraction", &o.global_fraction);
-    r.Scalar(s["initial_step"], "search.initial_step", &o.initial_step);
-    r.Scalar(s["seed"], "search.seed", &o.seed);
-  }
+  yaml::MapReader s = r.Sub("search");
+  SearchOptions& o = suite->search;
+  s.Read("global", &o.global_algorithm);
+  s.Read("local", &o.local_algorithm);
+  s.Read("budget", &o.budget);
+  s.Read("global_fraction", &o.global_fraction);
+  s.Read("initial_step", &o.initial_step);
+  s.Read("seed", &o.seed);
+  s.Finish();
 }
 
-void ParseUdacity(Reader& r, const YAML::Node& root, const std::string& base_dir, Suite* suite) {
-  r.Scalar(root["map"], "map", &suite->map_path);
+void ParseUdacity(yaml::MapReader& r, const std::string& base_dir, Suite* suite) {
+  r.Read("map", &suite->map_path);
   suite->map_path = Resolve(suite->map_path, base_dir);
-  r.Scalar(root["planner"], "planner", &suite->planner);
-  r.List(root["scenarios"], "scenarios", &suite->scenarios);
+  r.Read("planner", &suite->planner);
+  r.ReadList("scenarios", &suite->scenarios);
   for (std::string& s : suite->scenarios) {
     if (!IsScenarioName(s)) s = Resolve(s, base_dir);
   }
-  r.List(root["train_seeds"], "train_seeds", &suite->train_seeds);
-  r.List(root["holdout_seeds"], "holdout_seeds", &suite->holdout_seeds);
-  r.Scalar(root["episode_seconds"], "episode_seconds", &suite->episode_seconds);
-  r.Scalar(root["deterministic"], "deterministic", &suite->deterministic);
-  r.Scalar(root["latency"], "latency", &suite->latency);
+  r.ReadList("train_seeds", &suite->train_seeds);
+  r.ReadList("holdout_seeds", &suite->holdout_seeds);
+  r.Read("episode_seconds", &suite->episode_seconds);
+  r.Read("deterministic", &suite->deterministic);
+  r.Read("latency", &suite->latency);
   if (r.ok() && !suite->latency.empty() && suite->latency != "lockstep" &&
       suite->latency != "fixed" && suite->latency != "random") {
     r.Fail("latency", "must be lockstep, fixed or random, not '" + suite->latency + "'");
   }
 
-  if (const YAML::Node obj = root["objective"]; obj && r.ok()) {
-    r.CheckKeys(obj, "objective",
-                {"incidents_per_mile", "speed", "speed_target_mph", "comfort", "headway",
-                 "headway_target_s"});
-    if (const YAML::Node inc = obj["incidents_per_mile"]; inc && r.ok()) {
-      r.CheckKeys(inc, "objective.incidents_per_mile",
-                  {"collision", "speed", "acceleration", "jerk", "lane", "off_road"});
-      for (int k = 0; k < sim::kIncidentKinds && r.ok(); ++k) {
-        const char* name = sim::ToString(static_cast<sim::IncidentKind>(k));
-        r.Scalar(inc[name], std::string("objective.incidents_per_mile.") + name,
-                 &suite->objective.incidents_per_mile[k]);
-      }
-    }
-    ObjectiveWeights& o = suite->objective;
-    r.Scalar(obj["speed"], "objective.speed", &o.speed);
-    r.Scalar(obj["speed_target_mph"], "objective.speed_target_mph", &o.speed_target_mph);
-    r.Scalar(obj["comfort"], "objective.comfort", &o.comfort);
-    r.Scalar(obj["headway"], "objective.headway", &o.headway);
-    r.Scalar(obj["headway_target_s"], "objective.headway_target_s", &o.headway_target_s);
-    if (r.ok()) {
-      bool negative = o.speed < 0 || o.comfort < 0 || o.headway < 0;
-      for (double w : o.incidents_per_mile) negative = negative || w < 0;
-      if (negative) r.Fail("objective", "weights must be >= 0");
-    }
+  ObjectiveWeights& o = suite->objective;
+  yaml::MapReader obj = r.Sub("objective");
+  yaml::MapReader inc = obj.Sub("incidents_per_mile");
+  for (int k = 0; k < sim::kIncidentKinds; ++k) {
+    inc.Read(sim::ToString(static_cast<sim::IncidentKind>(k)), &o.incidents_per_mile[k]);
+  }
+  inc.Finish();
+  obj.Read("speed", &o.speed);
+  obj.Read("speed_target_mph", &o.speed_target_mph);
+  obj.Read("comfort", &o.comfort);
+  obj.Read("headway", &o.headway);
+  obj.Read("headway_target_s", &o.headway_target_s);
+  obj.Finish();
+  if (r.ok()) {
+    bool negative = o.speed < 0 || o.comfort < 0 || o.headway < 0;
+    for (double w : o.incidents_per_mile) negative = negative || w < 0;
+    if (negative) r.Fail("objective", "weights must be >= 0");
   }
 }
 
-void ParseCommonRoad(Reader& r, const YAML::Node& root, const std::string& base_dir, Suite* suite) {
+void ParseCommonRoad(yaml::MapReader& r, const std::string& base_dir, Suite* suite) {
   CommonRoadSuite& c = suite->commonroad;
-  PathList(r, root["commonroad"], "commonroad", base_dir, &c.train);
-  PathList(r, root["holdout"], "holdout", base_dir, &c.holdout);
-  r.Scalar(root["prediction"], "prediction", &c.prediction);
+  PathList(r, "commonroad", base_dir, &c.train);
+  PathList(r, "holdout", base_dir, &c.holdout);
+  r.Read("prediction", &c.prediction);
   if (r.ok() && c.prediction != "recorded" && c.prediction != "constant-velocity") {
     r.Fail("prediction", "must be recorded or constant-velocity, not '" + c.prediction + "'");
   }
-  r.Scalar(root["vehicle"], "vehicle", &c.vehicle);
+  r.Read("vehicle", &c.vehicle);
   if (r.ok() && (c.vehicle < 1 || c.vehicle > 3)) r.Fail("vehicle", "must be 1, 2 or 3");
-  r.Scalar(root["commonroad_config"], "commonroad_config", &c.overlay);
+  r.Read("commonroad_config", &c.overlay);
   c.overlay = Resolve(c.overlay, base_dir);
-  if (const YAML::Node obj = root["objective"]; obj && r.ok()) {
-    r.CheckKeys(obj, "objective", {"cost", "cost_scale"});
-    r.Scalar(obj["cost"], "objective.cost", &c.cost_function);
-    if (r.ok() && c.cost_function != "WX1" && c.cost_function != "JB1") {
-      r.Fail("objective.cost", "must be WX1 or JB1, not '" + c.cost_function + "'");
-    }
-    r.Scalar(obj["cost_scale"], "objective.cost_scale", &c.cost_scale);
-    if (r.ok() && !(c.cost_scale > 0)) r.Fail("objective.cost_scale", "must be > 0");
+  yaml::MapReader obj = r.Sub("objective");
+  obj.Read("cost", &c.cost_function);
+  if (r.ok() && c.cost_function != "WX1" && c.cost_function != "JB1") {
+    r.Fail("objective.cost", "must be WX1 or JB1, not '" + c.cost_function + "'");
   }
+  obj.Read("cost_scale", &c.cost_scale);
+  if (r.ok() && !(c.cost_scale > 0)) r.Fail("objective.cost_scale", "must be > 0");
+  obj.Finish();
 }
 
 }  // namespace
@@ -264,38 +187,26 @@ StatusOr<Suite> ParseSuite(std::string_view yaml_text, std::string_view source,
                            const std::string& base_dir) {
   Suite suite;
   suite.source = std::string(source);
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml_text));
-  } catch (const YAML::Exception& e) {
-    return Status::Error(suite.source + ": YAML error at line " + std::to_string(e.mark.line + 1) +
-                         ": " + e.msg);
-  }
-  Reader r(suite.source);
-  r.CheckKeys(root, "",
-              {"map", "planner", "scenarios", "train_seeds", "holdout_seeds", "episode_seconds",
-               "start_config", "start_set", "params", "objective", "search", "deterministic",
-               "latency", "commonroad", "holdout", "prediction", "vehicle", "commonroad_config"});
-  if (!r.ok()) return r.status();
+  auto root = yaml::Load(yaml_text, suite.source);
+  if (!root.ok()) return root.status();
+  yaml::MapReader r(*root, suite.source);
   // The kind: a CommonRoad suite names its scenario files under `commonroad`; the other kind's
   // keys are errors, named with what they belong to.
-  suite.kind = root["commonroad"] ? SuiteKind::kCommonRoad : SuiteKind::kUdacity;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.Scalar();
+  suite.kind = r.Has("commonroad") ? SuiteKind::kCommonRoad : SuiteKind::kUdacity;
+  for (const std::string& key : r.Keys()) {
     if (suite.kind == SuiteKind::kCommonRoad && IsOneOf(key, kUdacityKeys)) {
       r.Fail(key, "does not apply to a CommonRoad suite (one with 'commonroad')");
     } else if (suite.kind == SuiteKind::kUdacity && IsOneOf(key, kCommonRoadKeys)) {
       r.Fail(key, "applies to a CommonRoad suite only (one with 'commonroad')");
     }
   }
-  if (!r.ok()) return r.status();
-
   if (suite.kind == SuiteKind::kCommonRoad) {
-    ParseCommonRoad(r, root, base_dir, &suite);
+    ParseCommonRoad(r, base_dir, &suite);
   } else {
-    ParseUdacity(r, root, base_dir, &suite);
+    ParseUdacity(r, base_dir, &suite);
   }
-  ParseCommon(r, root, base_dir, &suite);
+  ParseCommon(r, base_dir, &suite);
+  r.Finish();
   if (!r.ok()) return r.status();
 
   auto err = [&](const std::string& m) { return Status::Error(suite.source + ": " + m); };

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "frenetic/units.h"
 #include "net/net_test_util.h"
 
 namespace frenetic::net {
@@ -55,7 +56,7 @@ TEST(ProtocolTest, ConvertsMphAndDegreesToSi) {
   j["yaw"] = 90;
   const ParsedFrame p = ParseFrame(Frame(j));
   ASSERT_EQ(p.kind, FrameKind::kTelemetry) << p.error;
-  EXPECT_NEAR(p.telemetry.speed, 49.5 / 2.23693629, 1e-12);
+  EXPECT_NEAR(p.telemetry.speed, 49.5 / units::kSimMpsToMph, 1e-12);
   EXPECT_NEAR(p.telemetry.speed, 22.1284, 1e-4);
   EXPECT_NEAR(p.telemetry.yaw, std::numbers::pi / 2, 1e-12);
 }
@@ -70,7 +71,7 @@ TEST(ProtocolTest, FirstMessageFormatsBackToTheSameText) {
 TEST(ProtocolTest, FormatsNumbersLikeDotNetFloat) {
   plan::Telemetry t;
   t.x = 909.536123;            // float32 → 909.5361
-  t.y = 0.002 / 0.02 / 2.23693629 * 2.23693629;
+  t.y = 0.002 / 0.02 / units::kSimMpsToMph * units::kSimMpsToMph;
   t.speed = 0.002 / 0.02;      // 0.1 m/s = 0.2236936 mph
   t.yaw = -std::numbers::pi / 2;  // -90° is written as 270
   t.sensor_fusion.push_back({7, 1.0, 2.0, 0.0, 0.0, 1e-7, 12345678.0});
@@ -117,7 +118,7 @@ TEST(ProtocolTest, RealRecordingRoundTrips) {
     const json written = json::parse(TelemetryToJson(p.telemetry));
     ASSERT_EQ(written, original) << "line " << lines;
     // Speed and yaw went through SI and back.
-    EXPECT_NEAR(p.telemetry.speed * 2.23693629, original["speed"].get<double>(), 1e-9);
+    EXPECT_NEAR(p.telemetry.speed * units::kSimMpsToMph, original["speed"].get<double>(), 1e-9);
   }
   EXPECT_EQ(lines, 1549);
   EXPECT_GT(with_path, 1500);

@@ -21,6 +21,7 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
+#include "frenetic/units.h"
 #include "plan/search_planner.h"
 #include "plan/search_stages_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
@@ -30,8 +31,6 @@
 
 namespace frenetic::plan {
 namespace {
-
-constexpr double kMph = 0.44704;
 
 std::shared_ptr<const map::ReferenceLine> UdacityLine() { return search::testing::UdacityLine(); }
 
@@ -213,7 +212,8 @@ TEST(SearchPlannerTest, FromStandstillReaches48MphInUnder3SecondsWithinLimits) {
     loop.Cycle();
     ASSERT_FALSE(HasFatalFailure());
     ++cycles;
-    if (reached < 0 && loop.speed() >= 48 * kMph) reached = loop.driven_x_.size() * kTickSeconds;
+    if (reached < 0 && loop.speed() >= 48 * units::kMphToMps)
+      reached = loop.driven_x_.size() * kTickSeconds;
   }
   RecordProperty("seconds_to_48mph", std::to_string(reached));
   EXPECT_GT(reached, 0) << "never reached 48 mph in 15 s";
@@ -228,7 +228,7 @@ TEST(SearchPlannerTest, FromStandstillReaches48MphInUnder3SecondsWithinLimits) {
   y.insert(y.end(), loop.driven_y_.begin(), loop.driven_y_.end());
   for (int phase = 0; phase < kBlockTicks; ++phase) {
     const XyMeasure m = MeasureLikeSimulator(x, y, phase);
-    EXPECT_LT(m.max_speed, 50 * kMph) << "phase " << phase;
+    EXPECT_LT(m.max_speed, 50 * units::kMphToMps) << "phase " << phase;
     EXPECT_LE(m.max_accel, 9.0) << "phase " << phase;
     EXPECT_LE(m.max_jerk, 9.0) << "phase " << phase;
   }
@@ -253,7 +253,7 @@ TEST(SearchPlannerTest, ChangesLaneAroundASlowCarWhenTheNeighbourIsFree) {
   }
   EXPECT_LT(worst, 150);
   const XyMeasure m = WorstSlidingMeasure(loop, 60);
-  EXPECT_LT(m.max_speed, 50 * kMph);
+  EXPECT_LT(m.max_speed, 50 * units::kMphToMps);
   EXPECT_LT(m.max_accel, 10.0);
   EXPECT_LT(m.max_jerk, 10.0);
 }
@@ -303,11 +303,11 @@ TEST(SearchPlannerTest, SplicesSmoothlyAtSpeedOnTheWholeLoop) {
   Loop loop(line, planner.get(), line->length() - 400, 10.0 - 0.2, 21.0, 5);
   RunFor(loop, 40.0);
   const XyMeasure m = WorstSlidingMeasure(loop, 60);
-  EXPECT_LT(m.max_speed, 50 * kMph);
+  EXPECT_LT(m.max_speed, 50 * units::kMphToMps);
   EXPECT_LT(m.max_accel, 9.5);
   EXPECT_LT(m.max_jerk, 9.5);
   EXPECT_EQ(loop.fallbacks, 0);
-  EXPECT_GT(loop.speed(), 45 * kMph);
+  EXPECT_GT(loop.speed(), 45 * units::kMphToMps);
 }
 
 TEST(SearchPlannerTest, SummaryIsFilled) {
@@ -663,8 +663,8 @@ TEST(BaselinePlannerTest, DrivesAndOvertakesLikeTheWalkthrough) {
   auto planner = Make("baseline", line);
   Loop loop(line, planner.get(), 124.83, 6.0, 0.0, 9);
   RunFor(loop, 25.0);
-  EXPECT_GT(loop.speed(), 45 * kMph);
-  EXPECT_LT(WorstSlidingMeasure(loop, 0).max_speed, 50 * kMph);
+  EXPECT_GT(loop.speed(), 45 * units::kMphToMps);
+  EXPECT_LT(WorstSlidingMeasure(loop, 0).max_speed, 50 * units::kMphToMps);
   loop.cars.push_back({0, loop.s() + 40, 6.0, 12.0});
   RunFor(loop, 15.0);
   EXPECT_FALSE(loop.collided);

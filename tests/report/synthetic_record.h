@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "frenetic/units.h"
 namespace frenetic::report::testing {
 
 struct SyntheticOptions {
@@ -208,7 +209,8 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
     json exchange = {
         {"type", "exchange"}, {"i", k}, {"t", t},
         {"telemetry", {{"x", x}, {"y", y}, {"yaw", yaw * 180 / std::numbers::pi},
-                       {"speed", speed / 0.44704}, {"s", std::fmod(ego_s, max_s)}, {"d", ego_d},
+                       {"speed", speed / units::kMphToMps}, {"s", std::fmod(ego_s, max_s)},
+                       {"d", ego_d},
                        {"previous_path_x", json::array()}, {"previous_path_y", json::array()},
                        {"end_path_s", 0}, {"end_path_d", 0}, {"sensor_fusion", fusion}}},
         {"path", {{"x", path_x}, {"y", path_y}}},
@@ -219,7 +221,7 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
                   {"winner_total_cost", w.total}, {"winner_lane", w.lane},
                   {"refine_iterations", 10}, {"refine_cost_before", w.total},
                   {"refine_cost_after", w.total * 0.95}, {"candidates", candidates}}},
-        {"metrics", {{"speed_mph", speed / 0.44704}, {"acc", 1.0 + 0.5 * noise(rng)},
+        {"metrics", {{"speed_mph", speed / units::kMphToMps}, {"acc", 1.0 + 0.5 * noise(rng)},
                      {"jerk", 2.0 + noise(rng)}, {"lane", static_cast<int>(ego_d / 4)},
                      {"gap", gap > 0 ? json(gap) : json(nullptr)},
                      {"headway", gap > 0 ? json(gap / speed) : json(nullptr)}}},
@@ -230,9 +232,10 @@ inline std::string SyntheticRecord(const SyntheticOptions& options = {}) {
     const double distance = ego_s - 10;
     const double seconds = options.exchanges * kSyntheticDt;
     json footer = {{"type", "footer"},
-                   {"report", {{"distance_m", distance}, {"distance_miles", distance / 1609.344},
+                   {"report", {{"distance_m", distance},
+                               {"distance_miles", distance / units::kMetersPerMile},
                                {"sim_seconds", seconds},
-                               {"avg_speed_mph", distance / seconds / 0.44704},
+                               {"avg_speed_mph", distance / seconds / units::kMphToMps},
                                {"incidents", {{"collision", incidents_total}}},
                                {"incidents_total", incidents_total},
                                {"miles_to_first_incident", nullptr},

@@ -8,6 +8,7 @@
 #include "frenetic/sim/drive_report.h"
 #include "frenetic/sim/episode.h"
 #include "frenetic/sim/scenario.h"
+#include "frenetic/units.h"
 #include "sim/sim_test_util.h"
 
 namespace frenetic::sim {
@@ -61,10 +62,10 @@ TEST(DriveBreakdown, FreeRoadAtTheLimitIsNotFollowing) {
   const LapBreakdown t = d.b.Total();
   EXPECT_NEAR(t.seconds, 5.0, 1e-9);
   EXPECT_NEAR(t.at_limit_s, 5.0, 1e-9);
-  EXPECT_NEAR(t.at_limit_mph(), 22.0 * 2.23693629, 1e-6);
+  EXPECT_NEAR(t.at_limit_mph(), 22.0 * units::kSimMpsToMph, 1e-6);
   EXPECT_EQ(t.following_s, 0);
   EXPECT_EQ(t.missed_passes, 0);
-  EXPECT_NEAR(t.avg_speed_mph(), 22.0 * 2.23693629, 1e-6);
+  EXPECT_NEAR(t.avg_speed_mph(), 22.0 * units::kSimMpsToMph, 1e-6);
 }
 
 TEST(DriveBreakdown, FollowingWithOpenNeighbourLanesCountsMissedPassesOncePerSpell) {

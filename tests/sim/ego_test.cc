@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "frenetic/units.h"
 namespace frenetic::sim {
 namespace {
 
@@ -66,7 +67,7 @@ TEST(EgoCar, SpeedIsTheFloatDisplacementOverTheTick) {
   const std::vector<double> x = {909.482, 909.484}, y = {1128.67, 1128.67};
   ego.ApplyPath(x, y);
   ego.Tick();
-  EXPECT_NEAR(ego.speed() * 2.23693629, 0.2252774, 2e-7);
+  EXPECT_NEAR(ego.speed() * units::kSimMpsToMph, 0.2252774, 2e-7);
 }
 
 }  // namespace

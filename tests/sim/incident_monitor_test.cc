@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "frenetic/units.h"
 namespace frenetic::sim {
 namespace {
 
@@ -111,7 +112,7 @@ TEST(IncidentMonitor, SuddenCircleRaisesJerkGentleOneDoesNot) {
 }
 
 TEST(IncidentMonitor, SpeedOverFiftyMphOnASingleTick) {
-  const double mps = 1 / 2.23693629;
+  const double mps = 1 / units::kSimMpsToMph;
   Driver drv;
   drv.WarmUp(49 * mps);
   drv.Tick(50.1 * mps);
@@ -125,7 +126,7 @@ TEST(IncidentMonitor, SpeedOverFiftyMphOnASingleTick) {
 }
 
 TEST(IncidentMonitor, OnsetsCountOnceAndMergeWithinTheHold) {
-  const double mps = 1 / 2.23693629;
+  const double mps = 1 / units::kSimMpsToMph;
   Driver drv;
   drv.WarmUp(40 * mps);
   drv.Tick(51 * mps);

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "frenetic/units.h"
 #include "sim_test_util.h"
 
 namespace frenetic::sim {
 namespace {
 
-constexpr double kMph = 2.23693629;
 
 // A ghost ego that drives the middle lane at constant speed (traffic sees it, nothing hits it).
 struct Ghost {
@@ -40,8 +40,8 @@ TEST(Traffic, SpawnRulesPlaceCarsAheadAndBehindWithTheirSpeedRanges) {
     }
     for (const TrafficCar& c : traffic.cars()) {
       ASSERT_TRUE(c.spawned) << "seed " << seed << " car " << c.id;
-      EXPECT_GE(c.top_speed * kMph, 40 - 1e-9);
-      EXPECT_LE(c.top_speed * kMph, 60 + 1e-9);
+      EXPECT_GE(c.top_speed * units::kSimMpsToMph, 40 - 1e-9);
+      EXPECT_LE(c.top_speed * units::kSimMpsToMph, 60 + 1e-9);
       EXPECT_TRUE(c.lane >= 0 && c.lane <= 2);
     }
     const auto& offsets = traffic.stats().spawn_offsets;
@@ -79,8 +79,8 @@ TEST(Traffic, FirstSchedulerRunSpawnsOneToThreeAndRowsAreInIdOrder) {
       EXPECT_EQ(rows[i].id, i);
       if (traffic.cars()[i].spawned) {
         // The spawn-speed quirk: top speed in mph reported as m/s until the next tick.
-        EXPECT_NEAR(std::hypot(rows[i].vx, rows[i].vy), traffic.cars()[i].top_speed * kMph,
-                    1e-3);
+        EXPECT_NEAR(std::hypot(rows[i].vx, rows[i].vy),
+                    traffic.cars()[i].top_speed * units::kSimMpsToMph, 1e-3);
       }
     }
     traffic.Tick(ego.View(), 0);
@@ -147,7 +147,7 @@ struct CarBehindGhost {
     c.lane = 0;
     c.s = car_s;
     c.d = 2;
-    c.top_speed = top_mph / kMph;
+    c.top_speed = top_mph / units::kSimMpsToMph;
     c.v = car_v;
     traffic.Place(c);
   }
@@ -221,7 +221,7 @@ double LowestSpeedBehindSlowLeader(std::shared_ptr<const World> world, bool to_l
     c.wander_amp = 0;
     traffic.Place(c);
   };
-  put(0, 1000, 20, 50 / kMph);
+  put(0, 1000, 20, 50 / units::kSimMpsToMph);
   put(1, 1000 + 8 + 4.6, 13.1, 13.1);
   TrafficCar& leader = traffic.mutable_cars()[1];
   leader.slow_left = 1e9;  // held at 13.1 m/s
@@ -280,7 +280,7 @@ TEST(Traffic, TooCloseCarBrakesToItsLeadersSpeedReadAsMph) {
   // §8.3: the desired speed is the leader's 13.1 m/s taken as 13.1 mph = 5.86 m/s; the recorded
   // deep dips end there. It creeps up to it while still too close, so it never goes lower.
   const double quirk = LowestSpeedBehindSlowLeader(world, true);
-  EXPECT_NEAR(quirk, 13.1 / kMph, 0.5);
+  EXPECT_NEAR(quirk, 13.1 / units::kSimMpsToMph, 0.5);
   // Without the quirk it brakes for as long as the gap is short: well below that.
   EXPECT_LT(LowestSpeedBehindSlowLeader(world, false), quirk - 2.0);
 }
@@ -347,7 +347,7 @@ double CruiseFraction(std::shared_ptr<const World> world, double top_mph, double
   car.lane = 0;
   car.s = 600;
   car.d = 2;
-  car.top_speed = top_mph / kMph;
+  car.top_speed = top_mph / units::kSimMpsToMph;
   car.v = car.top_speed;
   traffic.Place(car);
   double sum = 0;

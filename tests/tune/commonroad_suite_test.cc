@@ -115,13 +115,15 @@ objective: {cost: JB1, cost_scale: 5}
   EXPECT_EQ(plain->commonroad.cost_function, "WX1");
 }
 
-TEST_F(CommonRoadSuiteTest, BundledExampleSuiteParses) {
-  auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR) + "/config/tune/commonroad.yaml");
-  ASSERT_TRUE(suite.ok()) << suite.message();
-  EXPECT_EQ(suite->kind, SuiteKind::kCommonRoad);
-  ASSERT_FALSE(suite->commonroad.train.empty());
-  auto config = LoadStartConfig(*suite);
-  ASSERT_TRUE(config.ok()) << config.message();
+TEST_F(CommonRoadSuiteTest, BundledExampleSuitesParse) {
+  for (const char* name : {"commonroad", "commonroad-families"}) {
+    auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR) + "/config/tune/" + name + ".yaml");
+    ASSERT_TRUE(suite.ok()) << suite.message();
+    EXPECT_EQ(suite->kind, SuiteKind::kCommonRoad);
+    ASSERT_FALSE(suite->commonroad.train.empty());
+    auto config = LoadStartConfig(*suite);
+    ASSERT_TRUE(config.ok()) << config.message();
+  }
 }
 
 // The start configuration is the command's: planner.yaml with commonroad.yaml on top.
@@ -169,13 +171,13 @@ INSTANTIATE_TEST_SUITE_P(
                 "params: {weights.goal: {lo: 1, hi: 5}}\n",
                 "'holdout' applies to a CommonRoad suite only"},
         BadCase{"commonroad: d\nholdot: e\nparams: {weights.goal: {lo: 1, hi: 5}}\n",
-                "'holdot' is an unknown key"},
+                "unknown key 'holdot'"},
         BadCase{"commonroad: d\nprediction: psychic\nparams: {weights.goal: {lo: 1, hi: 5}}\n",
                 "'prediction' must be recorded or constant-velocity, not 'psychic'"},
         BadCase{"commonroad: d\nvehicle: 4\nparams: {weights.goal: {lo: 1, hi: 5}}\n", "'vehicle'"},
         BadCase{"commonroad: {a: b}\nparams: {weights.goal: {lo: 1, hi: 5}}\n", "'commonroad'"},
         BadCase{"commonroad: d\nobjective: {speed: 1}\nparams: {weights.goal: {lo: 1, hi: 5}}\n",
-                "'objective.speed' is an unknown key"},
+                "unknown key 'objective.speed'"},
         BadCase{"commonroad: d\nobjective: {cost: SM1}\nparams: {weights.goal: {lo: 1, hi: 5}}\n",
                 "'objective.cost' must be WX1 or JB1"},
         BadCase{

@@ -15,9 +15,6 @@
 
 namespace frenetic::net {
 
-// The simulator reports speed as |v| (m/s) times this factor (§3.3).
-inline constexpr double kMpsToMph = wire::kMpsToMph;
-
 enum class FrameKind {
   kTelemetry,      // 42["telemetry",{...}] with a usable payload
   kNullTelemetry,  // 42["telemetry",null]: answer manual

@@ -13,6 +13,7 @@
 #include "frenetic/sim/incident_judge.h"
 #include "frenetic/sim/incident_monitor.h"
 #include "frenetic/sim/oracle.h"
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 
@@ -49,7 +50,7 @@ struct DriveReport {
   LapBreakdown breakdown;
   std::vector<LapBreakdown> laps;
 
-  double miles() const { return distance_m / 1609.344; }
+  double miles() const { return distance_m / units::kMetersPerMile; }
   // Incidents per mile of `kind` (0 for a drive of no distance).
   double per_mile(IncidentKind kind) const;
   nlohmann::json ToJson() const;  // infinite values become null

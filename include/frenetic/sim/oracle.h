@@ -28,6 +28,7 @@
 
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
+#include "frenetic/units.h"
 
 namespace frenetic::sim {
 
@@ -103,8 +104,8 @@ struct OracleResult {
   double distance_m = 0;  // the best distance along the road in that time
   double driven_m = 0;    // the ego's own in the same time, as the trace has it
   std::vector<OracleWindow> windows;
-  double mph() const { return seconds > 0 ? distance_m / seconds * 2.2369362920544 : 0; }
-  double driven_mph() const { return seconds > 0 ? driven_m / seconds * 2.2369362920544 : 0; }
+  double mph() const { return seconds > 0 ? distance_m / seconds * units::kMpsToMph13 : 0; }
+  double driven_mph() const { return seconds > 0 ? driven_m / seconds * units::kMpsToMph13 : 0; }
 };
 
 // The search; an empty or one-row trace gives a zero result.

@@ -19,8 +19,6 @@
 namespace frenetic::sim {
 
 inline constexpr double kTick = 0.02;          // s, the physics step
-inline constexpr double kMetersPerMile = 1609.344;
-inline constexpr double kMpsToMph = 2.23693629;
 
 // The car ahead of the ego in its lane (smooth-line lanes), if any within 200 m.
 struct LeaderGap {
