@@ -161,8 +161,8 @@ std::string Server::Impl::StatusLine() {
   std::string ego = "no telemetry yet";
   if (iv.have_ego) {
     const int lane = iv.d >= 0 && iv.d < 12 ? static_cast<int>(iv.d / 4.0) : -1;
-    ego = fmt::format("speed {:.1f} m/s ({:.1f} mph), lane {}", iv.speed, iv.speed * kMpsToMph,
-                      lane);
+    ego = fmt::format("speed {:.1f} m/s ({:.1f} mph), lane {}", iv.speed,
+                      iv.speed * wire::kMpsToMph, lane);
   }
   const ServerStats& s = stats;
   std::string line = fmt::format(

@@ -18,7 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::sim {
 namespace {
@@ -197,7 +197,7 @@ void FormatExchange(int index, double t, const std::string& telemetry_json,
                          {"plan", plan},
                          {"metrics", metrics},
                          {"incidents", incidents}};
-  // The telemetry is spliced in as the simulator's own text (net::TelemetryToJson).
+  // The telemetry is spliced in as the simulator's own text (wire::TelemetryToJson).
   *line += "{\"type\":\"exchange\",\"i\":";
   *line += std::to_string(index);
   *line += ",\"t\":";
@@ -464,13 +464,13 @@ bool RecordWriter::Replay(int index, const std::string& telemetry_json,
                           std::vector<plan::CandidateTrace>* candidates) {
   // The telemetry as the planner received it: what ParseFrame makes of the text sent
   // (wire::TelemetryAsReceived), whatever its size.
-  net::FrameLimits unlimited;
+  wire::FrameLimits unlimited;
   unlimited.max_sensor_rows = 100000;
   unlimited.max_path_points = 1000000;
-  const net::ParsedFrame frame =
-      net::ParseFrame("42[\"telemetry\"," + telemetry_json + "]", unlimited);
+  const wire::ParsedFrame frame =
+      wire::ParseFrame("42[\"telemetry\"," + telemetry_json + "]", unlimited);
   const plan::PlanResult* r = nullptr;
-  if (frame.kind == net::FrameKind::kTelemetry) {
+  if (frame.kind == wire::FrameKind::kTelemetry) {
     replica_trace_.candidates.clear();
     r = &replica_->Plan(frame.telemetry);
   }

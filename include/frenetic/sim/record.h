@@ -65,7 +65,7 @@ class RecordWriter {
                    const nlohmann::json& config, std::string_view connect_url = {});
   // One exchange: the telemetry sent, the reply and how it was made, the metrics after it and
   // the incidents that started since the previous exchange (log indices [first, end)).
-  // `telemetry_json` is net::TelemetryToJson of the telemetry sent at simulated time t;
+  // `telemetry_json` is wire::TelemetryToJson of the telemetry sent at simulated time t;
   // l_old / l_new are the ticks run before and after the path was applied.
   void WriteExchange(int index, double t, const std::string& telemetry_json,
                      const plan::PlanResult& result, const plan::CycleTrace* trace,

@@ -1,4 +1,4 @@
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "net/net_test_util.h"
+#include "wire/frames.h"
 
-namespace frenetic::net {
+namespace frenetic::wire {
 namespace {
 
 using nlohmann::json;
@@ -470,4 +470,4 @@ TEST(ProtocolTest, ParseReplyReadsControlAndRejectsWhatTheSimulatorCannotUse) {
 }
 
 }  // namespace
-}  // namespace frenetic::net
+}  // namespace frenetic::wire
