@@ -24,10 +24,10 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/road.h"
 #include "frenetic/map/track.h"
-#include "frenetic/net/protocol.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/status.h"
+#include "frenetic/wire/protocol.h"
 #include "../tests/common/malloc_counter.h"
 
 namespace frenetic::bench {
@@ -84,8 +84,8 @@ inline StatusOr<Scene> LoadScene(const std::string& path) {
         return Status::Error(where + "exchange needs \"t\" and a \"telemetry\" object");
       }
       std::string frame = "42[\"telemetry\"," + j["telemetry"].dump() + "]";
-      net::ParsedFrame parsed = net::ParseFrame(frame);
-      if (parsed.kind != net::FrameKind::kTelemetry) {
+      wire::ParsedFrame parsed = wire::ParseFrame(frame);
+      if (parsed.kind != wire::FrameKind::kTelemetry) {
         return Status::Error(where + "telemetry: " + parsed.error);
       }
       scene.t.push_back(j["t"].get<double>());
@@ -188,7 +188,7 @@ inline Scene WithVehicles(const Scene& in, int vehicles, const map::ReferenceLin
       rows.push_back({static_cast<int>(1000 + j), p.x, p.y, cars[j].v * std::cos(p.heading),
                       cars[j].v * std::sin(p.heading), line.WrapS(s), cars[j].d});
     }
-    out.wire[m] = net::FormatTelemetryFrame(out.messages[m]);
+    out.wire[m] = wire::FormatTelemetryFrame(out.messages[m]);
   }
   return out;
 }

@@ -18,12 +18,12 @@
 #include "frenetic/cost/cost_set.h"
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
-#include "frenetic/net/protocol.h"
 #include "frenetic/plan/feasibility.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/traj/box.h"
 #include "frenetic/traj/frenet.h"
 #include "frenetic/traj/polynomial.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::bench {
 namespace {
@@ -491,7 +491,7 @@ BENCHMARK(BM_NloptRefine)->Unit(benchmark::kMicrosecond);
 void BM_ParseTelemetry(benchmark::State& state, const Scene* scene) {
   const std::string& frame = scene->wire.back();
   for (auto _ : state) {
-    net::ParsedFrame p = net::ParseFrame(frame);
+    wire::ParsedFrame p = wire::ParseFrame(frame);
     benchmark::DoNotOptimize(p.telemetry.x);
   }
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(frame.size()));
@@ -511,7 +511,7 @@ void BM_FormatControl(benchmark::State& state) {
   std::string out;
   out.reserve(8192);
   for (auto _ : state) {
-    benchmark::DoNotOptimize(net::FormatControl(x, y, &out));
+    benchmark::DoNotOptimize(wire::FormatControl(x, y, &out));
   }
   state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(out.size()));
 }

@@ -29,15 +29,15 @@
 #include <thread>
 #include <vector>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 #include "net/raw_websocket.h"
 
 namespace {
 
-using frenetic::net::ParsedReply;
-using frenetic::net::ParseReply;
-using frenetic::net::ReplyKind;
+using frenetic::wire::ParsedReply;
+using frenetic::wire::ParseReply;
+using frenetic::wire::ReplyKind;
 namespace t = frenetic::net::testing;
 using Clock = std::chrono::steady_clock;
 

@@ -17,6 +17,7 @@
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/record/plan_json.h"
 #include "frenetic/sim/episode.h"
 #include "frenetic/sim/record.h"
 #include "frenetic/sim/scenario.h"
@@ -206,7 +207,7 @@ int Drive(const DriveArgs& a) {
     std::ifstream in(config_path);
     std::stringstream text;
     text << in.rdbuf();
-    options.planner_config = sim::YamlToJson(text.str());
+    options.planner_config = record::YamlToJson(text.str());
   }
   if (a.progress || tty) {
     options.progress = [](const sim::Episode& ep) {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "frenetic/record/reader.h"
 #include "frenetic/report/page.h"
-#include "frenetic/report/record.h"
 
 namespace frenetic::apps {
 namespace {
@@ -18,7 +18,7 @@ namespace {
 struct ReportArgs {
   std::string run;
   std::string output;
-  report::ReadOptions read;
+  record::ReadOptions read;
   bool json = false;
 };
 
@@ -33,7 +33,7 @@ std::string DefaultOutput(std::string run) {
 
 // A CommonRoad run's verdict (its footer's, commonroad/record.h) as "; solved, goal at step 78"
 // or "; NOT solved: goal at step 50"; empty for a drive.
-std::string Verdict(const report::RunData& run) {
+std::string Verdict(const record::RunData& run) {
   if (run.header.world != "commonroad" || !run.has_footer) return "";
   const nlohmann::json f = nlohmann::json::parse(run.footer_json, nullptr, false);
   if (!f.is_object() || !f.contains("solved") || !f["solved"].is_boolean()) return "";
@@ -54,7 +54,7 @@ std::string Verdict(const report::RunData& run) {
 }
 
 int RunReport(const ReportArgs& args) {
-  auto run = report::ReadRecordFile(args.run, args.read);
+  auto run = record::ReadRecordFile(args.run, args.read);
   if (!run.ok()) {
     std::fprintf(stderr, "frenetic report: %s\n", run.message().c_str());
     return 1;

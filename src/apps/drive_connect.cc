@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "frenetic/net/client.h"
-#include "frenetic/net/protocol.h"
 #include "frenetic/sim/simulator.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::apps {
 namespace {
@@ -59,10 +59,10 @@ class EpisodeEndpoint final : public net::SimulatorEndpoint {
     std::string frame;
     if (record_ != nullptr) {
       // The record keeps the telemetry as the text sent, as an in-process record does.
-      telemetry_json_ = net::TelemetryToJson(episode_->telemetry());
+      telemetry_json_ = wire::TelemetryToJson(episode_->telemetry());
       frame = "42[\"telemetry\"," + telemetry_json_ + "]";
     } else {
-      frame = net::FormatTelemetryFrame(episode_->telemetry());
+      frame = wire::FormatTelemetryFrame(episode_->telemetry());
     }
     sent_at_ = std::chrono::steady_clock::now();
     return frame;

@@ -12,18 +12,22 @@
 #include <utility>
 
 #include "frenetic/commonroad/vehicle_params.h"
-#include "frenetic/sim/record.h"
+#include "frenetic/record/plan_json.h"
+#include "frenetic/record/replica.h"
+#include "frenetic/record/schema.h"
+#include "frenetic/record/writer.h"
 #include "frenetic/units.h"
 
 namespace frenetic::commonroad {
 namespace {
 
 using nlohmann::json;
+namespace key = record::key;
 
 constexpr double kBorderStep = 2.0;  // m between the points of a lane border
 constexpr int kCirclePoints = 24;    // a goal circle's outline
 // The planning thread waits for the queued lines to be written every this many cycles (fewer
-// than sim::RecordWriter's batch, which wakes its thread): the writer's thread, and the replica
+// than record::Writer's batch, which wakes its thread): the writer's thread, and the replica
 // planning on it, then works only while the planner waits between cycles, never beside it, so
 // the planning times measured stay those of a run without a record.
 constexpr int kDrainLines = 32;
@@ -105,18 +109,6 @@ json GoalsJson(const Scenario& sc, const PlanningProblem& problem) {
   return goals;
 }
 
-}  // namespace
-
-// The planner that traces the candidates: a replica of the one that drives, planning every cycle
-// again on the writer's thread (as sim::RecordWriter::TraceByReplay does for a drive), so the
-// planner that drives is not slowed by tracing. Used on the writer's thread only.
-struct RunRecorder::Replica {
-  std::unique_ptr<plan::Planner> planner;  // null once it planned otherwise (or never built)
-  plan::CycleTrace trace;
-};
-
-namespace {
-
 // An obstacle row of the telemetry, with what the drawing needs beyond the planner's row.
 struct CarRow {
   plan::SensorCar car;
@@ -169,47 +161,44 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
     index_ = 0;
     path_ =
         (std::filesystem::path(dir_) / RecordFileName(scenario_.benchmark_id, problem_)).string();
-    auto writer = sim::RecordWriter::Open(path_);
+    auto writer = record::Writer::Open(path_);
     if (!writer.ok()) {
       failed_ = true;
       if (status_.ok()) status_ = writer.status();
       return;
     }
     writer_ = std::move(writer).value();
-    writer_->set_timing(timing_);
     const VehicleParams vp = VehicleParamsForType(vehicle_type_).ok()
                                  ? *VehicleParamsForType(vehicle_type_)
                                  : VehicleParams();
-    json h = {{"type", "header"},
-              {"version", 1},
-              {"world", "commonroad"},
-              {"map", scenario_.source},
-              {"scenario", scenario_.benchmark_id},
-              {"problem", problem_},
-              {"dt", scenario_.dt},
-              {"seed", 0},
-              {"planner", "search"},
-              {"config", sim::YamlToJson(in.config.ToYaml())},
-              {"prediction", ToString(prediction_)},
-              {"vehicle", "KS" + std::to_string(vehicle_type_)},
-              {"timing", timing_ ? "wall" : "off"},
-              {"lanes", road.num_lanes()},
-              {"lane_width", Round(road.lane_width(), 3)},
-              {"max_s", Round(road.line().length(), 3)},
-              {"car_length", vp.length},
-              {"car_width", vp.width},
-              {"road", RoadJson(road)},
-              {"goals", GoalsJson(scenario_, in.problem)}};
-    writer_->WriteLine([text = h.dump()](std::string* line) { *line += text; });
-    replica_ = std::make_shared<Replica>();
+    json h = {{key::kType, key::kHeader},
+              {key::kVersion, record::kVersion},
+              {key::kWorld, key::kCommonRoad},
+              {key::kMap, scenario_.source},
+              {key::kScenario, scenario_.benchmark_id},
+              {key::kProblem, problem_},
+              {key::kDt, scenario_.dt},
+              {key::kSeed, 0},
+              {key::kPlanner, "search"},
+              {key::kConfig, record::YamlToJson(in.config.ToYaml())},
+              {key::kPrediction, ToString(prediction_)},
+              {key::kVehicle, "KS" + std::to_string(vehicle_type_)},
+              {key::kTiming, timing_ ? "wall" : "off"},
+              {key::kLanes, road.num_lanes()},
+              {key::kLaneWidth, Round(road.lane_width(), 3)},
+              {key::kMaxS, Round(road.line().length(), 3)},
+              {key::kCarLength, vp.length},
+              {key::kCarWidth, vp.width},
+              {key::kRoad, RoadJson(road)},
+              {key::kGoals, GoalsJson(scenario_, in.problem)}};
+    writer_->WriteText(h.dump());
     auto planner = plan::MakePlanner("search", in.config, in.road);
-    if (planner.ok()) {
-      replica_->planner = std::move(planner).value();
-      replica_->planner->set_trace(&replica_->trace, kRecordCandidates);
-    } else {
+    if (!planner.ok()) {
       spdlog::warn("record {}: no planner to trace the candidates ({}); they are left out", path_,
                    planner.message());
     }
+    replica_ = std::make_shared<record::Replica>(
+        planner.ok() ? std::move(planner).value() : nullptr, kRecordCandidates, path_);
   }
   // Copies for the writer's thread.
   const plan::Telemetry& t = in.telemetry;
@@ -224,36 +213,14 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
     cars.push_back(row);
   }
   const double scale = timing_ ? 1.0 : 0.0;
-  writer_->WriteLine([i = index_++, step = in.step, seconds = in.step * scenario_.dt, x = t.x,
-                      y = t.y, yaw = t.yaw, speed = t.speed, s = t.s, d = t.d,
-                      lane = road.LaneOf(t.s, t.d), cars = std::move(cars), path_x = result.x,
-                      path_y = result.y, status = result.status, summary = result.summary, scale,
-                      candidates = std::vector<plan::CandidateTrace>(), telemetry = t,
-                      replica = replica_, path = path_](std::string* line) mutable {
+  writer_->Write([i = index_++, step = in.step, seconds = in.step * scenario_.dt, x = t.x, y = t.y,
+                  yaw = t.yaw, speed = t.speed, s = t.s, d = t.d, lane = road.LaneOf(t.s, t.d),
+                  cars = std::move(cars), path_x = result.x, path_y = result.y,
+                  status = result.status, summary = result.summary, scale,
+                  candidates = std::vector<plan::CandidateTrace>(), telemetry = t,
+                  replica = replica_](std::string* line) mutable {
     // The candidates, traced by the replica; its counts with the driving planner's times.
-    if (replica->planner) {
-      replica->trace.candidates.clear();
-      const plan::PlanResult& r = replica->planner->Plan(telemetry);
-      if (r.x == path_x && r.y == path_y) {
-        plan::PlanSummary traced = r.summary;
-        traced.ms_prepare = summary.ms_prepare;
-        traced.ms_generate = summary.ms_generate;
-        traced.ms_score = summary.ms_score;
-        traced.ms_check = summary.ms_check;
-        traced.ms_refine = summary.ms_refine;
-        traced.ms_output = summary.ms_output;
-        traced.ms_total = summary.ms_total;
-        traced.deadline_stage = summary.deadline_stage;
-        summary = std::move(traced);
-        candidates.swap(replica->trace.candidates);
-      } else {
-        spdlog::warn(
-            "record {}: the replica that traces the candidates planned cycle {} otherwise "
-            "than the planner that drove; candidates are left out from there on",
-            path, i);
-        replica->planner.reset();
-      }
-    }
+    replica->Trace(&telemetry, path_x, path_y, i, &summary, &candidates);
     json rows = json::array();
     for (const CarRow& r : cars) {
       const plan::SensorCar& c = r.car;
@@ -264,23 +231,23 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
     json px = json::array(), py = json::array();
     for (double v : path_x) px.push_back(Round(v, 3));
     for (double v : path_y) py.push_back(Round(v, 3));
-    const json e = {{"type", "exchange"},
-                    {"i", i},
-                    {"t", Round(seconds, 6)},
-                    {"step", step},
-                    {"telemetry",
-                     {{"x", Round(x, 4)},
-                      {"y", Round(y, 4)},
-                      {"yaw", Round(yaw * units::kRadToDeg, 4)},
-                      {"speed", Round(speed * units::kMpsToMph, 4)},
-                      {"s", Round(s, 4)},
-                      {"d", Round(d, 4)},
-                      {"sensor_fusion", std::move(rows)}}},
-                    {"path", {{"x", std::move(px)}, {"y", std::move(py)}}},
-                    {"plan", sim::PlanJson(status, summary, summary.ms_total, scale, candidates)},
-                    {"metrics",
-                     {{"speed_mph", Round(speed * units::kMpsToMph, 4)}, {"lane", lane}}},
-                    {"incidents", json::array()}};
+    const json e = {
+        {key::kType, key::kExchange},
+        {key::kCycle, i},
+        {key::kTime, Round(seconds, 6)},
+        {key::kStep, step},
+        {key::kTelemetry,
+         {{"x", Round(x, 4)},
+          {"y", Round(y, 4)},
+          {"yaw", Round(yaw * units::kRadToDeg, 4)},
+          {"speed", Round(speed * units::kMpsToMph, 4)},
+          {"s", Round(s, 4)},
+          {"d", Round(d, 4)},
+          {key::kSensorFusion, std::move(rows)}}},
+        {key::kPath, {{"x", std::move(px)}, {"y", std::move(py)}}},
+        {key::kPlan, record::PlanJson(status, summary, summary.ms_total, scale, candidates)},
+        {key::kMetrics, {{"speed_mph", Round(speed * units::kMpsToMph, 4)}, {"lane", lane}}},
+        {key::kIncidents, json::array()}};
     *line += e.dump();
   });
   if (index_ % kDrainLines == 0) {
@@ -336,8 +303,7 @@ void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun&
         {"p99", Round(Percentile(ms, 0.99), 4)},
         {"max", Round(ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end()), 4)}}},
       {"plan_fallbacks", fallbacks}};
-  writer_->WriteLine([text = json({{"type", "footer"}, {"report", report}}).dump()](
-                         std::string* line) { *line += text; },
+  writer_->WriteText(json({{key::kType, key::kFooter}, {key::kReport, report}}).dump(),
                      /*last=*/true);
   const Status st = writer_->status();
   writer_.reset();

@@ -16,7 +16,7 @@
 #include <optional>
 #include <thread>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::net {
 namespace {
@@ -277,16 +277,18 @@ Status RunClient(const std::string& url, SimulatorEndpoint& endpoint,
   if (Status s = conn.Open(*parsed_url); !s.ok()) return s;
   stats.tcp_nodelay = conn.nodelay();
   if (options.send_ping) {
-    if (auto ec = conn.Write(kPingFrame)) return Status::Error("sending the ping: " + ec.message());
+    if (auto ec = conn.Write(wire::kPingFrame)) {
+      return Status::Error("sending the ping: " + ec.message());
+    }
   }
   const auto wall_start = std::chrono::steady_clock::now();
   std::string next = endpoint.OnOpen();
-  ParsedReply reply;
+  wire::ParsedReply reply;
   // A message that needs no answer (pong, binary, other non-42 frames) is counted and skipped.
   const auto ignorable = [&] {
     if (conn.binary()) return true;
-    ParseReply(conn.frame(), &reply);
-    return reply.kind == ReplyKind::kPong || reply.kind == ReplyKind::kIgnored;
+    wire::ParseReply(conn.frame(), &reply);
+    return reply.kind == wire::ReplyKind::kPong || reply.kind == wire::ReplyKind::kIgnored;
   };
   const auto protocol_error = [&](const std::string& what) {
     ++stats.protocol_errors;
@@ -342,11 +344,11 @@ Status RunClient(const std::string& url, SimulatorEndpoint& endpoint,
       break;
     }
     switch (reply.kind) {
-      case ReplyKind::kControl:
+      case wire::ReplyKind::kControl:
         ++stats.controls;
         next = endpoint.OnControl(reply.x, reply.y);
         break;
-      case ReplyKind::kManual:
+      case wire::ReplyKind::kManual:
         ++stats.manuals;
         next = endpoint.OnManual();
         break;

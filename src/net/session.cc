@@ -152,7 +152,7 @@ void Session::OnRead(beast::error_code ec) {
   const std::string_view frame = Frame();
   if (frame.substr(0, 2) != "42") {
     // engine.io packets need no JSON: answered (or not) here, without a trip to the pool.
-    ParsedFrame parsed = ParseFrame(frame, server_->options.frame_limits);
+    wire::ParsedFrame parsed = wire::ParseFrame(frame, server_->options.frame_limits);
     Finish(Handle(parsed));
     return;
   }
@@ -164,8 +164,9 @@ void Session::OnRead(beast::error_code ec) {
   // the thread kept for established ones.
   server_->pool.Submit(&usage_, /*heavy=*/Young(), shared_from_this(), [this] {
     Waiting(-1);
-    auto parsed = std::make_shared<ParsedFrame>(ParseFrame(Frame(), server_->options.frame_limits));
-    if (parsed->kind == FrameKind::kTelemetry && !planner_ && EnsurePlanner()) {
+    auto parsed = std::make_shared<wire::ParsedFrame>(
+        wire::ParseFrame(Frame(), server_->options.frame_limits));
+    if (parsed->kind == wire::FrameKind::kTelemetry && !planner_ && EnsurePlanner()) {
       Waiting(+1);
       server_->pool.Submit(&usage_, /*heavy=*/true, shared_from_this(), [this, parsed] {
         Waiting(-1);
@@ -257,10 +258,10 @@ void Session::OnCloseFrame() {
 // Fills reply_ and returns true when the frame needs an answer. On a planning thread for 42
 // frames (the I/O thread leaves this session alone meanwhile), on the I/O thread otherwise.
 // Telemetry is planned with the session's planner (built here if need be).
-bool Session::Handle(const ParsedFrame& parsed) {
+bool Session::Handle(const wire::ParsedFrame& parsed) {
   ServerStats& st = server_->stats;
   switch (parsed.kind) {
-    case FrameKind::kTelemetry:
+    case wire::FrameKind::kTelemetry:
       if (!parsed.error.empty()) {
         {
           std::lock_guard lock(server_->mutex);
@@ -269,37 +270,37 @@ bool Session::Handle(const ParsedFrame& parsed) {
         Problem("telemetry repaired: " + parsed.error);
       }
       return Plan(parsed.telemetry);
-    case FrameKind::kNullTelemetry: {
+    case wire::FrameKind::kNullTelemetry: {
       std::lock_guard lock(server_->mutex);
       ++st.null_telemetry;
       ++st.manual_replies;
-      reply_ = kManualFrame;
+      reply_ = wire::kManualFrame;
       return true;
     }
-    case FrameKind::kOtherEvent:
-    case FrameKind::kMalformed:
-    case FrameKind::kRefused: {
+    case wire::FrameKind::kOtherEvent:
+    case wire::FrameKind::kMalformed:
+    case wire::FrameKind::kRefused: {
       {
         std::lock_guard lock(server_->mutex);
-        ++(parsed.kind == FrameKind::kMalformed ? st.malformed_frames
-           : parsed.kind == FrameKind::kRefused ? st.refused_frames
-                                                : st.other_events);
+        ++(parsed.kind == wire::FrameKind::kMalformed ? st.malformed_frames
+           : parsed.kind == wire::FrameKind::kRefused ? st.refused_frames
+                                                      : st.other_events);
         ++st.manual_replies;
       }
-      Problem(std::string(parsed.kind == FrameKind::kMalformed ? "malformed frame"
-                          : parsed.kind == FrameKind::kRefused ? "frame over the limits"
-                                                               : "unexpected event") +
+      Problem(std::string(parsed.kind == wire::FrameKind::kMalformed ? "malformed frame"
+                          : parsed.kind == wire::FrameKind::kRefused ? "frame over the limits"
+                                                                     : "unexpected event") +
               " answered manual: " + parsed.error);
-      reply_ = kManualFrame;
+      reply_ = wire::kManualFrame;
       return true;
     }
-    case FrameKind::kPing: {
+    case wire::FrameKind::kPing: {
       std::lock_guard lock(server_->mutex);
       ++st.pings;
-      reply_ = kPongFrame;
+      reply_ = wire::kPongFrame;
       return server_->options.answer_ping;
     }
-    case FrameKind::kIgnored: {
+    case wire::FrameKind::kIgnored: {
       std::lock_guard lock(server_->mutex);
       ++st.ignored_frames;
       return false;
@@ -333,7 +334,7 @@ bool Session::EnsurePlanner() {
 
 bool Session::Plan(const plan::Telemetry& telemetry) {
   if (!EnsurePlanner()) {
-    reply_ = kManualFrame;
+    reply_ = wire::kManualFrame;
     return true;
   }
   ++plans_;
@@ -348,11 +349,11 @@ bool Session::Plan(const plan::Telemetry& telemetry) {
       ++server_->stats.manual_replies;
     }
     Problem(std::string("planner threw, answered manual: ") + e.what());
-    reply_ = kManualFrame;
+    reply_ = wire::kManualFrame;
     return true;
   }
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  const std::size_t written = FormatControl(result->x, result->y, &reply_);
+  const std::size_t written = wire::FormatControl(result->x, result->y, &reply_);
   const bool bad = written != result->x.size() || written != result->y.size();
   {
     std::lock_guard lock(server_->mutex);

@@ -14,8 +14,8 @@
 #include <string>
 #include <string_view>
 
-#include "frenetic/net/protocol.h"
 #include "frenetic/plan/planner.h"
+#include "frenetic/wire/protocol.h"
 #include "net/planning_pool.h"
 #include "net/server_impl.h"
 
@@ -46,7 +46,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void FrameDone();
   void Finish(bool answer);
   void OnCloseFrame();
-  bool Handle(const ParsedFrame& parsed);
+  bool Handle(const wire::ParsedFrame& parsed);
   bool EnsurePlanner();
   bool Plan(const plan::Telemetry& telemetry);
   void Problem(const std::string& what);

@@ -13,6 +13,15 @@
 namespace frenetic::report {
 namespace {
 
+using record::Candidate;
+using record::CandidateCost;
+using record::CountColumn;
+using record::CycleCandidates;
+using record::Incident;
+using record::RecordHeader;
+using record::RunData;
+using record::TermColumn;
+
 constexpr std::string_view kDataPlaceholder = "@FRENETIC_DATA@";
 
 // Appends compact JSON. Numbers are rounded here, once: the page's size (and so its opening

@@ -11,11 +11,11 @@
 #include <optional>
 #include <thread>
 
-#include "frenetic/net/protocol.h"
 #include "frenetic/sim/incident_recorder.h"
 #include "frenetic/sim/record.h"
 #include "frenetic/units.h"
-#include "frenetic/wire_precision.h"
+#include "frenetic/wire/precision.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::sim {
 namespace {
@@ -184,7 +184,7 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   int fallbacks = 0, bad_paths = 0;
   std::string telemetry_json;
   // The planner gets the telemetry as it arrives over the wire and the simulator the path as it
-  // arrives back (wire_precision.h: float32 printed with 7 digits out, 10 digits back, a path
+  // arrives back (wire/precision.h: float32 printed with 7 digits out, 10 digits back, a path
   // cut before its first unwritable point), so that this drive and the same seed through
   // `frenetic serve` + `drive --connect` are the same drive.
   plan::Telemetry received;
@@ -214,7 +214,7 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   }
   while (!ep.done()) {
     const double t_sent = ep.sim().time();
-    if (record != nullptr) telemetry_json = net::TelemetryToJson(ep.telemetry());
+    if (record != nullptr) telemetry_json = wire::TelemetryToJson(ep.telemetry());
     wire::TelemetryAsReceived(ep.telemetry(), &received);
     trace.candidates.clear();
     const auto t0 = std::chrono::steady_clock::now();

@@ -11,9 +11,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "frenetic/net/protocol.h"
 #include "frenetic/sim/ego.h"
 #include "frenetic/units.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::sim {
 namespace {
@@ -255,7 +255,7 @@ CheckReport CheckProtocol(std::span<const Recording> recordings, plan::Planner& 
   CheckRow parsed{"protocol: telemetry frame parsed", 0, 0, 0, 1e-9, "", {}};
   CheckRow answered{"protocol: valid control reply", 0, 0, 0, 1e-5, "m", {}};
   long not_ok_status = 0;
-  net::ParsedReply reply;
+  wire::ParsedReply reply;
   std::string frame, control;
   for (const Recording& rec : recordings) {
     planner.Reset();
@@ -265,11 +265,11 @@ CheckReport CheckProtocol(std::span<const Recording> recordings, plan::Planner& 
       frame = "42[\"telemetry\",";
       frame += m.json;
       frame += "]";
-      const net::ParsedFrame pf = net::ParseFrame(frame);
+      const wire::ParsedFrame pf = wire::ParseFrame(frame);
       ++parsed.cases;
       ++answered.cases;
-      if (pf.kind != net::FrameKind::kTelemetry || !pf.error.empty()) {
-        Fail(&parsed, where + ": " + net::ToString(pf.kind) + " " + pf.error);
+      if (pf.kind != wire::FrameKind::kTelemetry || !pf.error.empty()) {
+        Fail(&parsed, where + ": " + wire::ToString(pf.kind) + " " + pf.error);
         continue;  // nothing to plan on: not answered either
       }
       // The parser must hand the planner the recorded values (only mph and degrees converted).
@@ -315,12 +315,12 @@ CheckReport CheckProtocol(std::span<const Recording> recordings, plan::Planner& 
 
       const plan::PlanResult& result = planner.Plan(t);
       if (result.status != plan::PlanStatus::kOk) ++not_ok_status;
-      const std::size_t written = net::FormatControl(result.x, result.y, &control);
-      net::ParseReply(control, &reply);
+      const std::size_t written = wire::FormatControl(result.x, result.y, &control);
+      wire::ParseReply(control, &reply);
       std::string why;
       double reply_dev = 0;
-      if (reply.kind != net::ReplyKind::kControl) {
-        why = std::string("reply is ") + net::ToString(reply.kind) + " " + reply.error;
+      if (reply.kind != wire::ReplyKind::kControl) {
+        why = std::string("reply is ") + wire::ToString(reply.kind) + " " + reply.error;
       } else if (reply.x.size() != reply.y.size()) {
         why = "next_x and next_y differ in length";
       } else if (written != result.x.size() || result.x.size() != result.y.size() ||
@@ -478,7 +478,7 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
                  "digits", {}};
   CheckRow yaw{"ego: yaw toward the second point", 0, 0, 0, kYawToleranceDeg, "deg", {}};
   long settling = 0, splits = 0, speed_not_exact = 0;
-  net::ParsedReply reply;
+  wire::ParsedReply reply;
   std::vector<double> prev_x, prev_y;
   for (const Recording& rec : recordings) {
     for (std::size_t k = 0; k + 1 < rec.messages.size(); ++k) {
@@ -487,13 +487,13 @@ CheckReport CheckEgoMotion(std::span<const Recording> recordings, const EgoModel
       const std::string where = rec.name + " message " + std::to_string(k + 1);
       ++path.cases;
       ++pos.cases;
-      net::ParseReply(rec.replies[k], &reply);
+      wire::ParseReply(rec.replies[k], &reply);
       const long c = static_cast<long>(reply.x.size()) - static_cast<long>(n.path_x.size());
-      if (reply.kind != net::ReplyKind::kControl || c < 1) {
-        const std::string why = reply.kind != net::ReplyKind::kControl
-                                    ? "reply " + std::to_string(k) + " is not a control: " +
-                                          reply.error
-                                    : "no consumed count (" + std::to_string(c) + ")";
+      if (reply.kind != wire::ReplyKind::kControl || c < 1) {
+        const std::string why =
+            reply.kind != wire::ReplyKind::kControl
+                ? "reply " + std::to_string(k) + " is not a control: " + reply.error
+                : "no consumed count (" + std::to_string(c) + ")";
         Fail(&path, where + ": " + why);
         Fail(&pos, where + ": " + why);
         continue;

@@ -11,11 +11,11 @@
 #include <optional>
 #include <thread>
 
-#include "frenetic/net/protocol.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/episode.h"
 #include "frenetic/sim/fidelity.h"
 #include "frenetic/units.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::sim {
 namespace {
@@ -280,7 +280,7 @@ void TrafficStatsBuilder::AddRun(std::span<const TrafficSample> run) {
 
 std::vector<TrafficSample> RecordingTrafficSamples(const Recording& recording) {
   std::vector<TrafficSample> out(recording.messages.size());
-  net::ParsedReply reply;
+  wire::ParsedReply reply;
   for (std::size_t k = 0; k < recording.messages.size(); ++k) {
     const RecordedMessage& m = recording.messages[k];
     TrafficSample& t = out[k];
@@ -290,7 +290,7 @@ std::vector<TrafficSample> RecordingTrafficSamples(const Recording& recording) {
     if (k == 0) continue;
     // Points consumed since the previous message: the previous reply's length minus what is
     // left of it now (the planner re-sent its unconsumed points, so the tail is the same path).
-    net::ParseReply(recording.replies[k - 1], &reply);
+    wire::ParseReply(recording.replies[k - 1], &reply);
     const long c = static_cast<long>(reply.x.size()) - static_cast<long>(m.path_x.size());
     t.consumed = static_cast<int>(std::max(0L, c));
     t.dt = t.consumed * kTickSeconds;

@@ -16,8 +16,8 @@
 #include "apps_test_util.h"
 #include "commonroad/scenario_xml.h"
 #include "frenetic/commonroad/record.h"
+#include "frenetic/record/reader.h"
 #include "frenetic/report/page.h"
-#include "frenetic/report/record.h"
 
 namespace frenetic::testing {
 namespace {
@@ -73,9 +73,9 @@ TEST_F(CommonRoadRecordTest, RecordReadsBackWithLanesCarsAndOneExchangePerStep) 
   ASSERT_TRUE(fs::exists(file)) << file;
   EXPECT_EQ(std::vector<fs::path>(fs::directory_iterator(records), {}).size(), 1u);
 
-  auto run = report::ReadRecordFile(file.string());
+  auto run = record::ReadRecordFile(file.string());
   ASSERT_TRUE(run.ok()) << run.message();
-  const report::RecordHeader& h = run->header;
+  const record::RecordHeader& h = run->header;
   EXPECT_EQ(h.world, "commonroad");
   EXPECT_EQ(h.scenario, "ZAM_RecordTest-1_1_T-1");
   EXPECT_EQ(h.problem, 1);
@@ -87,7 +87,7 @@ TEST_F(CommonRoadRecordTest, RecordReadsBackWithLanesCarsAndOneExchangePerStep) 
   ASSERT_EQ(h.road_lanes.size(), 2u);
   const double border_y[2][2] = {{3.5, 0.0}, {0.0, -3.5}};
   for (int l = 0; l < 2; ++l) {
-    const report::RecordHeader::Lane& lane = h.road_lanes[l];
+    const record::RecordHeader::Lane& lane = h.road_lanes[l];
     ASSERT_GT(lane.left.x.size(), 100u);
     ASSERT_EQ(lane.left.x.size(), lane.left.y.size());
     ASSERT_EQ(lane.right.x.size(), lane.right.y.size());

@@ -83,7 +83,7 @@ std::string ClientUrl(int port) {
 }
 
 // The in-process drive rounds every telemetry number and every path point as the wire does
-// (wire_precision.h), so the same seed gives the same drive through `serve` + `drive --connect`:
+// (wire/precision.h), so the same seed gives the same drive through `serve` + `drive --connect`:
 // the whole report is equal except what cannot be: planning times (round trips over the wire),
 // the planner's name ("remote") and plan_fallbacks (in process: plans whose status was not ok;
 // over the wire: manual replies).

@@ -15,18 +15,18 @@
 #include <string_view>
 #include <vector>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 namespace {
 
-using frenetic::net::FormatControl;
-using frenetic::net::FormatTelemetryFrame;
-using frenetic::net::FrameKind;
-using frenetic::net::ParsedFrame;
-using frenetic::net::ParsedReply;
-using frenetic::net::ParseFrame;
-using frenetic::net::ParseReply;
-using frenetic::net::ReplyKind;
+using frenetic::wire::FormatControl;
+using frenetic::wire::FormatTelemetryFrame;
+using frenetic::wire::FrameKind;
+using frenetic::wire::ParsedFrame;
+using frenetic::wire::ParsedReply;
+using frenetic::wire::ParseFrame;
+using frenetic::wire::ParseReply;
+using frenetic::wire::ReplyKind;
 
 void Require(bool condition) {
   if (!condition) std::abort();

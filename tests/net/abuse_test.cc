@@ -21,9 +21,9 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/net/client.h"
-#include "frenetic/net/protocol.h"
 #include "frenetic/net/server.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 #include "net/raw_websocket.h"
 
@@ -48,9 +48,9 @@ using testing::TestServer;
 ::testing::AssertionResult IsControlFor(const std::optional<std::string>& reply, double x, double y,
                                         int cycle) {
   if (!reply.has_value()) return ::testing::AssertionFailure() << "no reply";
-  ParsedReply r;
-  ParseReply(*reply, &r);
-  if (r.kind != ReplyKind::kControl) {
+  wire::ParsedReply r;
+  wire::ParseReply(*reply, &r);
+  if (r.kind != wire::ReplyKind::kControl) {
     return ::testing::AssertionFailure()
            << "not a control: " << reply->substr(0, 80) << " " << r.error;
   }
@@ -298,7 +298,7 @@ TEST(AbuseTest, AClientOverTheCapIsRefusedWith503NamingTheLimit) {
   // The simulator's side says why.
   class OneFrame : public SimulatorEndpoint {
    public:
-    std::string OnOpen() override { return std::string(kNullTelemetryFrame); }
+    std::string OnOpen() override { return std::string(wire::kNullTelemetryFrame); }
     std::string OnControl(std::span<const double>, std::span<const double>) override { return ""; }
     std::string OnManual() override { return ""; }
     bool Done() const override { return true; }
@@ -325,9 +325,9 @@ TEST(AbuseTest, ThePlannerIsBuiltAtTheFirstTelemetryAndNotForOtherFrames) {
   TestServer server;
   TestClient client;
   ASSERT_TRUE(client.Connect(server.port()));
-  EXPECT_EQ(*client.Exchange(kNullTelemetryFrame), kManualFrame);
-  EXPECT_EQ(*client.Exchange("42[\"telemetry\",{\"x\":"), kManualFrame);
-  EXPECT_EQ(*client.Exchange(testing::FrameWithRows(100)), kManualFrame);
+  EXPECT_EQ(*client.Exchange(wire::kNullTelemetryFrame), wire::kManualFrame);
+  EXPECT_EQ(*client.Exchange("42[\"telemetry\",{\"x\":"), wire::kManualFrame);
+  EXPECT_EQ(*client.Exchange(testing::FrameWithRows(100)), wire::kManualFrame);
   EXPECT_EQ(server.planners_made, 0);
   EXPECT_TRUE(IsControlFor(client.Exchange(TelemetryFrameAt(4, 5)), 4, 5, 1));
   EXPECT_TRUE(IsControlFor(client.Exchange(TelemetryFrameAt(4, 5)), 4, 5, 2));
@@ -393,7 +393,7 @@ TEST(AbuseTest, OversizedAndPathologicalFramesDoNotDisturbAWellBehavedClient) {
       for (int n = 0; n < 200 && !done; ++n) {
         if (!s.WriteAll(frame)) return;
         const auto reply = ReadRawFrame(s);
-        if (reply.has_value() && reply->payload == kManualFrame) {
+        if (reply.has_value() && reply->payload == wire::kManualFrame) {
           ++manuals;
         } else {
           ++wrong;

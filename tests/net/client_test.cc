@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 #include "net/raw_websocket.h"
 
@@ -57,8 +57,8 @@ class ToyEndpoint : public SimulatorEndpoint {
  private:
   std::string Next() {
     ++frames_;
-    if (frames_ % 3 == 0) return std::string(kNullTelemetryFrame);
-    return FormatTelemetryFrame(t_);
+    if (frames_ % 3 == 0) return std::string(wire::kNullTelemetryFrame);
+    return wire::FormatTelemetryFrame(t_);
   }
   plan::Telemetry t_;
   int exchanges_;
@@ -298,8 +298,9 @@ TEST(ClientTest, ASecondReplyIsDroppedAndCountedWhenContinuing) {
   ToyEndpoint endpoint(3);
   ClientOptions options;
   options.continue_on_protocol_error = true;
-  const Status s = RunAgainstRawServer(TextFrame(kGoodControl) + TextFrame(kManualFrame), &echo,
-                                       &stats, &endpoint, options, /*replies=*/2, kGoodControl);
+  const Status s =
+      RunAgainstRawServer(TextFrame(kGoodControl) + TextFrame(wire::kManualFrame), &echo, &stats,
+                          &endpoint, options, /*replies=*/2, kGoodControl);
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(stats.protocol_errors, 1);
   EXPECT_EQ(stats.frames_sent, 3);

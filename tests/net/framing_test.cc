@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "frenetic/net/client.h"
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 #include "net/raw_websocket.h"
 
@@ -65,7 +65,8 @@ class BigTelemetryEndpoint : public SimulatorEndpoint {
  private:
   std::string Next() {
     const int i = sent_++;
-    return FormatTelemetryFrame(BigTelemetry(i, i + 1 == frames_ ? kHugePathPoints : kPathPoints));
+    return wire::FormatTelemetryFrame(
+        BigTelemetry(i, i + 1 == frames_ ? kHugePathPoints : kPathPoints));
   }
 
   int frames_, sent_ = 0, replies_ = 0;
@@ -103,10 +104,10 @@ TEST(FramingTest, ClientSendsEachMessageAsOneMaskedTextFrame) {
     std::optional<RawFrame> ping = ReadRawFrame(s);
     ASSERT_TRUE(ping.has_value());
     ExpectOneTextFrame(*ping, /*masked=*/true);
-    EXPECT_EQ(ping->payload, kPingFrame);
+    EXPECT_EQ(ping->payload, wire::kPingFrame);
     std::string control;
     const std::vector<double> xs(50, 1.0), ys(50, 2.0);
-    FormatControl(xs, ys, &control);
+    wire::FormatControl(xs, ys, &control);
     for (int i = 0; i < kFrames; ++i) {
       std::optional<RawFrame> f = ReadRawFrame(s);
       ASSERT_TRUE(f.has_value()) << "no frame " << i;
@@ -114,10 +115,10 @@ TEST(FramingTest, ClientSendsEachMessageAsOneMaskedTextFrame) {
       EXPECT_GT(f->payload.size(), i + 1 == kFrames ? 64u << 10 : 4096u * 2);
       // The whole message is in this one frame: it parses, and it is the i-th telemetry (the
       // last one beyond the server's default limits).
-      FrameLimits limits;
+      wire::FrameLimits limits;
       limits.max_path_points = kHugePathPoints;
-      const ParsedFrame parsed = ParseFrame(f->payload, limits);
-      ASSERT_EQ(parsed.kind, FrameKind::kTelemetry) << i << ": " << parsed.error;
+      const wire::ParsedFrame parsed = wire::ParseFrame(f->payload, limits);
+      ASSERT_EQ(parsed.kind, wire::FrameKind::kTelemetry) << i << ": " << parsed.error;
       EXPECT_TRUE(parsed.error.empty()) << parsed.error;
       EXPECT_EQ(parsed.telemetry.x, 1000.0 + i);
       EXPECT_EQ(parsed.telemetry.previous_path_x.size(),
@@ -148,24 +149,24 @@ TEST(FramingTest, ServerSendsEachReplyAsOneUnmaskedTextFrame) {
   EXPECT_NE(response.find(testing::kSampleAccept), std::string::npos) << response;
 
   for (int i = 0; i < 3; ++i) {
-    const std::string frame = FormatTelemetryFrame(BigTelemetry(i));
+    const std::string frame = wire::FormatTelemetryFrame(BigTelemetry(i));
     ASSERT_TRUE(s.WriteAll(EncodeRawFrame(kOpText, frame, /*mask=*/true)));
     std::optional<RawFrame> f = ReadRawFrame(s);
     ASSERT_TRUE(f.has_value()) << "no reply " << i;
     ExpectOneTextFrame(*f, /*masked=*/false);
     EXPECT_GT(f->payload.size(), 4096u * 2);
-    ParsedReply reply;
-    ParseReply(f->payload, &reply);
-    ASSERT_EQ(reply.kind, ReplyKind::kControl) << reply.error;
+    wire::ParsedReply reply;
+    wire::ParseReply(f->payload, &reply);
+    ASSERT_EQ(reply.kind, wire::ReplyKind::kControl) << reply.error;
     EXPECT_EQ(reply.x.size(), static_cast<std::size_t>(FakePlanner::kLongPoints));
     EXPECT_NEAR(reply.x[0], 1000.0 + i, 1e-6);
   }
   // A small reply too (null telemetry gets manual).
-  ASSERT_TRUE(s.WriteAll(EncodeRawFrame(kOpText, kNullTelemetryFrame, /*mask=*/true)));
+  ASSERT_TRUE(s.WriteAll(EncodeRawFrame(kOpText, wire::kNullTelemetryFrame, /*mask=*/true)));
   std::optional<RawFrame> manual = ReadRawFrame(s);
   ASSERT_TRUE(manual.has_value());
   ExpectOneTextFrame(*manual, /*masked=*/false);
-  EXPECT_EQ(manual->payload, kManualFrame);
+  EXPECT_EQ(manual->payload, wire::kManualFrame);
 
   const ServerStats stats = server.server().stats();
   EXPECT_EQ(stats.connections, 1);

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 
 namespace frenetic::net {
@@ -25,9 +25,9 @@ using testing::TestServer;
 // Checks that `reply` is the fake planner's control for an ego at (x, y) on its `cycle`-th call.
 void ExpectControlFor(const std::optional<std::string>& reply, double x, double y, int cycle) {
   ASSERT_TRUE(reply.has_value()) << "no reply";
-  ParsedReply r;
-  ParseReply(*reply, &r);
-  ASSERT_EQ(r.kind, ReplyKind::kControl) << *reply << " " << r.error;
+  wire::ParsedReply r;
+  wire::ParseReply(*reply, &r);
+  ASSERT_EQ(r.kind, wire::ReplyKind::kControl) << *reply << " " << r.error;
   ASSERT_EQ(r.x.size(), static_cast<std::size_t>(plan::kMinPathPoints));
   EXPECT_NEAR(r.x[0], x, 1e-6);
   EXPECT_NEAR(r.x[49], x + 49, 1e-6);
@@ -36,7 +36,7 @@ void ExpectControlFor(const std::optional<std::string>& reply, double x, double 
 
 void ExpectManual(const std::optional<std::string>& reply) {
   ASSERT_TRUE(reply.has_value()) << "no reply";
-  EXPECT_EQ(*reply, kManualFrame);
+  EXPECT_EQ(*reply, wire::kManualFrame);
 }
 
 TEST(ServerTest, AnswersTheRealFirstMessageWithControl) {
@@ -81,7 +81,7 @@ TEST(ServerTest, NullTelemetryAndOtherEventsGetManual) {
   TestServer server;
   TestClient client;
   ASSERT_TRUE(client.Connect(server.port()));
-  ExpectManual(client.Exchange(kNullTelemetryFrame));
+  ExpectManual(client.Exchange(wire::kNullTelemetryFrame));
   ExpectManual(client.Exchange(R"(42["hello",{}])"));
   ExpectControlFor(client.Exchange(TelemetryFrameAt(5, 6)), 5, 6, 1);
   const ServerStats stats = server.server().stats();
@@ -94,7 +94,7 @@ TEST(ServerTest, PingIsIgnoredByDefault) {
   TestServer server;
   TestClient client;
   ASSERT_TRUE(client.Connect(server.port()));
-  ASSERT_FALSE(client.Send(kPingFrame));
+  ASSERT_FALSE(client.Send(wire::kPingFrame));
   ASSERT_FALSE(client.Send("3"));
   // The first reply must be the one to the telemetry: nothing was sent for the ping.
   ExpectControlFor(client.Exchange(TelemetryFrameAt(5, 6)), 5, 6, 1);
@@ -107,9 +107,9 @@ TEST(ServerTest, PingIsAnsweredWhenConfigured) {
   TestServer server(options);
   TestClient client;
   ASSERT_TRUE(client.Connect(server.port()));
-  const auto pong = client.Exchange(kPingFrame);
+  const auto pong = client.Exchange(wire::kPingFrame);
   ASSERT_TRUE(pong.has_value());
-  EXPECT_EQ(*pong, kPongFrame);
+  EXPECT_EQ(*pong, wire::kPongFrame);
 }
 
 // Each hostile 42 frame is answered with manual (or a repaired control), and the same
@@ -131,12 +131,12 @@ TEST_P(ServerHostileTest, IsAnsweredAndTheNextTelemetryStillWorks) {
   ASSERT_TRUE(reply.has_value());
   int cycles = 0;
   if (c.expect_control) {
-    ParsedReply r;
-    ParseReply(*reply, &r);
-    EXPECT_EQ(r.kind, ReplyKind::kControl) << *reply;
+    wire::ParsedReply r;
+    wire::ParseReply(*reply, &r);
+    EXPECT_EQ(r.kind, wire::ReplyKind::kControl) << *reply;
     ++cycles;
   } else {
-    EXPECT_EQ(*reply, kManualFrame);
+    EXPECT_EQ(*reply, wire::kManualFrame);
   }
   ExpectControlFor(client.Exchange(TelemetryFrameAt(7, 8)), 7, 8, cycles + 1);
   client.Close();
@@ -282,9 +282,9 @@ TEST(ServerTest, BadPlansAreSentEqualAndFiniteAndCounted) {
     ASSERT_TRUE(client.Connect(server.port()));
     const auto reply = client.Exchange(TelemetryFrameAt(1, 2));
     ASSERT_TRUE(reply.has_value());
-    ParsedReply r;
-    ParseReply(*reply, &r);
-    ASSERT_EQ(r.kind, ReplyKind::kControl) << r.error;
+    wire::ParsedReply r;
+    wire::ParseReply(*reply, &r);
+    ASSERT_EQ(r.kind, wire::ReplyKind::kControl) << r.error;
     const std::size_t expected = mode == FakePlanner::Mode::kNaN ? 10 : mode == FakePlanner::Mode::kUnequal ? 20 : 3;
     EXPECT_EQ(r.x.size(), expected);
     const ServerStats stats = server.server().stats();
@@ -304,7 +304,7 @@ TEST(ServerTest, AFailingFactoryAnswersManualAndClosesOnlyThatConnection) {
   EXPECT_EQ(server.server().stats().refused_connections, 1);
   TestClient next(2.0);
   ASSERT_TRUE(next.Connect(server.port())) << "the server must still accept connections";
-  ExpectManual(next.Exchange(kNullTelemetryFrame));
+  ExpectManual(next.Exchange(wire::kNullTelemetryFrame));
 }
 
 TEST(ServerTest, StopClosesOpenConnections) {

@@ -1,29 +1,29 @@
 // Writes synthetic drive records and their report pages for the browser test:
 //   frenetic_report_fixture OUT_DIR [--large N]
-// OUT_DIR/run.{jsonl,html} (a short drive), OUT_DIR/incident.{jsonl,html} (with a collision and
-// the footer in the simulator's shape),
+// OUT_DIR/run.{jsonl,html} (a short drive), OUT_DIR/incident.{jsonl,html} (with a collision),
 // OUT_DIR/commonroad.{jsonl,html} (a CommonRoad run's header), and with --large N also
 // OUT_DIR/large.{jsonl,html} (N exchanges) to time the page's opening.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "frenetic/record/reader.h"
 #include "frenetic/report/page.h"
-#include "frenetic/report/record.h"
-#include "report/synthetic_record.h"
+#include "record/synthetic_record.h"
 
 namespace {
 
 int Write(const std::string& dir, const std::string& name,
-          const frenetic::report::testing::SyntheticOptions& options) {
+          const frenetic::record::testing::SyntheticOptions& options) {
   const std::string jsonl = dir + "/" + name + ".jsonl";
   const std::string html = dir + "/" + name + ".html";
-  if (auto s = frenetic::report::WriteFile(jsonl, frenetic::report::testing::SyntheticRecord(options));
+  if (auto s =
+          frenetic::report::WriteFile(jsonl, frenetic::record::testing::SyntheticRecord(options));
       !s.ok()) {
     std::fprintf(stderr, "%s\n", s.message().c_str());
     return 1;
   }
-  auto run = frenetic::report::ReadRecordFile(jsonl);
+  auto run = frenetic::record::ReadRecordFile(jsonl);
   if (!run.ok()) {
     std::fprintf(stderr, "%s\n", run.message().c_str());
     return 1;
@@ -44,13 +44,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
-  frenetic::report::testing::SyntheticOptions options;
+  frenetic::record::testing::SyntheticOptions options;
   if (Write(dir, "run", options) != 0) return 1;
   options.incident = true;
-  options.simulator_footer = true;
   if (Write(dir, "incident", options) != 0) return 1;
   {
-    frenetic::report::testing::SyntheticOptions cr;
+    frenetic::record::testing::SyntheticOptions cr;
     cr.commonroad = true;
     if (Write(dir, "commonroad", cr) != 0) return 1;
   }

@@ -11,10 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "report/synthetic_record.h"
+#include "record/synthetic_record.h"
 
 namespace frenetic::report {
 namespace {
+
+using record::ReadRecord;
+using record::RecordHeader;
+using record::RunData;
+namespace testing = record::testing;
 
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -67,7 +72,7 @@ TEST(PageDataTest, IsValidJsonWithColumnsOfOneLength) {
   EXPECT_EQ(data["incidents"][0]["kind"], "collision");
   EXPECT_EQ(data["header"]["lanes"], 3);
   EXPECT_EQ(data["header"]["config"]["weights"]["comfort"], 1.0);
-  EXPECT_EQ(data["footer"]["incidents_total"], 1);
+  EXPECT_EQ(data["footer"]["incidents"], 1);
   // Candidate rows: [lane, end_speed, duration, total, flags, reject, x, y, costs].
   const json& c0 = data["candidates"][0];
   EXPECT_EQ(c0["e"], 0);

@@ -4,10 +4,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
+#include "frenetic/record/plan_json.h"
 #include "frenetic/sim/record.h"
 #include "sim_test_util.h"
 
@@ -102,7 +102,7 @@ std::string RecordBytes(const std::shared_ptr<const World>& world, std::uint64_t
   RunOptions options;
   options.record = writer->get();
   options.timing = false;
-  options.planner_config = YamlToJson("weights: {speed: 1.5, lane: 2}\nname: test\n");
+  options.planner_config = record::YamlToJson("weights: {speed: 1.5, lane: 2}\nname: test\n");
   auto report = RunEpisode(world, Scenario(), seed, EpisodeLimits{0, 0, 20, 60}, planner, options);
   EXPECT_TRUE(report.ok()) << report.message();
   writer->reset();

@@ -1,6 +1,6 @@
 // Records of CommonRoad runs (`frenetic commonroad --record DIR`): one file per planning problem,
-// "<scenario id>_<problem id>.jsonl.gz", in the drive record's format (sim/record.h: JSON lines,
-// gzip, written by a thread of its own) so that `frenetic report` replays it.
+// "<scenario id>_<problem id>.jsonl.gz", in the record format of record/schema.h (JSON lines,
+// gzip, written by a record::Writer on a thread of its own) so that `frenetic report` replays it.
 //
 // The header line carries, besides the drive header's fields ("scenario": the benchmark id,
 // "map": the scenario file, "planner", "config", "lanes", "lane_width", "max_s", "car_length"
@@ -14,7 +14,7 @@
 // dt, s), "step", "telemetry" (the ego's x, y, yaw in degrees, speed in mph, s and d on the
 // road's reference line, and "sensor_fusion": the obstacles present at the step, each
 // [id, x, y, vx, vy, s, d, length, width, heading in degrees], the centre of its footprint's
-// bounding box), "path" (the plan's 0.02 s points, m), "plan" (sim::PlanJson, with up to
+// bounding box), "path" (the plan's 0.02 s points, m), "plan" (record::PlanJson, with up to
 // kRecordCandidates traced candidates; times 0 with timing off) and "metrics" (speed_mph, lane).
 // The footer's report holds the verdict: "solved", "goal_step", "stop_reason", "failures"
 // ([{kind, step, detail, obstacle}]), and the run's "steps", "distance_m", "sim_seconds",
@@ -36,9 +36,10 @@
 #include "frenetic/commonroad/scenario.h"
 #include "frenetic/status.h"
 
-namespace frenetic::sim {
-class RecordWriter;
-}
+namespace frenetic::record {
+class Replica;
+class Writer;
+}  // namespace frenetic::record
 
 namespace frenetic::commonroad {
 
@@ -78,13 +79,13 @@ class RunRecorder {
   bool timing_;
   Status status_;
   std::vector<std::string> files_;
-  std::unique_ptr<sim::RecordWriter> writer_;  // the current problem's
+  std::unique_ptr<record::Writer> writer_;     // the current problem's
   std::string path_;                           // its file
   int problem_ = 0;                            // its id
   int index_ = 0;                              // the next exchange's "i"
   bool failed_ = false;                        // the current problem's record could not open
-  struct Replica;
-  std::shared_ptr<Replica> replica_;  // the current problem's, handed to its lines
+  // The current problem's planner that traces the candidates, handed to its lines.
+  std::shared_ptr<record::Replica> replica_;
 };
 
 }  // namespace frenetic::commonroad

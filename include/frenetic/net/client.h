@@ -12,8 +12,8 @@
 namespace frenetic::net {
 
 // What the simulator does when frames arrive. Every method returns the next frame to send
-// (normally FormatTelemetryFrame(...), or kNullTelemetryFrame when no tick has elapsed since the
-// last real telemetry: the endpoint decides). An empty string ends the run like Done().
+// (normally wire::FormatTelemetryFrame(...), or wire::kNullTelemetryFrame when no tick has elapsed
+// since the last real telemetry: the endpoint decides). An empty string ends the run like Done().
 class SimulatorEndpoint {
  public:
   virtual ~SimulatorEndpoint() = default;

@@ -13,7 +13,7 @@
 // written), so its planner is used by one thread at a time and a client that floods or stops
 // reading only slows itself; the pool takes the waiting connection that has used the least
 // planning time lately (decayed over ~1 s), so a simulator that sends one frame per tick goes
-// ahead of clients that keep the pool busy. A frame's conversion is bounded by FrameLimits.
+// ahead of clients that keep the pool busy. A frame's conversion is bounded by wire::FrameLimits.
 // At most max_connections connections are open (upgrading or upgraded); one more is answered
 // `HTTP/1.1 503 Service Unavailable` with a one-line reason and closed. A connection's planner is
 // built at its first telemetry and freed when it closes (memory is then given back to the system).
@@ -30,9 +30,9 @@
 #include <memory>
 #include <string>
 
-#include "frenetic/net/protocol.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/status.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::net {
 
@@ -59,7 +59,7 @@ struct ServerOptions {
   // Bytes a connection is read at, on average (bursts up to max_frame_bytes); 0 = no limit.
   // A simulator sends ~0.3 MB/s, `drive --connect` up to ~10 MB/s.
   double max_read_bytes_per_second = 16 << 20;
-  FrameLimits frame_limits;     // sensor_fusion rows and path points a telemetry frame may hold
+  wire::FrameLimits frame_limits;  // sensor_fusion rows and path points a telemetry frame may hold
 
   Status Validate() const;  // a message naming the bad option
 };

@@ -1,7 +1,7 @@
 // Fidelity of the headless simulator against recordings of the real Unity simulator
 // (udacity-sim.md §14, shared/realdata/telemetry): `frenetic fidelity` runs every check below.
 //  - Protocol: every recorded telemetry object, framed as the simulator frames it, goes through
-//    net::ParseFrame and a planner; the reply goes through net::FormatControl / net::ParseReply.
+//    wire::ParseFrame and a planner; the reply goes through wire::FormatControl / wire::ParseReply.
 //  - Frenet: the chord-based s, d of the ego, of every sensor_fusion row and of end_path,
 //    recomputed from x, y, match the recorded values (documented quirks counted apart).
 //  - Ego motion: the recorded reply k, through the simulator's trimming and one-point-per-tick
@@ -88,10 +88,10 @@ bool EqualAsPrinted(double value, double recorded);
 double DigitsOff(double value, double recorded);
 
 // --- Protocol -----------------------------------------------------------------------------
-// Frames every message as `42["telemetry",<json>]`, parses it with net::ParseFrame (must be
+// Frames every message as `42["telemetry",<json>]`, parses it with wire::ParseFrame (must be
 // kTelemetry with no repair, fields equal to the recorded ones), plans with `planner` (Reset at
-// the start of each recording, messages in order), formats the result with net::FormatControl
-// and parses that with net::ParseReply: equal arrays equal to the plan, finite, >= 50 points.
+// the start of each recording, messages in order), formats the result with wire::FormatControl
+// and parses that with wire::ParseReply: equal arrays equal to the plan, finite, >= 50 points.
 CheckReport CheckProtocol(std::span<const Recording> recordings, plan::Planner& planner);
 
 // --- Frenet -------------------------------------------------------------------------------
@@ -140,7 +140,7 @@ inline constexpr double kSpeedToleranceDigits = 2;
 // k+1| is inferred from the data; the latency split (l_old ticks before the reply, c - l_old
 // after) is not observable, so EVERY split 0 <= l_old < c must reproduce message k+1: the model
 // starts at message k's pose with message k's previous_path, ticks l_old times, applies reply k
-// (parsed with net::ParseReply), ticks c - l_old times; then previous_path, x, y and speed
+// (parsed with wire::ParseReply), ticks c - l_old times; then previous_path, x, y and speed
 // (float32, as printed; speed to kSpeedToleranceDigits) and yaw (kYawToleranceDeg) must equal
 // message k+1's. The first move
 // from the start pose (message k with an empty previous_path) reports a speed that includes the

@@ -1,6 +1,6 @@
-// The in-process drive rounds numbers with wire_precision.h instead of writing and parsing text:
+// The in-process drive rounds numbers with wire/precision.h instead of writing and parsing text:
 // these tests hold it to the wire, bit for bit, so the two cannot drift apart.
-#include "frenetic/wire_precision.h"
+#include "frenetic/wire/precision.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 namespace frenetic::wire {
 namespace {
@@ -170,8 +170,8 @@ TEST(WirePrecisionTest, TelemetryAsReceivedIsWhatParseFrameMakesOfTheFrame) {
   plan::Telemetry received;
   for (int i = 0; i < 300; ++i) {
     const plan::Telemetry t = RandomTelemetry(rng, pool);
-    const net::ParsedFrame parsed = net::ParseFrame(net::FormatTelemetryFrame(t));
-    ASSERT_EQ(parsed.kind, net::FrameKind::kTelemetry) << parsed.error;
+    const wire::ParsedFrame parsed = wire::ParseFrame(wire::FormatTelemetryFrame(t));
+    ASSERT_EQ(parsed.kind, wire::FrameKind::kTelemetry) << parsed.error;
     TelemetryAsReceived(t, &received);
     ExpectSameTelemetry(received, parsed.telemetry);
     if (HasFailure()) FAIL() << "telemetry " << i;
@@ -184,16 +184,16 @@ TEST(WirePrecisionTest, ControlAsReceivedIsWhatParseReplyMakesOfTheControl) {
   pool.insert(pool.end(), random.begin(), random.end());
   std::mt19937_64 rng(11);
   std::string text;
-  net::ParsedReply reply;
+  wire::ParsedReply reply;
   std::vector<double> x, y;
   for (int i = 0; i < 300; ++i) {
     // Mostly writable points, so paths are not all cut at their first point.
     const std::size_t n = rng() % 80;
     std::vector<double> px = RandomValues(n), py = RandomValues(rng() % 5 == 0 ? n + 3 : n);
     for (double& v : px) v = ControlWritable(v) && rng() % 50 != 0 ? v : pool[rng() % pool.size()];
-    const std::size_t written = net::FormatControl(px, py, &text);
-    net::ParseReply(text, &reply);
-    ASSERT_EQ(reply.kind, net::ReplyKind::kControl) << reply.error;
+    const std::size_t written = wire::FormatControl(px, py, &text);
+    wire::ParseReply(text, &reply);
+    ASSERT_EQ(reply.kind, wire::ReplyKind::kControl) << reply.error;
     ControlAsReceived(px, py, &x, &y);
     ASSERT_EQ(x.size(), written);
     ASSERT_EQ(x.size(), reply.x.size());

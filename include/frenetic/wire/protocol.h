@@ -1,6 +1,8 @@
 // The simulator's wire protocol (udacity-sim.md §3): socket.io-flavoured text frames
 // `42["telemetry",{...}]`, `42["control",{"next_x":[...],"next_y":[...]}]`, `42["manual",{}]`.
 // Units on the wire: speed mph, yaw degrees; converted here to and from plan::Telemetry (SI).
+// The codec alone, text in and text out: net/ carries the frames over a WebSocket, the
+// in-process drive (drive/) and the fidelity checks (eval/) use it without one.
 #pragma once
 
 #include <cstddef>
@@ -11,9 +13,9 @@
 
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/status.h"
-#include "frenetic/wire_precision.h"
+#include "frenetic/wire/precision.h"
 
-namespace frenetic::net {
+namespace frenetic::wire {
 
 enum class FrameKind {
   kTelemetry,      // 42["telemetry",{...}] with a usable payload
@@ -63,19 +65,18 @@ ParsedFrame ParseFrame(std::string_view frame, const FrameLimits& limits = {});
 // Appends `42["control",{"next_x":[...],"next_y":[...]}]` to *out (cleared first). Only finite
 // numbers are written; both arrays always have the same length: min(x.size(), y.size()) points,
 // cut before the first point with a non-finite coordinate or one beyond float32 range (which
-// the simulator cannot parse): wire::ControlPoints. Numbers are written with kControlDigits
+// the simulator cannot parse): ControlPoints. Numbers are written with kControlDigits
 // significant digits (far below the float32 resolution the simulator parses to):
-// wire::FormatControlNumber. wire::ControlAsReceived gives the parsed result without the text.
+// FormatControlNumber. ControlAsReceived gives the parsed result without the text.
 // Returns the number of points written.
-inline constexpr int kControlDigits = wire::kControlDigits;
 std::size_t FormatControl(std::span<const double> x, std::span<const double> y, std::string* out);
 inline constexpr std::string_view kManualFrame = R"(42["manual",{}])";
 
 // The telemetry as the simulator writes it (field names and order of §3.3, mph, degrees in
 // [0, 360), numbers as float32 with 7 significant digits like .NET float.ToString(), sensor ids
 // as integers), as the JSON object alone and as a whole frame. Non-finite numbers (which the
-// simulator never sends) are written as 0. Numbers go through wire::FormatTelemetryNumber;
-// wire::TelemetryAsReceived gives what ParseFrame makes of the frame, without the text.
+// simulator never sends) are written as 0. Numbers go through FormatTelemetryNumber;
+// TelemetryAsReceived gives what ParseFrame makes of the frame, without the text.
 std::string TelemetryToJson(const plan::Telemetry& telemetry);
 std::string FormatTelemetryFrame(const plan::Telemetry& telemetry);
 inline constexpr std::string_view kNullTelemetryFrame = R"(42["telemetry",null])";
@@ -105,4 +106,4 @@ struct ParsedReply {
 // ignored, as the simulator reads the two arrays by name. Never throws.
 void ParseReply(std::string_view frame, ParsedReply* out);
 
-}  // namespace frenetic::net
+}  // namespace frenetic::wire

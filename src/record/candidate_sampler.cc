@@ -1,8 +1,8 @@
-#include "report/candidate_sampler.h"
+#include "record/candidate_sampler.h"
 
 #include <utility>
 
-namespace frenetic::report {
+namespace frenetic::record {
 
 void CandidateSampler::Add(CycleCandidates cycle, bool incident, bool lane_change) {
   const int k = cycle.exchange;
@@ -54,4 +54,4 @@ void CandidateSampler::Thin() {
   }
 }
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,4 +1,4 @@
-#include "frenetic/report/record.h"
+#include "frenetic/record/reader.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +9,11 @@
 #include <numbers>
 #include <utility>
 
-#include "report/candidate_sampler.h"
-#include "report/gzip_stream.h"
+#include "frenetic/record/schema.h"
+#include "record/candidate_sampler.h"
+#include "record/gzip_stream.h"
 
-namespace frenetic::report {
+namespace frenetic::record {
 namespace {
 
 using json = nlohmann::json;
@@ -68,9 +69,9 @@ class Reader {
         Skip(line_number, "not a JSON object");
         continue;
       }
-      const std::string type = Str(record, "type");
+      const std::string type = Str(record, key::kType);
       if (!have_header_) {
-        if (type != "header") {
+        if (type != key::kHeader) {
           if (type.empty()) {
             Skip(line_number, "no \"type\"");
             continue;
@@ -85,14 +86,14 @@ class Reader {
                                ": header: " + status.message());
         }
         have_header_ = true;
-      } else if (type == "exchange") {
+      } else if (type == key::kExchange) {
         std::string why = ReadExchange(record);
         if (!why.empty()) Skip(line_number, why);
-      } else if (type == "footer") {
-        const json* report = Field(record, "report");
+      } else if (type == key::kFooter) {
+        const json* report = Field(record, key::kReport);
         run_.has_footer = true;
         run_.footer_json = report != nullptr ? report->dump() : "null";
-      } else if (type == "header") {
+      } else if (type == key::kHeader) {
         Skip(line_number, "a second header");
       } else {
         Skip(line_number, "unknown type \"" + type + "\"");
@@ -125,17 +126,17 @@ class Reader {
 
   Status ReadHeader(const json& h) {
     RecordHeader& header = run_.header;
-    header.version = Int(h, "version", 0);
-    header.map = Str(h, "map");
-    header.scenario = Str(h, "scenario");
-    header.planner = Str(h, "planner");
-    const double seed = Num(h, "seed", 0);
+    header.version = Int(h, key::kVersion, 0);
+    header.map = Str(h, key::kMap);
+    header.scenario = Str(h, key::kScenario);
+    header.planner = Str(h, key::kPlanner);
+    const double seed = Num(h, key::kSeed, 0);
     header.seed = std::isfinite(seed) ? static_cast<std::int64_t>(seed) : 0;
-    header.max_s = Num(h, "max_s", 0);
-    header.lane_width = Num(h, "lane_width", 4.0);
-    header.lanes = Int(h, "lanes", 3);
-    header.car_length = Num(h, "car_length", 4.6);
-    header.car_width = Num(h, "car_width", 2.4);
+    header.max_s = Num(h, key::kMaxS, 0);
+    header.lane_width = Num(h, key::kLaneWidth, 4.0);
+    header.lanes = Int(h, key::kLanes, 3);
+    header.car_length = Num(h, key::kCarLength, 4.6);
+    header.car_width = Num(h, key::kCarWidth, 2.4);
     if (!(header.lane_width > 0 && header.lane_width < 100)) {
       return Status::Error("lane_width must be in (0, 100) m");
     }
@@ -143,7 +144,7 @@ class Reader {
     if (!(header.car_length > 0 && header.car_width > 0)) {
       return Status::Error("car_length and car_width must be > 0");
     }
-    if (const json* c = Field(h, "centerline"); c != nullptr && c->is_array()) {
+    if (const json* c = Field(h, key::kCenterline); c != nullptr && c->is_array()) {
       for (const json& p : *c) {
         if (p.is_array() && p.size() >= 2 && p[0].is_number() && p[1].is_number()) {
           header.center_x.push_back(p[0].get<double>());
@@ -151,30 +152,30 @@ class Reader {
         }
       }
     }
-    if (const json* config = Field(h, "config"); config != nullptr) {
+    if (const json* config = Field(h, key::kConfig); config != nullptr) {
       header.config_json = config->dump();
     }
-    header.world = Str(h, "world");
+    header.world = Str(h, key::kWorld);
     if (header.world.empty()) return Status::Ok();
-    header.problem = Int(h, "problem", -1);
-    header.dt = Num(h, "dt", 0);
-    header.prediction = Str(h, "prediction");
-    header.vehicle = Str(h, "vehicle");
-    if (const json* road = Field(h, "road"); road != nullptr) {
-      if (const json* lanes = Field(*road, "lanes"); lanes != nullptr && lanes->is_array()) {
+    header.problem = Int(h, key::kProblem, -1);
+    header.dt = Num(h, key::kDt, 0);
+    header.prediction = Str(h, key::kPrediction);
+    header.vehicle = Str(h, key::kVehicle);
+    if (const json* road = Field(h, key::kRoad); road != nullptr) {
+      if (const json* lanes = Field(*road, key::kLanes); lanes != nullptr && lanes->is_array()) {
         for (const json& l : *lanes) {
           RecordHeader::Lane lane;
-          lane.left = ReadPolyline(Field(l, "left"));
-          lane.right = ReadPolyline(Field(l, "right"));
+          lane.left = ReadPolyline(Field(l, key::kLeft));
+          lane.right = ReadPolyline(Field(l, key::kRight));
           header.road_lanes.push_back(std::move(lane));
         }
       }
     }
-    if (const json* goals = Field(h, "goals"); goals != nullptr && goals->is_array()) {
+    if (const json* goals = Field(h, key::kGoals); goals != nullptr && goals->is_array()) {
       for (const json& g : *goals) {
         RecordHeader::Goal goal;
         goal.outline = ReadPolyline(&g);
-        if (const json* steps = Field(g, "steps");
+        if (const json* steps = Field(g, key::kSteps);
             steps != nullptr && steps->is_array() && steps->size() == 2 &&
             (*steps)[0].is_number_integer() && (*steps)[1].is_number_integer()) {
           goal.step_lo = (*steps)[0].get<int>();
@@ -230,15 +231,15 @@ class Reader {
 
   // Returns why the exchange is unusable, or an empty string once it has been added.
   std::string ReadExchange(const json& e) {
-    const json* tel = Field(e, "telemetry");
+    const json* tel = Field(e, key::kTelemetry);
     if (tel == nullptr || !tel->is_object()) return "exchange without \"telemetry\"";
     const double x = Num(*tel, "x"), y = Num(*tel, "y");
     if (!std::isfinite(x) || !std::isfinite(y)) return "telemetry.x or telemetry.y missing";
-    const double t = Num(e, "t");
+    const double t = Num(e, key::kTime);
     if (!std::isfinite(t)) return "exchange without a numeric \"t\"";
 
     const int k = run_.size();  // the row being added
-    run_.cycle.push_back(Int(e, "i", k));
+    run_.cycle.push_back(Int(e, key::kCycle, k));
     run_.t.push_back(t);
     run_.x.push_back(x);
     run_.y.push_back(y);
@@ -249,7 +250,7 @@ class Reader {
     run_.d.push_back(d);
 
     static const json kEmpty = json::object();
-    const json* metrics = Field(e, "metrics");
+    const json* metrics = Field(e, key::kMetrics);
     const json& m = metrics != nullptr ? *metrics : kEmpty;
     run_.acc.push_back(Num(m, "acc"));
     run_.jerk.push_back(Num(m, "jerk"));
@@ -262,7 +263,7 @@ class Reader {
     }
     run_.lane.push_back(lane);
 
-    const json* plan = Field(e, "plan");
+    const json* plan = Field(e, key::kPlan);
     const json& p = plan != nullptr ? *plan : kEmpty;
     run_.ms_total.push_back(Num(p, "ms_total"));
     run_.winner_total_cost.push_back(Num(p, "winner_total_cost"));
@@ -300,9 +301,9 @@ class Reader {
       }
     }
 
-    ReadPath(Field(e, "path"));
-    ReadTraffic(Field(*tel, "sensor_fusion"), x, y);
-    ReadIncidents(Field(e, "incidents"), k);
+    ReadPath(Field(e, key::kPath));
+    ReadTraffic(Field(*tel, key::kSensorFusion), x, y);
+    ReadIncidents(Field(e, key::kIncidents), k);
     ReadCandidates(Field(p, "candidates"), k);
     return "";
   }
@@ -470,4 +471,4 @@ StatusOr<RunData> ReadRecordFile(const std::string& path, const ReadOptions& opt
   return ReadRecord(in, path, options);
 }
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,6 +1,6 @@
 // Wire protocol: parse with nlohmann (the whole frame, unlike the starter's substring cut),
 // format with std::to_chars (fast, locale-independent, no allocation beyond the output).
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 #include <algorithm>
 #include <charconv>
@@ -9,7 +9,7 @@
 #include <numbers>
 #include <nlohmann/json.hpp>
 
-namespace frenetic::net {
+namespace frenetic::wire {
 namespace {
 
 using nlohmann::json;
@@ -285,8 +285,8 @@ void ParseTelemetry(const json& payload, const FrameLimits& limits, ParsedFrame*
   }
   if (xs->size() > max_points) return over("previous_path_x", xs->size(), limits.max_path_points);
   if (ys->size() > max_points) return over("previous_path_y", ys->size(), limits.max_path_points);
-  t.yaw = wire::YawFromDegrees(yaw_deg);
-  t.speed = wire::SpeedFromMph(speed_mph);
+  t.yaw = YawFromDegrees(yaw_deg);
+  t.speed = SpeedFromMph(speed_mph);
   Problems repairs;
   ReadPath(*xs, *ys, &t, &repairs);
   t.sensor_fusion.reserve(rows->size());
@@ -305,8 +305,8 @@ void ParseTelemetry(const json& payload, const FrameLimits& limits, ParsedFrame*
 
 // Appends a float32 rendering like .NET float.ToString() ("G7").
 void AppendFloat32(double value, std::string* out) {
-  char buf[wire::kMaxNumberChars];
-  out->append(buf, wire::FormatTelemetryNumber(value, buf));
+  char buf[kMaxNumberChars];
+  out->append(buf, FormatTelemetryNumber(value, buf));
 }
 
 void AppendInt(int value, std::string* out) {
@@ -331,8 +331,8 @@ void AppendTelemetryJson(const plan::Telemetry& t, std::string* out) {
   };
   field("{\"x\":", t.x);
   field(",\"y\":", t.y);
-  field(",\"yaw\":", wire::YawToDegrees(t.yaw));
-  field(",\"speed\":", wire::SpeedToMph(t.speed));
+  field(",\"yaw\":", YawToDegrees(t.yaw));
+  field(",\"speed\":", SpeedToMph(t.speed));
   field(",\"s\":", t.s);
   field(",\"d\":", t.d);
   out->append(",\"previous_path_x\":");
@@ -481,15 +481,15 @@ std::size_t FormatControl(std::span<const double> x, std::span<const double> y,
                           std::string* out) {
   // A coordinate beyond float32 range is one the simulator's float.Parse cannot read (and one
   // near DBL_MAX would round up to an overflowing literal at kControlDigits): cut there too.
-  const std::size_t n = wire::ControlPoints(x, y);
+  const std::size_t n = ControlPoints(x, y);
   out->clear();
   // Up to ~17 characters per number plus separators; reserving avoids regrowth.
   out->reserve(40 + 2 * 18 * n);
   const auto append_array = [out, n](std::span<const double> v) {
-    char buf[wire::kMaxNumberChars];
+    char buf[kMaxNumberChars];
     for (std::size_t i = 0; i < n; ++i) {
       if (i > 0) out->push_back(',');
-      out->append(buf, wire::FormatControlNumber(v[i], buf));
+      out->append(buf, FormatControlNumber(v[i], buf));
     }
   };
   out->append(R"(42["control",{"next_x":[)");
@@ -556,4 +556,4 @@ void ParseReply(std::string_view frame, ParsedReply* out) {
   out->kind = ReplyKind::kControl;
 }
 
-}  // namespace frenetic::net
+}  // namespace frenetic::wire

@@ -1,4 +1,4 @@
-// Which cycles' candidates a report keeps (internal to report): a bounded, evenly spread set,
+// Which cycles' candidates a report keeps (internal to record): a bounded, evenly spread set,
 // chosen while the record streams by, plus the cycles that explain an incident or a lane change.
 #pragma once
 
@@ -7,9 +7,9 @@
 #include <set>
 #include <vector>
 
-#include "frenetic/report/record.h"
+#include "frenetic/record/reader.h"
 
-namespace frenetic::report {
+namespace frenetic::record {
 
 // Cycles before an incident whose candidates are kept with it: the decision that led to an
 // incident is usually made a few cycles earlier.
@@ -47,4 +47,4 @@ class CandidateSampler {
   std::deque<CycleCandidates> recent_;
 };
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,5 +1,5 @@
 // The numbers of the simulator's wire (udacity-sim.md §3.2), in one place for the wire formatter
-// (net/protocol.cc) and the in-process drive (sim/episode.cc), so that a planner driven in
+// (wire/protocol.cc) and the in-process drive (drive/episode.cc), so that a planner driven in
 // process sees exactly the numbers a planner behind `frenetic serve` sees, and the simulator
 // gets exactly the path it would have parsed:
 //  - telemetry: every number is float32 printed with 7 significant digits (.NET
@@ -127,8 +127,8 @@ inline double YawFromDegrees(double deg) { return deg * units::kDegToRad; }
 inline double SpeedToMph(double mps) { return mps * units::kSimMpsToMph; }
 inline double SpeedFromMph(double mph) { return mph / units::kSimMpsToMph; }
 
-// The telemetry as a planner receives it over the wire, i.e. what net::ParseFrame makes of
-// net::FormatTelemetryFrame(in), without the text: every number through AsTelemetryNumber (yaw
+// The telemetry as a planner receives it over the wire, i.e. what ParseFrame makes of
+// FormatTelemetryFrame(in), without the text: every number through AsTelemetryNumber (yaw
 // and speed in degrees and mph on the way), unequal previous_path arrays cut to the shorter one.
 // `out` must not be `in`; its vectors are reused.
 inline void TelemetryAsReceived(const plan::Telemetry& in, plan::Telemetry* out) {
@@ -176,8 +176,8 @@ inline std::size_t ControlPoints(std::span<const double> x, std::span<const doub
   return n;
 }
 
-// The path as the simulator receives it, i.e. what net::ParseReply makes of
-// net::FormatControl(x, y): ControlPoints points, each through AsControlNumber.
+// The path as the simulator receives it, i.e. what ParseReply makes of
+// FormatControl(x, y): ControlPoints points, each through AsControlNumber.
 inline void ControlAsReceived(std::span<const double> x, std::span<const double> y,
                               std::vector<double>* out_x, std::vector<double>* out_y) {
   const std::size_t n = ControlPoints(x, y);

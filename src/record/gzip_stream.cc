@@ -1,6 +1,6 @@
-#include "report/gzip_stream.h"
+#include "record/gzip_stream.h"
 
-namespace frenetic::report {
+namespace frenetic::record {
 
 GzipStreambuf::GzipStreambuf(std::istream& in) : in_(in), in_buf_(256 << 10), out_buf_(256 << 10) {
   // 15 window bits + 32: a gzip (or zlib) header, detected.
@@ -48,4 +48,4 @@ GzipStreambuf::int_type GzipStreambuf::underflow() {
   return traits_type::eof();
 }
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,6 +1,7 @@
-// Reading a drive record (`frenetic drive --record run.jsonl.gz`, JSON lines: one header, one
-// line per exchange, an optional footer; plain text or gzip-compressed, told apart by the first
-// byte, whatever the file's name) into compact columns for the HTML report.
+// Reading a record (schema.h: `frenetic drive --record run.jsonl.gz`, `frenetic commonroad
+// --record DIR`; JSON lines: one header, one line per exchange, an optional footer; plain text or
+// gzip-compressed, told apart by the first byte, whatever the file's name) into compact columns
+// for the HTML report (report/page.h).
 //
 // Units are the record's own, kept as written so the page can show what the simulator measured:
 // positions in m (map frame: x east, y north), time in simulated s, ego yaw in degrees
@@ -16,7 +17,7 @@
 
 #include "frenetic/status.h"
 
-namespace frenetic::report {
+namespace frenetic::record {
 
 // How much of the record is kept. The defaults keep a 10-lap drive (~25,000 exchanges) small
 // enough to open in a browser in well under 3 s.
@@ -168,4 +169,4 @@ StatusOr<RunData> ReadRecord(std::istream& in, std::string_view source,
 // As ReadRecord, from a file; a missing or unreadable file is an error naming it.
 StatusOr<RunData> ReadRecordFile(const std::string& path, const ReadOptions& options = {});
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

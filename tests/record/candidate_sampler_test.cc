@@ -1,12 +1,12 @@
 // The candidate sampler on its own (the reader's tests cover it through records).
-#include "report/candidate_sampler.h"
+#include "record/candidate_sampler.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <vector>
 
-namespace frenetic::report {
+namespace frenetic::record {
 namespace {
 
 CycleCandidates Cycle(int k) {
@@ -59,4 +59,4 @@ TEST(CandidateSamplerTest, LaneChangesHaveTheirOwnBudget) {
 }
 
 }  // namespace
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,5 +1,5 @@
 // The text of a gzip-compressed record (`drive --record run.jsonl.gz`), inflated as it is read
-// (internal to report).
+// (internal to record).
 #pragma once
 
 #include <zlib.h>
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace frenetic::report {
+namespace frenetic::record {
 
 // A read-only streambuf over the inflated bytes of `in` (gzip, or zlib, detected by the
 // header). Concatenated gzip members read as one text. Data that ends early or is corrupt ends
@@ -34,4 +34,4 @@ class GzipStreambuf : public std::streambuf {
   std::string error_;
 };
 
-}  // namespace frenetic::report
+}  // namespace frenetic::record

@@ -1,4 +1,4 @@
-#include "frenetic/net/protocol.h"
+#include "frenetic/wire/protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "frenetic/units.h"
-#include "net/net_test_util.h"
+#include "wire/frames.h"
 
-namespace frenetic::net {
+namespace frenetic::wire {
 namespace {
 
 using nlohmann::json;
@@ -471,4 +471,4 @@ TEST(ProtocolTest, ParseReplyReadsControlAndRejectsWhatTheSimulatorCannotUse) {
 }
 
 }  // namespace
-}  // namespace frenetic::net
+}  // namespace frenetic::wire
