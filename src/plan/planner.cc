@@ -25,15 +25,6 @@ const char* ToString(PlanSummary::Stage stage) {
   return "unknown";
 }
 
-const char* ToString(StrategyPlan::Mode mode) {
-  switch (mode) {
-    case StrategyPlan::Mode::kKeep: return "keep";
-    case StrategyPlan::Mode::kDropBack: return "drop_back";
-    case StrategyPlan::Mode::kSpeedUp: return "speed_up";
-  }
-  return "unknown";
-}
-
 const char* ToString(Reject reason) {
   switch (reason) {
     case Reject::kSpeed: return "speed";

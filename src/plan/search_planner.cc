@@ -26,7 +26,6 @@
 #include "plan/search_refiner.h"
 #include "plan/search_scoring.h"
 #include "plan/search_settings.h"
-#include "plan/search_strategy.h"
 #include "plan/search_workspace.h"
 
 namespace frenetic::plan {
@@ -86,7 +85,6 @@ class SearchPlanner : public Planner {
         costs_(std::move(costs)),
         predictor_(MakePredictor(config, road_, cfg_)),
         ws_(cfg_),
-        strategy_(cfg_, *predictor_, ws_),
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
         checker_(cfg_, *line_, ws_),
@@ -125,7 +123,6 @@ class SearchPlanner : public Planner {
     sim_time_ = NAN;
     none_passed_last_ = false;
     predictor_->Reset();
-    strategy_.Reset();
   }
 
   const PlanResult& Plan(const Telemetry& t) override {
@@ -209,7 +206,6 @@ class SearchPlanner : public Planner {
     predictor_->Observe(WithLaneEnds(t.sensor_fusion, start.s), start.s, sim_time_, t.futures,
                         start.d);
     search::BuildContext(cfg_, *road_, *predictor_, ws_);
-    strategy_.Decide(elapsed, &sum.strategy);
     continuity_.SetXyPrefix(checker_);
     sum.ms_prepare = Elapsed();
 
@@ -304,8 +300,6 @@ class SearchPlanner : public Planner {
     s.refine_iterations = 0;
     s.refine_cost_before = s.refine_cost_after = 0;
     s.points_kept = 0;
-    s.strategy.num_plans = 0;
-    s.strategy.chosen = -1;
     s.deadline_stage = PlanSummary::Stage::kNone;
     s.ms_prepare = s.ms_generate = s.ms_score = s.ms_check = s.ms_refine = s.ms_output = 0;
     s.ms_total = 0;
@@ -595,7 +589,6 @@ class SearchPlanner : public Planner {
   std::unique_ptr<Predictor> predictor_;
   // The stages, in cycle order after the context (search::BuildContext), all on ws_.
   search::Workspace ws_;
-  search::Strategy strategy_;
   search::Lattice lattice_;
   search::Scorer scorer_;
   search::Checker checker_;

@@ -85,16 +85,6 @@ Settings::Settings(const PlannerConfig& c) {
   fallback_jerk = c.value("fallback.jerk");
   fallback_lat_duration = c.value("fallback.lat_duration");
   budget_ms = c.budget_pinned() ? kInf : c.budget_ms();
-  strategy = c.int_value("strategy.enabled") != 0;
-  strategy_horizon = c.value("strategy.horizon");
-  strategy_dt = c.value("strategy.dt");
-  strategy_change_time = c.value("strategy.change_time");
-  strategy_change_cost = c.value("strategy.change_cost");
-  strategy_hold = c.value("strategy.hold");
-  strategy_window = c.value("strategy.window");
-  strategy_terminal_time = c.value("strategy.terminal_time");
-  strategy_gap_cars = c.int_value("strategy.gap_cars");
-  strategy_one_sided = c.int_value("strategy.one_sided") != 0;
 }
 
 Settings::Settings(const PlannerConfig& c, const map::Road& road) : Settings(c) {

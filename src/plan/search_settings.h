@@ -76,12 +76,6 @@ struct Settings {
   double refine_budget_ms;
   double fallback_decel, fallback_jerk, fallback_lat_duration;
   double budget_ms;
-  // strategy.*: the strategic layer (search_strategy.h). Seconds, and metres of progress.
-  bool strategy;
-  double strategy_horizon, strategy_dt, strategy_change_time, strategy_change_cost;
-  double strategy_hold, strategy_window, strategy_terminal_time;
-  int strategy_gap_cars;
-  bool strategy_one_sided;  // no plan's regret above keeping the lane's  // cars of the next lane per side a plan may drop back behind / pass
 
   // On the configured uniform road (road.num_lanes x road.lane_width).
   explicit Settings(const PlannerConfig& c);

@@ -104,8 +104,6 @@ struct Workspace {
   // The goals of this cycle (Telemetry::goals), times relative to the start state.
   cost::GoalRegion goals[cost::kMaxGoalRegions];
   int num_goals = 0;
-  // The strategic layer's lane plan (Strategy::Decide; ctx.strategy points here when it ran).
-  cost::StrategyGoal strategy_goal;
   // Cars the hard checks test against: ctx.num_cars real ones, then the predictor's lane-change
   // ghosts (a hypothesis the plan must survive, not traffic the costs should weigh).
   int num_check_cars = 0;

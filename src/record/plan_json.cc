@@ -149,22 +149,4 @@ nlohmann::json YamlToJson(const std::string& yaml_text) {
   }
 }
 
-nlohmann::json StrategyJson(const plan::StrategySummary& st) {
-  nlohmann::json plans = nlohmann::json::array();
-  for (int i = 0; i < st.num_plans && i < plan::StrategySummary::kMaxPlans; ++i) {
-    const plan::StrategyPlan& p = st.plans[i];
-    nlohmann::json lanes = nlohmann::json::array();
-    for (const int l : p.lanes) {
-      if (l >= 0) lanes.push_back(l);
-    }
-    plans.push_back({{"lanes", lanes},
-                     {"mode", plan::ToString(p.mode)},
-                     {"car", p.car >= 0 ? nlohmann::json(p.car) : nlohmann::json(nullptr)},
-                     {"t_change", p.t_change >= 0 ? Finite(p.t_change) : nlohmann::json(nullptr)},
-                     {"progress", Finite(p.progress)},
-                     {"value", Finite(p.value)}});
-  }
-  return {{"chosen", st.chosen}, {"plans", plans}};
-}
-
 }  // namespace frenetic::record

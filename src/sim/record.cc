@@ -185,10 +185,7 @@ void RecordWriter::WriteExchange(int index, double t, const std::string& telemet
           replica->Trace(frame.kind == wire::FrameKind::kTelemetry ? &frame.telemetry : nullptr,
                          path_x, path_y, index, &summary, &candidates);
         }
-        nlohmann::json plan = record::PlanJson(status, summary, plan_ms, k, candidates);
-        if (summary.strategy.num_plans > 0) {
-          plan["strategy"] = record::StrategyJson(summary.strategy);
-        }
+        const nlohmann::json plan = record::PlanJson(status, summary, plan_ms, k, candidates);
         FormatExchange(index, t, telemetry_json, path_x, path_y, plan, metrics, incidents, line);
       });
 }

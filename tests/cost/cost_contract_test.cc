@@ -23,7 +23,6 @@ constexpr int kN = 25;
 struct Fixture {
   std::vector<double> s, s_d, s_dd, d, d_d, d_dd, car_s, car_d, car_v, prev_s, prev_d;
   std::vector<GoalRegion> goals;
-  std::vector<StrategyGoal> strategy;  // none or one (a vector: its address survives a move)
   CostContext ctx;
   CostInput in;
 
@@ -36,7 +35,6 @@ struct Fixture {
     ctx.previous_d = prev_d.empty() ? nullptr : prev_d.data();
     ctx.num_goals = static_cast<int>(goals.size());
     ctx.goals = goals.empty() ? nullptr : goals.data();
-    ctx.strategy = strategy.empty() ? nullptr : strategy.data();
   }
 };
 
@@ -151,21 +149,6 @@ Fixture RandomFixture(std::mt19937& rng) {
       }
       f.goals.push_back(r);
     }
-  }
-  // The strategic layer's lane plan half the time: options for any lane, some with a window in
-  // s (drop back behind a car, or get ahead of one, by time t).
-  if (u(rng) < 0.5) {
-    StrategyGoal g;
-    g.num_options = static_cast<int>(u(rng) * 6);
-    for (int i = 0; i < g.num_options; ++i) {
-      StrategyOption& o = g.options[i];
-      o.lane = static_cast<int>(u(rng) * 3);
-      o.regret = 60 * u(rng);
-      o.t = 6 * u(rng);
-      if (u(rng) < 0.3) o.s_hi = 150 * u(rng);
-      if (u(rng) < 0.3) o.s_lo = 150 * u(rng);
-    }
-    f.strategy.push_back(g);
   }
   f.Wire();
   // A two-way road's oncoming lane on the left half the time.

@@ -473,7 +473,6 @@ TEST(SearchPlannerTest, NoAllocationAfterWarmUp) {
   for (const int refine : {0, 1}) {
     PlannerConfig config = Config();
     ASSERT_TRUE(config.Set("refine.enabled", refine).ok());
-    ASSERT_TRUE(config.Set("strategy.enabled", 1).ok());  // whatever the shipped default
     auto made = MakePlanner("search", config, line);
     ASSERT_TRUE(made.ok());
     auto planner = std::move(made).value();

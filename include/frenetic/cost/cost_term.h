@@ -24,24 +24,6 @@ namespace frenetic::cost {
 
 inline constexpr int kMaxLanes = 8;
 
-// The strategic layer's lane plan for the cycle (the search planner's Strategy), as the options
-// a candidate can follow: a candidate bound for `lane` follows an option when its s at time t
-// (s after the start, the scoring sample nearest it) is within [s_lo, s_hi] (unwrapped s, as
-// CostContext's; infinite: no bound) — a plan may have to drop back behind a car of the next
-// lane, or get ahead of one, before its lane change. Read by the `strategy` cost term.
-inline constexpr int kMaxStrategyOptions = 24;
-struct StrategyOption {
-  int lane = -1;
-  double regret = 0;  // m of progress over the strategy's horizon lost against its best plan
-  double t = 0;       // s
-  double s_lo = -std::numeric_limits<double>::infinity();
-  double s_hi = std::numeric_limits<double>::infinity();
-};
-struct StrategyGoal {
-  int num_options = 0;
-  StrategyOption options[kMaxStrategyOptions];
-};
-
 // What every term may read about the planning cycle (shared by all candidates). Frenet frame of
 // the reference line, s unwrapped (continuous through the loop's seam), d positive to the right.
 // Sample k of every array is at time t_k = k * dt after the candidates' start state.
@@ -65,8 +47,6 @@ struct CostContext {
   int previous_target_lane = -1;
   double time_since_lane_change = 1e9;
   int lane_before_change = -1;  // lane the latest lane change left (-1: none)
-  // The strategic layer's lane plan (nullptr: none this cycle).
-  const StrategyGoal* strategy = nullptr;
   // Last cycle's chosen trajectory at the same sample times (nullptr when there is none).
   const double* previous_s = nullptr;
   const double* previous_d = nullptr;

@@ -42,30 +42,6 @@ struct CostTermValue {
   double value = 0;  // unweighted; contribution = weight * value
 };
 
-// The strategic layer's decision (the search planner's lane plan over the next
-// strategy.horizon s, on the predicted traffic): the plans it weighed, the best of each kind,
-// and the one chosen. Fixed size: filling it does not allocate.
-struct StrategyPlan {
-  enum class Mode : std::uint8_t {
-    kKeep,      // change lanes as soon as a gap passes the rules of the hard checks (or stay)
-    kDropBack,  // first drop back behind `car` of the next lane, then change in behind it
-    kSpeedUp,   // first get ahead of `car` of the next lane, then change in ahead of it
-  };
-  std::array<int, 2> lanes{-1, -1};  // the lanes it changes to, in order (-1: none: stay)
-  Mode mode = Mode::kKeep;
-  int car = -1;          // the car it drops back behind or gets ahead of (sensor id), else -1
-  double t_change = -1;  // s until its first lane change starts (-1: none within the horizon)
-  double progress = 0;   // m driven over the horizon
-  double value = 0;      // m: progress, plus the end speed's worth, less lane changes
-};
-const char* ToString(StrategyPlan::Mode mode);  // "keep", "drop_back", "speed_up"
-struct StrategySummary {
-  static constexpr int kMaxPlans = 12;
-  int num_plans = 0;  // 0: the strategic layer did not run this cycle
-  int chosen = -1;    // index into plans
-  std::array<StrategyPlan, kMaxPlans> plans{};
-};
-
 struct PlanSummary {
   int candidates_generated = 0;
   int candidates_scored = 0;
@@ -86,7 +62,6 @@ struct PlanSummary {
   // found so far, else last cycle's plan or the braking fallback), refinement (skipped).
   enum class Stage : std::uint8_t { kNone, kScore, kCheck, kRefine };
   Stage deadline_stage = Stage::kNone;
-  StrategySummary strategy;
   // Time per stage, milliseconds.
   double ms_prepare = 0, ms_generate = 0, ms_score = 0, ms_check = 0, ms_refine = 0,
          ms_output = 0, ms_total = 0;

@@ -18,10 +18,6 @@ namespace frenetic::record {
 nlohmann::json PlanJson(plan::PlanStatus status, const plan::PlanSummary& summary, double plan_ms,
                         double time_scale, const std::vector<plan::CandidateTrace>& candidates);
 
-// The strategic layer's decision (a drive's "plan.strategy"): the plans it weighed and the one
-// chosen.
-nlohmann::json StrategyJson(const plan::StrategySummary& strategy);
-
 // The planner YAML as JSON (numbers, booleans, strings, maps, lists); the text itself on error.
 nlohmann::json YamlToJson(const std::string& yaml_text);
 

@@ -33,8 +33,7 @@
 //   "path"         {"x": [...], "y": [...]}: the path sent, m, map frame, a point per 0.02 s
 //   "plan"         PlanJson (plan_json.h): "status", "ms_total" and, from an in-process planner,
 //                  the counts, "rejections" by reason, "winner_costs" [{name, weight, value}],
-//                  the winner's lane, end speed and duration, the refinement, "strategy" (a
-//                  drive's, when the planner weighed lane plans) and "candidates" (best first:
+//                  the winner's lane, end speed and duration, the refinement and "candidates" (best first:
 //                  lane, end_speed, duration, total_cost, checked, winner, reject, reject_car,
 //                  reject_t, x, y at 0.1 m, costs). Times are 0 with timing off, so the same
 //                  seed gives byte-identical records.
