@@ -391,7 +391,7 @@ std::optional<Failure> VerdictChecker::UnavoidableCollision(const PlanningProble
   const double steer_rate = std::max(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
   const double steer_max = std::max(std::abs(p.steering_min), std::abs(p.steering_max));
   const double half_l = 0.5 * p.length, half_w = 0.5 * p.width;
-  const Vec2 along{std::cos(psi0), std::sin(psi0)}, across{-along.y, along.x};
+  const Vec2 along{std::cos(psi0), std::sin(psi0)};
   for (int k = 1; k <= kUnavoidableSteps; ++k) {
     const double t = k * dt;
     // The rear axle's path length (signed) within [x_lo, x_hi], its heading within +-dpsi of
