@@ -17,10 +17,20 @@ import argparse
 import asyncio
 import gzip
 import json
+import os
 import sys
 import time
 
-import websockets
+try:
+    import websockets
+except ImportError:
+    # Debian's python3-websockets is installed for the system interpreter; another python3 first
+    # on PATH (pyenv, a venv) does not see it: run under the system one instead.
+    if os.path.realpath(sys.executable) != os.path.realpath("/usr/bin/python3") and \
+            os.path.exists("/usr/bin/python3"):
+        os.execv("/usr/bin/python3", ["/usr/bin/python3", *sys.argv])
+    sys.exit("serve-replay.py: the python3 websockets module is missing "
+             "(apt-get install python3-websockets)")
 
 
 def exchanges(path):
