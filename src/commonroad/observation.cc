@@ -90,6 +90,19 @@ std::optional<State> StateBefore(const Obstacle& o, int step) {
   return step > INT_MIN ? o.StateAt(step - 1) : std::nullopt;
 }
 
+// Appends the obstacle's state at step q (footprint centre, measured speed and heading) to a
+// recorded future; `prev` is its state a step before (none: the speed as stated).
+Footprint AppendFuture(const Obstacle& o, int q, const State& sq, const std::optional<State>& prev,
+                       double dt, plan::CarFuture* fut) {
+  const Footprint fq = FootprintWith(o, q, sq);
+  const MeasuredVelocity vq = Measure(StatedSpeed(o, q, sq, dt), fq.heading, sq, prev, dt);
+  fut->x.push_back(fq.centre.x);
+  fut->y.push_back(fq.centre.y);
+  fut->v.push_back(vq.speed);
+  fut->heading.push_back(vq.heading);
+  return fq;
+}
+
 }  // namespace
 
 std::optional<Footprint> FootprintAt(const Obstacle& o, int step) {
@@ -148,12 +161,7 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     for (int q = step; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
       const std::optional<State> sq = q == step ? st : o.StateAt(q);
       if (!sq) break;
-      const Footprint fq = FootprintWith(o, q, *sq);
-      const MeasuredVelocity vq = Measure(StatedSpeed(o, q, *sq, dt), fq.heading, *sq, prev, dt);
-      fut.x.push_back(fq.centre.x);
-      fut.y.push_back(fq.centre.y);
-      fut.v.push_back(vq.speed);
-      fut.heading.push_back(vq.heading);
+      AppendFuture(o, q, *sq, prev, dt, &fut);
       prev = sq;
     }
   }
@@ -176,16 +184,11 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     for (int q = first; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
       const std::optional<State> sq = o.StateAt(q);
       if (!sq) break;
-      const Footprint fq = FootprintWith(o, q, *sq);
+      const Footprint fq = AppendFuture(o, q, *sq, prev, dt, &fut);
       if (q == first) {
         fut.length = fq.length;
         fut.width = fq.width;
       }
-      const MeasuredVelocity vq = Measure(StatedSpeed(o, q, *sq, dt), fq.heading, *sq, prev, dt);
-      fut.x.push_back(fq.centre.x);
-      fut.y.push_back(fq.centre.y);
-      fut.v.push_back(vq.speed);
-      fut.heading.push_back(vq.heading);
       prev = sq;
     }
     if (fut.x.empty()) --futures;
