@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sim/incident_judge_internal.h"
+#include "sim/key_set.h"
 
 namespace frenetic::sim {
 namespace judge {
@@ -38,56 +39,6 @@ constexpr int kLookTicks = 80;  // 1.6 s
 constexpr int kLookStep = 5;
 
 double NanToZero(double v) { return std::isnan(v) ? 0.0 : v; }
-
-// A set of 64-bit keys (open addressing, linear probing): the transposition table, probed for
-// every child of every node (std::unordered_set took a sixth of the judging time).
-class KeySet {
- public:
-  void Clear() {
-    slots_.assign(1024, 0);
-    size_ = 0;
-  }
-  bool Contains(std::uint64_t key) const {
-    const std::uint64_t k = key | kUsed;
-    for (std::size_t i = Mix(k) & (slots_.size() - 1);; i = (i + 1) & (slots_.size() - 1)) {
-      if (slots_[i] == k) return true;
-      if (slots_[i] == 0) return false;
-    }
-  }
-  bool Insert(std::uint64_t key) {  // false when already there
-    if (2 * (size_ + 1) > slots_.size()) Grow();
-    const std::uint64_t k = key | kUsed;
-    for (std::size_t i = Mix(k) & (slots_.size() - 1);; i = (i + 1) & (slots_.size() - 1)) {
-      if (slots_[i] == k) return false;
-      if (slots_[i] == 0) {
-        slots_[i] = k;
-        ++size_;
-        return true;
-      }
-    }
-  }
-
- private:
-  static constexpr std::uint64_t kUsed = 1ULL << 63;  // keys use fewer bits: 0 marks a free slot
-  static std::uint64_t Mix(std::uint64_t x) {         // splitmix64's finaliser
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ULL;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
-  }
-  void Grow() {
-    std::vector<std::uint64_t> old;
-    old.swap(slots_);
-    slots_.assign(2 * old.size(), 0);
-    size_ = 0;
-    for (std::uint64_t k : old) {
-      if (k != 0) Insert(k);
-    }
-  }
-  std::vector<std::uint64_t> slots_ = std::vector<std::uint64_t>(1024, 0);
-  std::size_t size_ = 0;
-};
 
 // The simulator's lane and road-edge thresholds of d (IncidentMonitor::Update).
 constexpr std::array<double, 6> kLaneThresholds = {0.8, 3.2, 4.8, 7.2, 8.8, 11.2};
@@ -579,52 +530,6 @@ Status JudgeOptions::Validate() const {
   return Status::Ok();
 }
 
-void IncidentCase::AddTick(const RecordedEgo& e, std::span<const RecordedCar> tick_cars) {
-  ego.push_back(e);
-  cars.insert(cars.end(), tick_cars.begin(), tick_cars.end());
-  car_begin.push_back(static_cast<int>(cars.size()));
-}
-
-void IncidentCase::AddMonitor(std::int64_t tick, const IncidentMonitor& monitor) {
-  monitor_ticks.push_back(tick);
-  monitors.push_back(monitor);
-  monitors.back().ClearLog();
-}
-
-std::span<const RecordedCar> IncidentCase::CarsAt(std::int64_t tick) const {
-  const std::int64_t i = tick - first_tick;
-  if (i < 0 || i + 1 >= static_cast<std::int64_t>(car_begin.size())) return {};
-  return {cars.data() + car_begin[i], cars.data() + car_begin[i + 1]};
-}
-
-const char* ToString(StartResult result) {
-  switch (result) {
-    case StartResult::kAvoidable:
-      return "avoidable";
-    case StartResult::kUnavoidable:
-      return "unavoidable";
-    case StartResult::kUndecided:
-      return "undecided";
-    case StartResult::kInIncident:
-      return "in_incident";
-  }
-  return "?";
-}
-
-const char* ToString(Verdict verdict) {
-  switch (verdict) {
-    case Verdict::kAvoidable:
-      return "avoidable";
-    case Verdict::kUnavoidable:
-      return "unavoidable";
-    case Verdict::kUndecided:
-      return "undecided";
-    case Verdict::kNotJudged:
-      return "not_judged";
-  }
-  return "?";
-}
-
 IncidentJudgement JudgeIncident(const World& world, const IncidentCase& c,
                                 const JudgeOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -697,30 +602,6 @@ IncidentJudgement JudgeIncident(const World& world, const IncidentCase& c,
   }
   j.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return j;
-}
-
-std::string Describe(const IncidentJudgement& j) {
-  switch (j.verdict) {
-    case Verdict::kAvoidable:
-      return fmt::format("avoidable from t = {:.2f} s, last chance {:.2f} s ({:.2f} s before)",
-                         j.avoidable_from, j.last_chance, j.incident_t - j.last_chance);
-    case Verdict::kUnavoidable: {
-      double first = j.incident_t;
-      for (const StartJudgement& s : j.starts) {
-        if (s.result != StartResult::kInIncident) first = std::min(first, s.t);
-      }
-      return fmt::format("unavoidable from every start since t = {:.2f} s: the traffic's", first);
-    }
-    case Verdict::kUndecided: {
-      int out = 0;
-      for (const StartJudgement& s : j.starts) out += s.result == StartResult::kUndecided;
-      return fmt::format("undecided: no escape found, {} of {} searches ran out of budget", out,
-                         j.starts.size());
-    }
-    case Verdict::kNotJudged:
-      break;
-  }
-  return "not judged";
 }
 
 }  // namespace frenetic::sim
