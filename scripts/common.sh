@@ -32,6 +32,7 @@ ensure_packages() {
 }
 
 # configure_and_build [extra cmake args...]
+# Builds the targets named in FRENETIC_TARGETS (space-separated), else everything configured.
 configure_and_build() {
   local generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
@@ -41,8 +42,10 @@ configure_and_build() {
   elif [ $# -gt 0 ]; then
     cmake -S "$FRENETIC_ROOT" -B "$BUILD_DIR" "$@" >/dev/null
   fi
-  log "building with $JOBS jobs"
-  cmake --build "$BUILD_DIR" -j "$JOBS"
+  local targets=()
+  for t in ${FRENETIC_TARGETS:-}; do targets+=(--target "$t"); done
+  log "building ${FRENETIC_TARGETS:-everything} with $JOBS jobs"
+  cmake --build "$BUILD_DIR" -j "$JOBS" "${targets[@]}"
 }
 
 # A separate build with AddressSanitizer + UndefinedBehaviorSanitizer (plus float-to-int overflow,
