@@ -25,6 +25,7 @@
 #include "plan/search_least_harm.h"
 #include "plan/search_refiner.h"
 #include "plan/search_scoring.h"
+#include "plan/search_selection.h"
 #include "plan/search_settings.h"
 #include "plan/search_workspace.h"
 
@@ -36,11 +37,8 @@ using traj::FrenetState;
 using traj::FrenetTrajectory;
 
 // Traced, CheckLazily walks this many ranks in cost order (more when more are traced), then
-// tests the rest by their cost bound; untraced, it tests them all by bound.
+// tests the rest by their cost bound (Selection); untraced, it tests them all by bound.
 constexpr int kCheckRestMin = 4;
-// CheckRest takes this many candidates cheapest bound first, then the rest in any order, when
-// none passed in the last search either.
-constexpr int kRestHeapTests = 64;
 // Lane ends (WithLaneEnds): the id of lane l's car is kLaneEndId - l; it is kLaneEndLength m
 // long; ends within kLaneEndRange m ahead are shown (ends within kLaneEndSlack m of the road's
 // own end are the road's end, not a lane's).
@@ -89,14 +87,12 @@ class SearchPlanner : public Planner {
         scorer_(cfg_, *costs_, ws_, timer_),
         checker_(cfg_, *line_, ws_),
         least_harm_(cfg_, ws_, scorer_, checker_, timer_),
+        selection_(cfg_, ws_, scorer_, checker_, timer_),
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
         continuity_(cfg_, *line_, ws_, timer_) {
     per_term_.assign(costs_->size(), 0.0);
     rows_.reserve(search::kMaxCars + cost::kMaxLanes);
     for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
-    rest_.reserve(ws_.order.capacity());
-    clear_.reserve(ws_.order.capacity());
-    popped_.assign(ws_.order.capacity(), 0);
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -309,7 +305,7 @@ class SearchPlanner : public Planner {
   // first, then the hard limits. False when none passed or the deadline (85% of budget_ms) cut
   // it short (then *over_budget is set). Traced, the traced ranks are checked in cost order,
   // sorting lazily (the trace shows why each was rejected); the rest, and untraced every
-  // candidate, are tested by their cost bound instead (CheckRest), which needs no exact cost
+  // candidate, are tested by their cost bound instead (Selection::CheapestPassing), which needs no exact cost
   // for a candidate that collides: the same winner.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
@@ -322,7 +318,7 @@ class SearchPlanner : public Planner {
       }
       if (r == rest_at) {
         bool cut = false;
-        const int best = CheckRest(r, &cut);
+        const int best = selection_.CheapestPassing(r, none_passed_last_, &sum, &cut);
         if (cut) *over_budget = true;
         if (best < 0) return false;
         ws_.TakeWinner(best);
@@ -368,125 +364,6 @@ class SearchPlanner : public Planner {
       return true;
     }
     return false;
-  }
-
-  // The cheapest candidate of ranks [r0, n) that passes every check, -1 when none does (or the
-  // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
-  // (a heap: only the ones taken are ordered; a coarse bound that comes up is completed and
-  // queued again, so they come up in the order of complete bounds, Scorer::SortUpTo's
-  // argument), and tested for collision; one that does not collide waits in a second heap,
-  // by its bound until it comes up there, then by its exact cost (the same laziness: a clear
-  // one that never comes up is never costed in full). The cheapest waiting one is the
-  // cheapest candidate that does not collide once no bound left ranks before its cost: it is
-  // tested for the hard limits then, and is the answer when it passes (every cheaper one
-  // collides or breaks a limit). So no candidate that collides is costed in full, and only
-  // the cheapest clear ones are converted to XY. After kRestHeapTests the rest are taken in any
-  // order, each skipped when its bound is not below the cost of the cheapest that passed: the same
-  // cheapest one. Every one tested counts as checked, and as rejected when it collides or
-  // breaks a limit (one outranked by a passing one is neither).
-  int CheckRest(int r0, bool* cut) {
-    PlanSummary& sum = result_.summary;
-    const int n = static_cast<int>(ws_.order.size());
-    rest_.clear();
-    clear_.clear();
-    for (int k = r0; k < n; ++k) {
-      const int c = ws_.order[k];
-      rest_.push_back({scorer_.KnownBound(c), c});
-      popped_[c] = 0;
-    }
-    // Min-heaps by (bound, index) and (cost, index): Cheaper's order on exact costs.
-    const auto later = std::greater<std::pair<double, int>>();
-    std::make_heap(rest_.begin(), rest_.end(), later);
-    // Whether c passes the hard limits (counted as feasible or rejected).
-    const auto within_limits = [&](int c) {
-      Reject why = Reject::kCount;
-      if (checker_.CandidateViolation(c, &why) > 0) {
-        ++sum.rejections[static_cast<int>(why)];
-        return false;
-      }
-      ++sum.candidates_feasible;
-      return true;
-    };
-    // Whether c collides (counted as checked, and as rejected when it does).
-    const auto collides = [&](int c) {
-      ++sum.candidates_checked;
-      if (!checker_.CandidateCollides(c)) return false;
-      ++sum.rejections[static_cast<int>(Reject::kCollision)];
-      return true;
-    };
-    // Popped in bound order to the end, unless the last search found none passing either.
-    const int heap_tests = none_passed_last_ ? kRestHeapTests : n;
-    int k = 0;
-    while (k < heap_tests) {
-      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
-        *cut = true;
-        return -1;
-      }
-      if (!clear_.empty() && (rest_.empty() || clear_.front() < rest_.front())) {
-        // A bound until the key is the exact cost (a candidate the traced ranks' sort costed
-        // may wait by its bound too).
-        if (const int c = clear_.front().second;
-            !scorer_.Resolved(c) || clear_.front().first != ws_.cand_cost[c]) {
-          clear_.front().first = scorer_.Advance(c);
-          search::SiftDownTop(clear_.begin(), clear_.end(), later);
-          continue;
-        }
-        std::pop_heap(clear_.begin(), clear_.end(), later);
-        const int c = clear_.back().second;
-        clear_.pop_back();
-        if (within_limits(c)) return c;
-        continue;
-      }
-      if (rest_.empty()) return -1;  // every candidate collides or breaks a limit
-      const int c = rest_.front().second;
-      // A coarse bound is completed before the collision test (the tests then come in a
-      // better order), unless nothing passed last cycle: then mostly every candidate collides,
-      // and the ones that do need no complete bound (any lower bound gives the same answer).
-      if (!none_passed_last_ && !scorer_.BoundComplete(c)) {
-        rest_.front().first = scorer_.Bound(c);
-        search::SiftDownTop(rest_.begin(), rest_.end(), later);
-        continue;
-      }
-      std::pop_heap(rest_.begin(), rest_.end(), later);
-      rest_.pop_back();
-      popped_[c] = 1;
-      ++k;
-      if (collides(c)) continue;
-      clear_.push_back({scorer_.KnownBound(c), c});  // advanced when it comes up
-      std::push_heap(clear_.begin(), clear_.end(), later);
-    }
-    // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
-    // clear ones taken so far in cost order until one passes, then the rest in rank order
-    // (popping each costs more than the order saves; the candidates of a bundle are neighbours
-    // there), each skipped when its bound cannot beat the cheapest that passed.
-    int best = -1;
-    for (auto& e : clear_) e.first = scorer_.ExactCost(e.second);
-    std::sort(clear_.begin(), clear_.end(), later);  // descending: the cheapest last
-    for (; !clear_.empty() && best < 0; clear_.pop_back()) {
-      if (within_limits(clear_.back().second)) best = clear_.back().second;
-    }
-    const auto beaten = [&](double bc, int c) {
-      if (best < 0) return false;
-      const double cost = ws_.cand_cost[best];
-      return bc > cost || (bc == cost && c > best);
-    };
-    for (int e = r0; !rest_.empty() && e < n; ++e, ++k) {
-      if ((k & 31) == 31 && Elapsed() > 0.85 * cfg_.budget_ms) {
-        *cut = true;
-        return -1;
-      }
-      const int c = ws_.order[e];
-      if (popped_[c] || beaten(scorer_.KnownBound(c), c) || beaten(scorer_.Bound(c), c)) continue;
-      if (collides(c)) continue;
-      if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
-        scorer_.ExactCost(c);
-        if (!search::Cheaper(ws_, c, best)) continue;
-      }
-      if (!within_limits(c)) continue;
-      scorer_.ExactCost(c);
-      best = c;
-    }
-    return best;
   }
 
   // The sensor rows plus, for every lane that ends ahead before the road does (a lane drop, an
@@ -593,6 +470,7 @@ class SearchPlanner : public Planner {
   search::Scorer scorer_;
   search::Checker checker_;
   search::LeastHarm least_harm_;
+  search::Selection selection_;
   search::Refiner refiner_;
   search::Continuity continuity_;
 
@@ -601,10 +479,6 @@ class SearchPlanner : public Planner {
   // The road's end: the farthest lane end (a lane ending before it, by more than kLaneEndSlack,
   // ends within the road).
   double road_end_ = -std::numeric_limits<double>::infinity();
-  std::vector<std::pair<double, int>> rest_;   // CheckRest's candidates: a heap by bound
-  std::vector<std::pair<double, int>> clear_;  // CheckRest's collision-free ones: a heap by cost
-                                               // (by a bound until they come up)
-  std::vector<char> popped_;                   // CheckRest: taken from the heap
   bool none_passed_last_ = false;              // the last search's checks found no candidate passing
   CycleTrace* trace_ = nullptr;
   int trace_max_ = 0;

@@ -1,0 +1,122 @@
+#include "plan/search_selection.h"
+
+#include <algorithm>
+#include <functional>
+#include <utility>
+
+namespace frenetic::plan::search {
+
+Selection::Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+                     const CycleClock& clock)
+    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
+  rest_.reserve(ws_.order.capacity());
+  clear_.reserve(ws_.order.capacity());
+  popped_.assign(ws_.order.capacity(), 0);
+}
+
+int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* summary, bool* cut) {
+  PlanSummary& sum = *summary;
+  const int n = static_cast<int>(ws_.order.size());
+  rest_.clear();
+  clear_.clear();
+  for (int k = r0; k < n; ++k) {
+    const int c = ws_.order[k];
+    rest_.push_back({scorer_.KnownBound(c), c});
+    popped_[c] = 0;
+  }
+  // Min-heaps by (bound, index) and (cost, index): Cheaper's order on exact costs.
+  const auto later = std::greater<std::pair<double, int>>();
+  std::make_heap(rest_.begin(), rest_.end(), later);
+  // Whether c passes the hard limits (counted as feasible or rejected).
+  const auto within_limits = [&](int c) {
+    Reject why = Reject::kCount;
+    if (checker_.CandidateViolation(c, &why) > 0) {
+      ++sum.rejections[static_cast<int>(why)];
+      return false;
+    }
+    ++sum.candidates_feasible;
+    return true;
+  };
+  // Whether c collides (counted as checked, and as rejected when it does).
+  const auto collides = [&](int c) {
+    ++sum.candidates_checked;
+    if (!checker_.CandidateCollides(c)) return false;
+    ++sum.rejections[static_cast<int>(Reject::kCollision)];
+    return true;
+  };
+  // Popped in bound order to the end, unless the last search found none passing either.
+  const int heap_tests = none_passed_before ? kRestHeapTests : n;
+  int k = 0;
+  while (k < heap_tests) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *cut = true;
+      return -1;
+    }
+    if (!clear_.empty() && (rest_.empty() || clear_.front() < rest_.front())) {
+      // A bound until the key is the exact cost (a candidate the traced ranks' sort costed
+      // may wait by its bound too).
+      if (const int c = clear_.front().second;
+          !scorer_.Resolved(c) || clear_.front().first != ws_.cand_cost[c]) {
+        clear_.front().first = scorer_.Advance(c);
+        SiftDownTop(clear_.begin(), clear_.end(), later);
+        continue;
+      }
+      std::pop_heap(clear_.begin(), clear_.end(), later);
+      const int c = clear_.back().second;
+      clear_.pop_back();
+      if (within_limits(c)) return c;
+      continue;
+    }
+    if (rest_.empty()) return -1;  // every candidate collides or breaks a limit
+    const int c = rest_.front().second;
+    // A coarse bound is completed before the collision test (the tests then come in a
+    // better order), unless nothing passed last cycle: then mostly every candidate collides,
+    // and the ones that do need no complete bound (any lower bound gives the same answer).
+    if (!none_passed_before && !scorer_.BoundComplete(c)) {
+      rest_.front().first = scorer_.Bound(c);
+      SiftDownTop(rest_.begin(), rest_.end(), later);
+      continue;
+    }
+    std::pop_heap(rest_.begin(), rest_.end(), later);
+    rest_.pop_back();
+    popped_[c] = 1;
+    ++k;
+    if (collides(c)) continue;
+    clear_.push_back({scorer_.KnownBound(c), c});  // advanced when it comes up
+    std::push_heap(clear_.begin(), clear_.end(), later);
+  }
+  // None of the cheapest passed, and none did last cycle: mostly none will (a box-in). The
+  // clear ones taken so far in cost order until one passes, then the rest in rank order
+  // (popping each costs more than the order saves; the candidates of a bundle are neighbours
+  // there), each skipped when its bound cannot beat the cheapest that passed.
+  int best = -1;
+  for (auto& e : clear_) e.first = scorer_.ExactCost(e.second);
+  std::sort(clear_.begin(), clear_.end(), later);  // descending: the cheapest last
+  for (; !clear_.empty() && best < 0; clear_.pop_back()) {
+    if (within_limits(clear_.back().second)) best = clear_.back().second;
+  }
+  const auto beaten = [&](double bc, int c) {
+    if (best < 0) return false;
+    const double cost = ws_.cand_cost[best];
+    return bc > cost || (bc == cost && c > best);
+  };
+  for (int e = r0; !rest_.empty() && e < n; ++e, ++k) {
+    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      *cut = true;
+      return -1;
+    }
+    const int c = ws_.order[e];
+    if (popped_[c] || beaten(scorer_.KnownBound(c), c) || beaten(scorer_.Bound(c), c)) continue;
+    if (collides(c)) continue;
+    if (best >= 0) {  // the cost first once there is one to beat (the limits cost more)
+      scorer_.ExactCost(c);
+      if (!Cheaper(ws_, c, best)) continue;
+    }
+    if (!within_limits(c)) continue;
+    scorer_.ExactCost(c);
+    best = c;
+  }
+  return best;
+}
+
+}  // namespace frenetic::plan::search
