@@ -88,11 +88,14 @@ class Scorer {
   // left it coarse): its exact cost is never below it.
   double Bound(int c) {
     Tighten(c);
-    return bound_[c];
+    return KnownBound(c);
   }
   // Candidate c's lower bound as far as it is known: Bound(c) when that is complete
-  // (BoundComplete), else the coarse one, never above it.
-  double KnownBound(int c) const { return bound_[c]; }
+  // (BoundComplete), else the coarse one, never above it. A cost set without Score() (tests)
+  // is exact, and its own bound.
+  double KnownBound(int c) const {
+    return c < static_cast<int>(bound_.size()) ? bound_[c] : ws_.cand_cost[c];
+  }
   bool BoundComplete(int c) const { return complete_[c] != 0; }
   // Whether candidate c's ws.cand_cost is exact (ExactCost would evaluate nothing).
   bool Resolved(int c) const {

@@ -81,6 +81,21 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   EXPECT_EQ(st.ws.sorted, 0) << "a feasible colliding one is found without the whole ranking";
 }
 
+// The harness sets costs without Scorer::Score (SetCandidates): they are exact, and their own
+// bounds. (Read before Score() had sized the bounds, they were heap garbage: the next test
+// failed or passed with what the previous test left in the heap.)
+TEST(SearchLeastHarmTest, CostsSetWithoutScoringAreTheirOwnBounds) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  Start(st, {});
+  SetCandidates(st, {{20, 3.0, 1.5}, {10, 4.0, 2.5}});
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(st.scorer.KnownBound(c), st.ws.cand_cost[c]);
+    EXPECT_EQ(st.scorer.Bound(c), st.ws.cand_cost[c]);
+    EXPECT_EQ(st.scorer.ExactCost(c), st.ws.cand_cost[c]);
+  }
+}
+
 // check.clear_enough: the cheapest candidate keeping that much room wins over the roomiest.
 TEST(SearchLeastHarmTest, ClearEnoughTakesTheCheapestWithThatMuchRoom) {
   REQUIRE_UDACITY_MAP();
