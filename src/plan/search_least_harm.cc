@@ -73,7 +73,7 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
   const auto later = std::greater<BoundIndex>();
   std::make_heap(rest_.begin(), rest_.end(), later);
   for (int k = 0;; ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return -1;
     }
@@ -204,7 +204,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   heap_.clear();
   int r = 0;
   for (; unbounded && r < n && best < 0; ++r) {
-    if ((r & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((r & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return -1;
     }
@@ -221,7 +221,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   bool done = false;
   visited_.assign(n, 0);
   for (; !heap_.empty() && k < kHeapVisits; ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return -1;
     }
@@ -238,7 +238,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   // The rest in cost order (the candidates of a bundle are neighbours there: their rows stay
   // in cache), skipping the ones visited.
   for (int e = r0; !done && !heap_.empty() && e < n; ++e, ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return -1;
     }
@@ -290,7 +290,7 @@ int LeastHarm::CheapestFeasible(std::vector<BoundIndex>::iterator first,
   std::make_heap(first, last, later);
   int best = -1;
   for (; first != last; ++*k) {
-    if ((*k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((*k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return -1;
     }
@@ -366,7 +366,7 @@ int LeastHarm::LatestContact(bool* over_budget) {
     }
     bounded_ = 0;
     for (int r = 0; r < n; ++r, ++k) {
-      if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
         *over_budget = true;
         return -1;
       }
@@ -392,7 +392,7 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
   first_hit_.resize(n);
   clearance_.resize(n);
   for (int r = 0; r < n; ++r) {
-    if ((r & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((r & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
       return false;
     }
@@ -415,7 +415,7 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
   for (const bool lane_line : {true, false}) {
     if (lane_line && all_known) continue;
     for (int r = 0; r < n; ++r) {
-      if ((r & 7) == 7 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+      if ((r & 7) == 7 && clock_.ChecksOver(cfg_.budget_ms)) {
         *over_budget = true;
         return false;
       }

@@ -312,7 +312,7 @@ class SearchPlanner : public Planner {
     const int n = static_cast<int>(ws_.order.size());
     const int rest_at = trace_ != nullptr ? std::max(kCheckRestMin, trace_max_) : 0;
     for (int r = 0; r < n; ++r) {
-      if ((r & 7) == 7 && Elapsed() > 0.85 * cfg_.budget_ms) {
+      if ((r & 7) == 7 && timer_.ChecksOver(cfg_.budget_ms)) {
         *over_budget = true;
         return false;
       }

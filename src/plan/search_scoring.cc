@@ -206,7 +206,7 @@ bool Scorer::SortUpTo(int rank) {
       SiftDownTop(pending_.begin(), pending_.end(), ByBound{this});
       continue;
     }
-    if ((++resolved & 63) == 0 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;
+    if ((++resolved & 63) == 0 && clock_.ChecksOver(cfg_.budget_ms)) return false;
     std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
     pending_.pop_back();
     Resolve(p);
@@ -225,7 +225,7 @@ bool Scorer::SortUpTo(int rank) {
 
 bool Scorer::ResolveAll() {
   for (int k = 0; !pending_.empty(); ++k) {
-    if ((k & 63) == 63 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) return false;
+    if ((k & 63) == 63 && clock_.ChecksOver(cfg_.budget_ms)) return false;
     std::pop_heap(pending_.begin(), pending_.end(), ByBound{this});
     const int p = pending_.back();
     pending_.pop_back();

@@ -48,7 +48,7 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
   const int heap_tests = none_passed_before ? kRestHeapTests : n;
   int k = 0;
   while (k < heap_tests) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *cut = true;
       return -1;
     }
@@ -101,7 +101,7 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
     return bc > cost || (bc == cost && c > best);
   };
   for (int e = r0; !rest_.empty() && e < n; ++e, ++k) {
-    if ((k & 31) == 31 && clock_.Elapsed() > 0.85 * cfg_.budget_ms) {
+    if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *cut = true;
       return -1;
     }

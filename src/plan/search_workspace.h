@@ -25,6 +25,11 @@ class CycleClock {
   explicit CycleClock(PlannerClock now_ms) : now_ms_(std::move(now_ms)) {}
   void Start() { t0_ = now_ms_(); }
   double Elapsed() const { return now_ms_() - t0_; }
+  // The search's deadline: the checks' share (kChecksShare) of budget_ms spent. Scoring, the
+  // checks, least harm and the selection all stop there (tested every few candidates), so that
+  // the output always fits in the budget.
+  static constexpr double kChecksShare = 0.85;
+  bool ChecksOver(double budget_ms) const { return Elapsed() > kChecksShare * budget_ms; }
 
  private:
   PlannerClock now_ms_;
