@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
@@ -12,16 +13,9 @@
 namespace frenetic::plan {
 namespace {
 
-std::shared_ptr<const map::ReferenceLine> UdacityLine() { return search::testing::UdacityLine(); }
-
-#define REQUIRE_MAP(line)                                                                \
-  auto line = UdacityLine();                                                             \
-  if (line == nullptr) {                                                                 \
-    GTEST_SKIP() << "Udacity map not found at " FRENETIC_SHARED_DIR "/data/highway_map.csv"; \
-  }
-
 TEST(PredictorTest, RepairsGlitchesAndDropsParkedCars) {
-  REQUIRE_MAP(line);
+  REQUIRE_UDACITY_MAP();
+  const auto line = search::testing::UdacityLine();
   PredictorOptions o;
   auto pred = MakeConstantVelocityPredictor(line, o);
   const map::CartesianPose a = line->ToCartesian(200, 6);
@@ -62,7 +56,8 @@ TEST(PredictorTest, RepairsGlitchesAndDropsParkedCars) {
 // The manoeuvre-aware predictor: a braking car keeps braking (for brake_horizon), a car moving
 // across lanes reaches the next lane's centre and stops there.
 TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
-  REQUIRE_MAP(line);
+  REQUIRE_UDACITY_MAP();
+  const auto line = search::testing::UdacityLine();
   PredictorOptions o;
   auto pred = MakeManoeuvrePredictor(line, o);
   const map::CartesianPose p = line->ToCartesian(300, 9.0);
@@ -96,7 +91,8 @@ TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
 // middle lane, to the middle from the outer ones) after the rule's onset; not when the target
 // lane is taken, not without a leader, not within 20 m of the ego.
 TEST(PredictorTest, BrakingCarsBehindALeaderMayChangeLanes) {
-  REQUIRE_MAP(line);
+  REQUIRE_UDACITY_MAP();
+  const auto line = search::testing::UdacityLine();
   PredictorOptions o;
   o.lane_change_ghosts = true;
   // Ego at s = 200. Cars given at t = 0 as (s, d, v), all braking at 3 m/s^2 since then,
