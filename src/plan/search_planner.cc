@@ -305,8 +305,8 @@ class SearchPlanner : public Planner {
   // first, then the hard limits. False when none passed or the deadline (85% of budget_ms) cut
   // it short (then *over_budget is set). Traced, the traced ranks are checked in cost order,
   // sorting lazily (the trace shows why each was rejected); the rest, and untraced every
-  // candidate, are tested by their cost bound instead (Selection::CheapestPassing), which needs no exact cost
-  // for a candidate that collides: the same winner.
+  // candidate, are tested by their cost bound instead (Selection::CheapestPassing), which
+  // needs no exact cost for a candidate that collides: the same winner.
   bool CheckLazily(bool* over_budget) {
     PlanSummary& sum = result_.summary;
     const int n = static_cast<int>(ws_.order.size());

@@ -119,6 +119,13 @@ double Scorer::ExactCost(int c) {
   return ws_.cand_cost[c];
 }
 
+void Scorer::TakeCostsAsExact() {
+  const int n = static_cast<int>(ws_.cand_cost.size());
+  bound_.assign(ws_.cand_cost.begin(), ws_.cand_cost.end());
+  std::fill(resolved_.begin(), resolved_.begin() + std::min<int>(n, resolved_.size()), 1);
+  std::fill(complete_.begin(), complete_.begin() + std::min<int>(n, complete_.size()), 1);
+}
+
 void Scorer::Tighten(int c) {
   if (complete_[c]) return;
   complete_[c] = 1;

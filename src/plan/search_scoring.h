@@ -88,14 +88,14 @@ class Scorer {
   // left it coarse): its exact cost is never below it.
   double Bound(int c) {
     Tighten(c);
-    return KnownBound(c);
+    return bound_[c];
   }
   // Candidate c's lower bound as far as it is known: Bound(c) when that is complete
-  // (BoundComplete), else the coarse one, never above it. A cost set without Score() (tests)
-  // is exact, and its own bound.
-  double KnownBound(int c) const {
-    return c < static_cast<int>(bound_.size()) ? bound_[c] : ws_.cand_cost[c];
-  }
+  // (BoundComplete), else the coarse one, never above it.
+  double KnownBound(int c) const { return bound_[c]; }
+  // In place of Score(), for costs set directly in ws.cand_cost (tests): each is exact and its
+  // own bound, for the candidates of ws.order.
+  void TakeCostsAsExact();
   bool BoundComplete(int c) const { return complete_[c] != 0; }
   // Whether candidate c's ws.cand_cost is exact (ExactCost would evaluate nothing).
   bool Resolved(int c) const {

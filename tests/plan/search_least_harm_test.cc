@@ -36,6 +36,7 @@ void SetCandidates(Stages& st, const std::vector<Option>& options) {
     ws.order.push_back(static_cast<int>(ws.cand_cost.size()));
     ws.cand_cost.push_back(o.cost);
   }
+  st.scorer.TakeCostsAsExact();
 }
 
 void Start(Stages& st, const std::vector<SceneCar>& cars) {
@@ -81,9 +82,9 @@ TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   EXPECT_EQ(st.ws.sorted, 0) << "a feasible colliding one is found without the whole ranking";
 }
 
-// The harness sets costs without Scorer::Score (SetCandidates): they are exact, and their own
-// bounds. (Read before Score() had sized the bounds, they were heap garbage: the next test
-// failed or passed with what the previous test left in the heap.)
+// The harness sets costs without Scorer::Score (SetCandidates, Scorer::TakeCostsAsExact): they
+// are exact, and their own bounds. (Before, the bounds were read unsized: heap garbage, and the
+// next test failed or passed with what the previous test left in the heap.)
 TEST(SearchLeastHarmTest, CostsSetWithoutScoringAreTheirOwnBounds) {
   REQUIRE_UDACITY_MAP();
   Stages st;
