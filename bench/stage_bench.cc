@@ -1,5 +1,5 @@
 // The stages of a planning cycle alone, on the public building blocks the search planner is
-// made of (its stages, src/plan/search_*.h, are private to the plan module; their in-planner
+// made of (its stages, src/plan/search/*.h, are private to the plan module; their in-planner
 // times are the gen_us / score_us / check_us / refine_us counters of BM_Plan*): polynomial
 // solves, bundle generation (solve + sample, the planner's Lattice::Generate work), cost
 // scoring, the collision check, XY feasibility, Frenet <-> XY, NLopt refinement, telemetry

@@ -11,7 +11,7 @@
 #include "frenetic/plan/predictor.h"
 #include "frenetic/units.h"
 #include "plan/predictor_options.h"
-#include "plan/search_planner.h"
+#include "plan/search/planner.h"
 
 namespace frenetic::plan {
 namespace {

@@ -22,8 +22,8 @@
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
 #include "frenetic/units.h"
-#include "plan/search_planner.h"
-#include "plan/search_stages_testing.h"
+#include "plan/search/planner.h"
+#include "plan/search/stages_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../common/malloc_counter.h"
 

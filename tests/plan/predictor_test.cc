@@ -8,7 +8,7 @@
 
 #include "frenetic/map/reference_line.h"
 #include "frenetic/plan/predictor.h"
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan {
 namespace {

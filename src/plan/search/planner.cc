@@ -1,9 +1,9 @@
 // The `search` planner. Werling, Ziegler, Kammel, Thrun, "Optimal Trajectory Generation for
 // Dynamic Street Scenarios in a Frenet Frame", ICRA 2010: 1-D longitudinal and lateral bundles,
 // every pair scored, lazy hard checks in cost order, a backup that always exists. This file is
-// the cycle's orchestration; the stages live in search_*.h (context, lattice, scoring, checks,
+// the cycle's orchestration; the stages live in search/*.h (context, lattice, scoring, checks,
 // least_harm, refiner, fallback, continuity) and share one Workspace.
-#include "plan/search_planner.h"
+#include "plan/search/planner.h"
 
 #include <algorithm>
 #include <chrono>
@@ -17,17 +17,17 @@
 #include "frenetic/plan/predictor.h"
 #include "frenetic/traj/frenet.h"
 #include "plan/predictor_options.h"
-#include "plan/search_checks.h"
-#include "plan/search_context.h"
-#include "plan/search_continuity.h"
-#include "plan/search_fallback.h"
-#include "plan/search_lattice.h"
-#include "plan/search_least_harm.h"
-#include "plan/search_refiner.h"
-#include "plan/search_scoring.h"
-#include "plan/search_selection.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/context.h"
+#include "plan/search/continuity.h"
+#include "plan/search/fallback.h"
+#include "plan/search/lattice.h"
+#include "plan/search/least_harm.h"
+#include "plan/search/refiner.h"
+#include "plan/search/scoring.h"
+#include "plan/search/selection.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan {
 namespace {

@@ -18,8 +18,8 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/box.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

@@ -1,4 +1,4 @@
-#include "plan/search_continuity.h"
+#include "plan/search/continuity.h"
 
 #include <algorithm>
 #include <cmath>

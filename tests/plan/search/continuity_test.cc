@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {

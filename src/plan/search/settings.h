@@ -1,6 +1,6 @@
 // The search planner's settings, read once from PlannerConfig (SI units: the configured mph
 // speed limit is converted here), and the fixed constants its stages share. Private to
-// src/plan/: the stages of the search planner (search_*.h) live in frenetic::plan::search.
+// src/plan/: the stages of the search planner (search/*.h) live in frenetic::plan::search.
 #pragma once
 
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "plan/search_refiner.h"
+#include "plan/search/refiner.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
-#include "plan/search_lattice.h"
+#include "plan/search/lattice.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "plan/search_context.h"
-#include "plan/search_scoring.h"
-#include "plan/search_workspace.h"
+#include "plan/search/context.h"
+#include "plan/search/scoring.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 namespace {

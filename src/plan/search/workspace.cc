@@ -1,4 +1,4 @@
-#include "plan/search_workspace.h"
+#include "plan/search/workspace.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "plan/search_selection.h"
+#include "plan/search/selection.h"
 
 #include <algorithm>
 #include <functional>

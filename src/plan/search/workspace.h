@@ -12,9 +12,9 @@
 
 #include "frenetic/cost/cost_term.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_lattice.h"
-#include "plan/search_planner.h"
-#include "plan/search_settings.h"
+#include "plan/search/lattice.h"
+#include "plan/search/planner.h"
+#include "plan/search/settings.h"
 
 namespace frenetic::plan::search {
 

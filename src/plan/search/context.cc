@@ -1,4 +1,4 @@
-#include "plan/search_context.h"
+#include "plan/search/context.h"
 
 #include <algorithm>
 #include <cmath>

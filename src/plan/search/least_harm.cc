@@ -1,4 +1,4 @@
-#include "plan/search_least_harm.h"
+#include "plan/search/least_harm.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "frenetic/plan/planner.h"
-#include "plan/search_scoring.h"
+#include "plan/search/scoring.h"
 
 namespace frenetic::plan::search {
 
@@ -57,7 +57,7 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
 
 int LeastHarm::CheapestClearEnough(bool* over_budget) {
   // The cheapest candidate (exact cost, then index) that passes the three tests, found as
-  // CheckRest finds the cheapest feasible one: the candidates come off a heap by cost bound,
+  // Selection::CheapestPassing finds the cheapest feasible one: the candidates come off a heap by cost bound,
   // the cheap tests first (bare boxes, clearance), and one that passes them waits in a second
   // heap, by a bound raised one term at a time until it is its exact cost; the top of that
   // heap, once no bound left ranks before it, is tested for the limits (the dearest test) and

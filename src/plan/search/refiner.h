@@ -12,11 +12,11 @@
 
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_checks.h"
-#include "plan/search_lattice.h"
-#include "plan/search_scoring.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/lattice.h"
+#include "plan/search/scoring.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

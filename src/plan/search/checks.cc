@@ -1,4 +1,4 @@
-#include "plan/search_checks.h"
+#include "plan/search/checks.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {
@@ -239,7 +239,7 @@ TEST(SearchLeastHarmTest, ClearEnoughIsTheCheapestThatPassesAfterTheLazyCheck) {
     st.Prepare({kS, 8.0 + scene % 12, 0, st.ws.lane_center[1], 0, 0}, cars);
     st.lattice.Generate();
     ASSERT_TRUE(st.scorer.Score());
-    // As CheckRest does: some bounds completed, some raised a term or more.
+    // As Selection::CheapestPassing does: some bounds completed, some raised a term or more.
     for (const int c : st.ws.order) {
       if (pick(rng) < 0.5) st.scorer.Bound(c);
       if (pick(rng) < 0.5) st.scorer.Advance(c);

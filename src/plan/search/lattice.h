@@ -8,7 +8,7 @@
 #include "frenetic/cost/cost_term.h"
 #include "frenetic/plan/predictor.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_settings.h"
+#include "plan/search/settings.h"
 
 namespace frenetic::plan::search {
 

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "frenetic/plan/planner.h"
-#include "plan/search_checks.h"
-#include "plan/search_scoring.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/scoring.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

@@ -11,9 +11,9 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_checks.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

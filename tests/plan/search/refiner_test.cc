@@ -2,7 +2,7 @@
 // collision, the parameters map back to the winner, and braking is sent as sampled.
 #include <gtest/gtest.h>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {

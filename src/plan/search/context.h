@@ -6,8 +6,8 @@
 
 #include "frenetic/map/road.h"
 #include "frenetic/plan/predictor.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

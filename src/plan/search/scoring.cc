@@ -1,4 +1,4 @@
-#include "plan/search_scoring.h"
+#include "plan/search/scoring.h"
 
 #include <algorithm>
 

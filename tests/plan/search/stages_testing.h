@@ -1,6 +1,6 @@
 // The search planner's stages wired as the planner wires them, on the Udacity map, with a
 // fake clock (a cycle never runs out of time unless a test moves `now_ms`) and a
-// constant-velocity predictor: for the per-stage tests (search_*_test.cc).
+// constant-velocity predictor: for the per-stage tests (search/*_test.cc).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -15,15 +15,15 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
-#include "plan/search_checks.h"
-#include "plan/search_context.h"
-#include "plan/search_continuity.h"
-#include "plan/search_lattice.h"
-#include "plan/search_least_harm.h"
-#include "plan/search_refiner.h"
-#include "plan/search_scoring.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/context.h"
+#include "plan/search/continuity.h"
+#include "plan/search/lattice.h"
+#include "plan/search/least_harm.h"
+#include "plan/search/refiner.h"
+#include "plan/search/scoring.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search::testing {
 

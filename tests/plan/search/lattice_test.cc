@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {

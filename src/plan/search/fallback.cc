@@ -1,10 +1,10 @@
-#include "plan/search_fallback.h"
+#include "plan/search/fallback.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "frenetic/plan/planner.h"
-#include "plan/search_context.h"
+#include "plan/search/context.h"
 
 namespace frenetic::plan::search {
 

@@ -1,4 +1,4 @@
-#include "plan/search_settings.h"
+#include "plan/search/settings.h"
 
 #include <algorithm>
 #include <limits>

@@ -2,9 +2,9 @@
 // still clear of traffic (after a search cut short by the deadline), else keep-lane braking.
 #pragma once
 
-#include "plan/search_checks.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/checks.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

@@ -10,8 +10,8 @@
 #include "frenetic/cost/cost_set.h"
 #include "frenetic/cost/cost_term.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search_settings.h"
-#include "plan/search_workspace.h"
+#include "plan/search/settings.h"
+#include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
 

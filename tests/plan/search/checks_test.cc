@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "plan/search_stages_testing.h"
+#include "plan/search/stages_testing.h"
 
 namespace frenetic::plan::search {
 namespace {
