@@ -248,4 +248,40 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   c.goals = ws.goals;
 }
 
+LaneEnds::LaneEnds(const map::Road& road)
+    : road_(road), road_end_(-std::numeric_limits<double>::infinity()) {
+  rows_.reserve(kMaxCars + cost::kMaxLanes);
+  for (int l = 0; l < road_.num_lanes(); ++l) road_end_ = std::max(road_end_, road_.LaneEnd(l));
+}
+
+std::span<const SensorCar> LaneEnds::With(const std::vector<SensorCar>& rows, double start_s) {
+  if (road_.uniform()) return rows;
+  rows_.assign(rows.begin(), rows.begin() + std::min<std::size_t>(rows.size(), kMaxCars));
+  const map::ReferenceLine& line = road_.line();
+  for (int l = 0; l < road_.num_lanes(); ++l) {
+    // The lane's wall (a closed end of the map), or its own end before the road's.
+    double end = road_.Wall(l);
+    if (road_.LaneEnd(l) < road_end_ - kLaneEndSlack) end = std::min(end, road_.LaneEnd(l));
+    if (!std::isfinite(end) || end < start_s - kLaneEndSlack || end > start_s + kLaneEndRange) {
+      continue;
+    }
+    // The car fills the lane's last kLaneEndLength m (inside the road, where the predictor
+    // keeps it).
+    const double s_car = end - 0.5 * kLaneEndLength;
+    const map::Road::Span at = road_.LaneAt(l, s_car);
+    if (!at.exists) continue;
+    const map::CartesianPose p = line.ToCartesian(s_car, at.centre());
+    SensorCar c;
+    c.id = kLaneEndId - l;
+    c.x = p.x;
+    c.y = p.y;
+    c.s = s_car;
+    c.d = at.centre();
+    c.length = kLaneEndLength;
+    c.width = std::max(at.width() - 0.2, 0.5);
+    rows_.push_back(c);
+  }
+  return rows_;
+}
+
 }  // namespace frenetic::plan::search

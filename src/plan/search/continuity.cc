@@ -236,4 +236,30 @@ void Continuity::SearchDone(const Telemetry& t, bool can_reuse) {
   Snapshot(t);
 }
 
+traj::FrenetState Continuity::MeasuredStart(const Telemetry& t, bool ego_ok) const {
+  traj::FrenetState start;
+  if (ego_ok) {
+    const double hint = have_plan_ ? plan_s_[0] : t.s;
+    const map::FrenetPoint f = line_.ToFrenet(t.x, t.y, hint);
+    const map::RefSample c = line_.At(f.s);
+    const double rel = t.yaw - c.heading;
+    const double v = std::max(t.speed, 0.0);
+    // The measured speed is the XY one: on a path at offset d the XY speed is
+    // s' (1 + kappa d) (d to the right, kappa positive to the left), so on a bend's outer
+    // lane s' is below it. Taking s' as the XY speed started every candidate there a few
+    // percent too fast, over the speed limit near it (a previous path not ours, on a bend).
+    const double stretch = 1.0 + c.kappa * f.d;
+    const double along = std::isfinite(stretch) && stretch > 0.5 ? 1.0 / stretch : 1.0;
+    start = {f.s, v * std::cos(rel) * along, 0.0, f.d, -v * std::sin(rel), 0.0};
+  } else {
+    start = {0.0, 0.0, 0.0, ws_.lane_center[std::min(1, cfg_.num_lanes - 1)], 0.0, 0.0};
+  }
+  if (!start.IsFinite()) start = {0.0, 0.0, 0.0, ws_.lane_center[0], 0.0, 0.0};
+  // s' and d' from the measured heading can be off on the very first tick; the lattice
+  // starts from rest in d' to avoid sweeping across the road.
+  start.d_d = std::clamp(start.d_d, -2.0, 2.0);
+  start.s_d = std::clamp(start.s_d, 0.0, cfg_.max_speed);
+  return start;
+}
+
 }  // namespace frenetic::plan::search

@@ -47,6 +47,10 @@ class Continuity {
   traj::FrenetState KeepPoints(int consumed, int kept, double* elapsed);
   // After losing sync: no history, the lane-line timer restarts.
   void Desync();
+  // The start state when previous_path is not the stored plan's rest: from the measured pose
+  // and speed (ego_ok), the lateral rate clamped to +-2 m/s and s' to [0, max_speed]; with an
+  // unusable pose, at rest in the middle lane.
+  traj::FrenetState MeasuredStart(const Telemetry& t, bool ego_ok) const;
   // Keeps start.s in [0, L): shifts it, the kept points and ws.prev_traj by whole loops.
   void Rebase(traj::FrenetState& start, int kept);
   // Gives the checker the XY prefix of every candidate: history, then the kept points.

@@ -27,6 +27,7 @@
 #include "plan/search/scoring.h"
 #include "plan/search/selection.h"
 #include "plan/search/settings.h"
+#include "plan/search/tracer.h"
 #include "plan/search/workspace.h"
 
 namespace frenetic::plan {
@@ -36,16 +37,6 @@ using search::Finite;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
 
-// Traced, CheckLazily walks this many ranks in cost order (more when more are traced), then
-// tests the rest by their cost bound (Selection); untraced, it tests them all by bound.
-constexpr int kCheckRestMin = 4;
-// Lane ends (WithLaneEnds): the id of lane l's car is kLaneEndId - l; it is kLaneEndLength m
-// long; ends within kLaneEndRange m ahead are shown (ends within kLaneEndSlack m of the road's
-// own end are the road's end, not a lane's).
-constexpr int kLaneEndId = -1000;
-constexpr double kLaneEndLength = 1.0;
-constexpr double kLaneEndRange = 250.0;
-constexpr double kLaneEndSlack = 1.0;
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -86,13 +77,13 @@ class SearchPlanner : public Planner {
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
         checker_(cfg_, *line_, ws_),
+        tracer_(cfg_, ws_, scorer_, *costs_, *line_, *predictor_),
+        selection_(cfg_, ws_, scorer_, checker_, tracer_, timer_),
         least_harm_(cfg_, ws_, scorer_, checker_, timer_),
-        selection_(cfg_, ws_, scorer_, checker_, timer_),
         refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
-        continuity_(cfg_, *line_, ws_, timer_) {
+        continuity_(cfg_, *line_, ws_, timer_),
+        lane_ends_(*road_) {
     per_term_.assign(costs_->size(), 0.0);
-    rows_.reserve(search::kMaxCars + cost::kMaxLanes);
-    for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
     result_.x.reserve(cfg_.output_points + 1);
     result_.y.reserve(cfg_.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
@@ -106,8 +97,7 @@ class SearchPlanner : public Planner {
   std::string_view name() const override { return "search"; }
 
   void set_trace(CycleTrace* trace, int max_candidates) override {
-    trace_ = trace;
-    trace_max_ = max_candidates;
+    tracer_.Attach(trace, max_candidates);
   }
 
   void Reset() override {
@@ -128,7 +118,7 @@ class SearchPlanner : public Planner {
     result_.status = PlanStatus::kOk;
     result_.x.clear();
     result_.y.clear();
-    if (trace_ != nullptr) trace_->candidates.clear();
+    tracer_.Clear();
 
     const bool ego_ok = Finite(t.x) && Finite(t.y) && Finite(t.yaw) && Finite(t.speed) &&
                         std::abs(t.x) < 1e6 && std::abs(t.y) < 1e6 && t.speed > -1 && t.speed < 100;
@@ -158,27 +148,7 @@ class SearchPlanner : public Planner {
     } else {
       continuity_.Desync();
       ws_.have_prev_traj = false;
-      if (ego_ok) {
-        const double hint = continuity_.have_plan() ? continuity_.plan_s(0) : t.s;
-        const map::FrenetPoint f = line_->ToFrenet(t.x, t.y, hint);
-        const map::RefSample c = line_->At(f.s);
-        const double rel = t.yaw - c.heading;
-        const double v = std::max(t.speed, 0.0);
-        // The measured speed is the XY one: on a path at offset d the XY speed is
-        // s' (1 + kappa d) (d to the right, kappa positive to the left), so on a bend's outer
-        // lane s' is below it. Taking s' as the XY speed started every candidate there a few
-        // percent too fast, over the speed limit near it (a previous path not ours, on a bend).
-        const double stretch = 1.0 + c.kappa * f.d;
-        const double along = std::isfinite(stretch) && stretch > 0.5 ? 1.0 / stretch : 1.0;
-        start = {f.s, v * std::cos(rel) * along, 0.0, f.d, -v * std::sin(rel), 0.0};
-      } else {
-        start = {0.0, 0.0, 0.0, ws_.lane_center[std::min(1, cfg_.num_lanes - 1)], 0.0, 0.0};
-      }
-      if (!start.IsFinite()) start = {0.0, 0.0, 0.0, ws_.lane_center[0], 0.0, 0.0};
-      // s' and d' from the measured heading can be off on the very first tick; the lattice
-      // starts from rest in d' to avoid sweeping across the road.
-      start.d_d = std::clamp(start.d_d, -2.0, 2.0);
-      start.s_d = std::clamp(start.s_d, 0.0, cfg_.max_speed);
+      start = continuity_.MeasuredStart(t, ego_ok);
       invalid = invalid || !ego_ok;
     }
     if (line_->closed() && (start.s >= line_->length() || start.s < 0)) {
@@ -199,7 +169,7 @@ class SearchPlanner : public Planner {
 
     // Prediction (relative to the start state's s; the observation is "now"), with the ends of
     // lanes that end ahead as cars at rest.
-    predictor_->Observe(WithLaneEnds(t.sensor_fusion, start.s), start.s, sim_time_, t.futures,
+    predictor_->Observe(lane_ends_.With(t.sensor_fusion, start.s), start.s, sim_time_, t.futures,
                         start.d);
     search::BuildContext(cfg_, *road_, *predictor_, ws_);
     continuity_.SetXyPrefix(checker_);
@@ -222,7 +192,7 @@ class SearchPlanner : public Planner {
       const double t_check = Elapsed();
       bool check_cut = false;
       const bool none_passed_before = none_passed_last_;
-      found = CheckLazily(&check_cut);
+      found = selection_.Select(none_passed_before, &sum, &check_cut);
       none_passed_last_ = !found && !check_cut;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut, none_passed_before);
       if (check_cut) {
@@ -301,135 +271,6 @@ class SearchPlanner : public Planner {
     s.ms_total = 0;
   }
 
-  // Finds the cheapest candidate that passes every check: the Frenet-only collision test
-  // first, then the hard limits. False when none passed or the deadline (85% of budget_ms) cut
-  // it short (then *over_budget is set). Traced, the traced ranks are checked in cost order,
-  // sorting lazily (the trace shows why each was rejected); the rest, and untraced every
-  // candidate, are tested by their cost bound instead (Selection::CheapestPassing), which
-  // needs no exact cost for a candidate that collides: the same winner.
-  bool CheckLazily(bool* over_budget) {
-    PlanSummary& sum = result_.summary;
-    const int n = static_cast<int>(ws_.order.size());
-    const int rest_at = trace_ != nullptr ? std::max(kCheckRestMin, trace_max_) : 0;
-    for (int r = 0; r < n; ++r) {
-      if ((r & 7) == 7 && timer_.ChecksOver(cfg_.budget_ms)) {
-        *over_budget = true;
-        return false;
-      }
-      if (r == rest_at) {
-        bool cut = false;
-        const int best = selection_.CheapestPassing(r, none_passed_last_, &sum, &cut);
-        if (cut) *over_budget = true;
-        if (best < 0) return false;
-        ws_.TakeWinner(best);
-        return true;
-      }
-      if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
-        *over_budget = true;
-        return false;
-      }
-      const int c = ws_.order[r];
-      ++sum.candidates_checked;
-      // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
-      // conversion for the many candidates that run into traffic.
-      // Past the traced ranks, whether it collides is all the walk needs.
-      int hit_car = -1, hit = ws_.n_steps + 1;
-      if (trace_ != nullptr && r < trace_max_) {
-        hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
-                                      ws_.CheckSteps(c));
-      } else {
-        hit = checker_.CandidateCollides(c) ? 1 : hit;
-      }
-      if (hit <= ws_.n_steps) {
-        ++sum.rejections[static_cast<int>(Reject::kCollision)];
-        Trace(r, false, static_cast<int>(Reject::kCollision), hit_car,
-              hit * ws_.collision_step * kTickSeconds);
-        continue;
-      }
-      Reject why = Reject::kCount;
-      if (checker_.CandidateViolation(c, &why) > 0) {
-        ++sum.rejections[static_cast<int>(why)];
-        Trace(r, false, static_cast<int>(why));
-        continue;
-      }
-      ++sum.candidates_feasible;
-      ws_.TakeWinner(c);
-      Trace(r, true, -1);
-      for (int rr = r + 1;
-           rr < n && trace_ != nullptr && static_cast<int>(trace_->candidates.size()) < trace_max_;
-           ++rr) {
-        if (!scorer_.SortUpTo(rr)) break;
-        Trace(rr, false, -1);
-      }
-      return true;
-    }
-    return false;
-  }
-
-  // The sensor rows plus, for every lane that ends ahead before the road does (a lane drop, an
-  // on-ramp's end) or at a wall (the map's closed end), a car at rest in its last metre: the
-  // lattice follows and stops for it, the costs and checks see the lane as blocked there, as a
-  // driver sees a lane drop. Rows are returned as they are on a road whose lanes never end.
-  std::span<const SensorCar> WithLaneEnds(const std::vector<SensorCar>& rows, double start_s) {
-    if (road_->uniform()) return rows;
-    rows_.assign(rows.begin(), rows.begin() + std::min<std::size_t>(rows.size(), search::kMaxCars));
-    for (int l = 0; l < road_->num_lanes(); ++l) {
-      // The lane's wall (a closed end of the map), or its own end before the road's.
-      double end = road_->Wall(l);
-      if (road_->LaneEnd(l) < road_end_ - kLaneEndSlack) end = std::min(end, road_->LaneEnd(l));
-      if (!std::isfinite(end) || end < start_s - kLaneEndSlack || end > start_s + kLaneEndRange) {
-        continue;
-      }
-      // The car fills the lane's last kLaneEndLength m (inside the road, where the predictor
-      // keeps it).
-      const double s_car = end - 0.5 * kLaneEndLength;
-      const map::Road::Span at = road_->LaneAt(l, s_car);
-      if (!at.exists) continue;
-      const map::CartesianPose p = line_->ToCartesian(s_car, at.centre());
-      SensorCar c;
-      c.id = kLaneEndId - l;
-      c.x = p.x;
-      c.y = p.y;
-      c.s = s_car;
-      c.d = at.centre();
-      c.length = kLaneEndLength;
-      c.width = std::max(at.width() - 0.2, 0.5);
-      rows_.push_back(c);
-    }
-    return rows_;
-  }
-
-  // car: context index of the car a collision rejection is against (-1: none), at time t.
-  void Trace(int rank, bool winner, int reject, int car = -1, double t = 0) {
-    if (trace_ == nullptr || static_cast<int>(trace_->candidates.size()) >= trace_max_) return;
-    const int c = ws_.order[rank];
-    CandidateTrace ct;
-    ct.lane = ws_.lat[ws_.cand_lat[c]].lane;
-    const search::LonTraj& lt = ws_.lon[ws_.cand_lon[c]];
-    ct.end_speed = lt.traj.poly.V(lt.traj.duration);
-    ct.duration = lt.traj.duration;
-    ct.total_cost = ws_.cand_cost[c];
-    ct.checked = winner || reject >= 0;
-    ct.winner = winner;
-    ct.reject = reject;
-    if (car >= 0) {
-      ct.reject_car = predictor_->cars()[ws_.car_index[car]].id;
-      ct.reject_time = t;
-    }
-    const FrenetTrajectory tr = ws_.Candidate(c);
-    for (double tt = 0; tt <= cfg_.score_horizon + 1e-9; tt += 0.25) {
-      const FrenetState st = tr.At(tt);
-      const map::CartesianPose p = line_->ToCartesian(st.s, st.d);
-      ct.x.push_back(p.x);
-      ct.y.push_back(p.y);
-    }
-    costs_->Evaluate(ws_.ctx, scorer_.InputFor(ws_.cand_lon[c], ws_.cand_lat[c]), per_term_.data());
-    for (int i = 0; i < costs_->size(); ++i) {
-      ct.costs.push_back({costs_->name(i), costs_->weight(i), per_term_[i]});
-    }
-    trace_->candidates.push_back(std::move(ct));
-  }
-
   // Remembers the winner's lane decision (the lane-change timer starts when the target lane
   // changes) and trajectory for the next cycles.
   void RecordDecision(int lane) {
@@ -469,19 +310,15 @@ class SearchPlanner : public Planner {
   search::Lattice lattice_;
   search::Scorer scorer_;
   search::Checker checker_;
-  search::LeastHarm least_harm_;
+  search::Tracer tracer_;
   search::Selection selection_;
+  search::LeastHarm least_harm_;
   search::Refiner refiner_;
   search::Continuity continuity_;
+  search::LaneEnds lane_ends_;
 
-  std::vector<double> per_term_;  // unweighted term values (Trace, EvaluateWinnerCosts)
-  std::vector<SensorCar> rows_;   // WithLaneEnds' rows
-  // The road's end: the farthest lane end (a lane ending before it, by more than kLaneEndSlack,
-  // ends within the road).
-  double road_end_ = -std::numeric_limits<double>::infinity();
+  std::vector<double> per_term_;  // unweighted term values (EvaluateWinnerCosts)
   bool none_passed_last_ = false;              // the last search's checks found no candidate passing
-  CycleTrace* trace_ = nullptr;
-  int trace_max_ = 0;
   double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
   PlanResult result_;
 };

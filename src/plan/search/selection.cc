@@ -7,11 +7,69 @@
 namespace frenetic::plan::search {
 
 Selection::Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
-                     const CycleClock& clock)
-    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
+                     Tracer& tracer, const CycleClock& clock)
+    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), tracer_(tracer), clock_(clock) {
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   popped_.assign(ws_.order.capacity(), 0);
+}
+
+bool Selection::Select(bool none_passed_before, PlanSummary* summary, bool* over_budget) {
+  PlanSummary& sum = *summary;
+  const int n = static_cast<int>(ws_.order.size());
+  const int traced = tracer_.on() ? tracer_.max_candidates() : 0;
+  const int rest_at = tracer_.on() ? std::max(kTracedRanksMin, traced) : 0;
+  for (int r = 0; r < n; ++r) {
+    if ((r & 7) == 7 && clock_.ChecksOver(cfg_.budget_ms)) {
+      *over_budget = true;
+      return false;
+    }
+    if (r == rest_at) {
+      bool cut = false;
+      const int best = CheapestPassing(r, none_passed_before, &sum, &cut);
+      if (cut) *over_budget = true;
+      if (best < 0) return false;
+      ws_.TakeWinner(best);
+      return true;
+    }
+    if (!scorer_.SortUpTo(r)) {  // costing the next candidates ran into the deadline
+      *over_budget = true;
+      return false;
+    }
+    const int c = ws_.order[r];
+    ++sum.candidates_checked;
+    // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
+    // conversion for the many candidates that run into traffic. Past the traced ranks, whether
+    // it collides is all the walk needs.
+    int hit_car = -1, hit = ws_.n_steps + 1;
+    if (r < traced) {
+      hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
+                                    ws_.CheckSteps(c));
+    } else {
+      hit = checker_.CandidateCollides(c) ? 1 : hit;
+    }
+    if (hit <= ws_.n_steps) {
+      ++sum.rejections[static_cast<int>(Reject::kCollision)];
+      tracer_.Add(r, false, static_cast<int>(Reject::kCollision), hit_car,
+                  hit * ws_.collision_step * kTickSeconds);
+      continue;
+    }
+    Reject why = Reject::kCount;
+    if (checker_.CandidateViolation(c, &why) > 0) {
+      ++sum.rejections[static_cast<int>(why)];
+      tracer_.Add(r, false, static_cast<int>(why));
+      continue;
+    }
+    ++sum.candidates_feasible;
+    ws_.TakeWinner(c);
+    tracer_.Add(r, true, -1);
+    for (int rr = r + 1; rr < n && !tracer_.full(); ++rr) {
+      if (!scorer_.SortUpTo(rr)) break;
+      tracer_.Add(rr, false, -1);
+    }
+    return true;
+  }
+  return false;
 }
 
 int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* summary, bool* cut) {

@@ -1,5 +1,6 @@
 // The heart of the search's lazy best-first: of the candidates in scorer order, the cheapest
 // that passes every hard check, found with as few exact costs and XY checks as the answer needs.
+// Traced, the traced ranks are walked in cost order first, each with why it was rejected.
 #pragma once
 
 #include <utility>
@@ -9,6 +10,7 @@
 #include "plan/search/checks.h"
 #include "plan/search/scoring.h"
 #include "plan/search/settings.h"
+#include "plan/search/tracer.h"
 #include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
@@ -16,13 +18,24 @@ namespace frenetic::plan::search {
 // Candidates taken cheapest bound first, then the rest in any order, when none passed in the
 // last search either.
 inline constexpr int kRestHeapTests = 64;
+// Traced, Select walks at least this many ranks in cost order (more when more are traced).
+inline constexpr int kTracedRanksMin = 4;
 
 class Selection {
  public:
-  // `ws`, `scorer`, `checker` and `clock` must outlive this; sized for ws's largest candidate
-  // set.
+  // `ws`, `scorer`, `checker`, `tracer` and `clock` must outlive this; sized for ws's largest
+  // candidate set.
   Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
-            const CycleClock& clock);
+            Tracer& tracer, const CycleClock& clock);
+
+  // The hard checks of a cycle: the cheapest candidate that passes every check is taken as
+  // ws's winner (Workspace::TakeWinner) and true returned. False when none passes, or when the
+  // deadline (CycleClock::ChecksOver) cut it short: then *over_budget is set. Untraced, every
+  // candidate goes through CheapestPassing; traced, the traced ranks (at least
+  // kTracedRanksMin) are checked in cost order first (Scorer::SortUpTo), the Frenet-only
+  // collision test before the limits, each traced with why it was rejected, and the rest
+  // through CheapestPassing: the same winner. Counts go to *summary.
+  bool Select(bool none_passed_before, PlanSummary* summary, bool* over_budget);
 
   // The cheapest candidate of ranks [r0, n) that passes every check, -1 when none does (or the
   // deadline cut it short: then *cut is set). They are taken by cost bound, smallest first
@@ -47,6 +60,7 @@ class Selection {
   Workspace& ws_;
   Scorer& scorer_;
   Checker& checker_;
+  Tracer& tracer_;
   const CycleClock& clock_;
   std::vector<std::pair<double, int>> rest_;   // candidates: a heap by bound
   std::vector<std::pair<double, int>> clear_;  // collision-free ones: a heap by cost (by a
