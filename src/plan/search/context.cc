@@ -217,7 +217,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     ws.car_reach_s[i] = own > base ? kReachS * own - ws.reach_s_base : 0.0;
     ws.car_reach_d[i] = own > base ? kReachD * own - ws.reach_d : 0.0;
   }
-  // Bounds the collision check's margins (Checker::FirstCollision).
+  // Bounds the collision check's margins (CollisionChecker::FirstCollision).
   ++ws.traffic_stamp;
   ws.step_v_max = 0;
   for (int i = 0; i < nc; ++i) {

@@ -187,9 +187,9 @@ void Continuity::Rebase(traj::FrenetState& start, int kept) {
   ws_.prev_traj.lon.poly.c[0] -= shift;
 }
 
-void Continuity::SetXyPrefix(Checker& checker) const {
-  checker.SetXyPrefix(hist_x_.data(), hist_y_.data(), hist_n_, plan_x_.data(), plan_y_.data(),
-                      ws_.kept);
+void Continuity::SetXyPrefix(LimitChecker& limits) const {
+  limits.SetXyPrefix(hist_x_.data(), hist_y_.data(), hist_n_, plan_x_.data(), plan_y_.data(),
+                     ws_.kept);
 }
 
 void Continuity::Store(PlanResult& result) {

@@ -11,7 +11,7 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search/checks.h"
+#include "plan/search/limits.h"
 #include "plan/search/settings.h"
 #include "plan/search/workspace.h"
 
@@ -53,8 +53,8 @@ class Continuity {
   traj::FrenetState MeasuredStart(const Telemetry& t, bool ego_ok) const;
   // Keeps start.s in [0, L): shifts it, the kept points and ws.prev_traj by whole loops.
   void Rebase(traj::FrenetState& start, int kept);
-  // Gives the checker the XY prefix of every candidate: history, then the kept points.
-  void SetXyPrefix(Checker& checker) const;
+  // Gives the limit checks the XY prefix of every candidate: history, then the kept points.
+  void SetXyPrefix(LimitChecker& limits) const;
 
   // Stores the kept points plus ws.tk_* as the new plan and writes it to result (x, y), a
   // non-finite point replaced by the last finite one.

@@ -8,15 +8,15 @@
 
 namespace frenetic::plan::search {
 
-bool ContinuePrevious(Workspace& ws, Checker& checker) {
+bool ContinuePrevious(Workspace& ws, const CollisionChecker& collisions) {
   if (!ws.have_prev_traj) return false;
-  checker.FillTicks(ws.prev_traj, ws.prev_elapsed);
-  if (checker.Collides()) return false;
+  ws.FillTicks(ws.prev_traj, ws.prev_elapsed);
+  if (collisions.Collides()) return false;
   ws.prev_base = ws.prev_elapsed;  // the next cycle's elapsed time counts from this start
   return true;
 }
 
-void BuildFallback(const Settings& cfg, Workspace& ws, const Checker& checker) {
+void BuildFallback(const Settings& cfg, Workspace& ws, const CollisionChecker& collisions) {
   const traj::FrenetState& start = ws.start;
   const double levels[3] = {cfg.fallback_decel,
                             std::min(2 * cfg.fallback_decel, 0.75 * cfg.max_accel),
@@ -49,7 +49,7 @@ void BuildFallback(const Settings& cfg, Workspace& ws, const Checker& checker) {
       ws.tk_dd[i] = d.v;
       ws.tk_ddd[i] = d.a;
     }
-    if (!checker.Collides()) break;
+    if (!collisions.Collides()) break;
   }
 }
 

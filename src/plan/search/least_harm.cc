@@ -14,9 +14,15 @@ double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr) {
   return ClearanceAt(ws, [&](int i) { return tr.At(i * kTickSeconds); });
 }
 
-LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
+                     CollisionChecker& collisions,
                      const CycleClock& clock)
-    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), clock_(clock) {
+    : cfg_(cfg),
+      ws_(ws),
+      scorer_(scorer),
+      limits_(limits),
+      collisions_(collisions),
+      clock_(clock) {
   known_.reserve(ws_.order.capacity());
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
@@ -87,7 +93,7 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
       std::pop_heap(clear_.begin(), clear_.end(), later);
       const int c = clear_.back().second;
       clear_.pop_back();
-      if (!checker_.CandidateBreaksLimits(c)) return c;
+      if (!limits_.CandidateBreaksLimits(c)) return c;
       continue;
     }
     if (rest_.empty()) return -1;
@@ -96,11 +102,11 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
     const int c = rest_.front().second;
     std::pop_heap(rest_.begin(), rest_.end(), later);
     rest_.pop_back();
-    if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+    if (collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
         ws_.n_steps) {
       continue;
     }
-    const Checker::Rows rows = checker_.StepRows(c);
+    const CollisionChecker::Rows rows = collisions_.StepRows(c);
     if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.clear_enough) >= cfg_.clear_enough)) continue;
     clear_.push_back({scorer_.KnownBound(c), c});
     std::push_heap(clear_.begin(), clear_.end(), later);
@@ -146,7 +152,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   const auto bound_of = [&](int c) {
     const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
     if (!lon_done_[i] || !lat_done_[k]) {
-      const Checker::Rows rows = checker_.StepRows(c);
+      const CollisionChecker::Rows rows = collisions_.StepRows(c);
       if (!lon_done_[i]) fill(rows.s, ws_.step_s, ws_.car_sep_s, &lon_sep_[i * row]);
       if (!lat_done_[k]) fill(rows.d, ws_.step_d, ws_.car_sep_d, &lat_sep_[k * row]);
       lon_done_[i] = lat_done_[k] = 1;
@@ -174,27 +180,27 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       clearance_[c] = 0.0;
       Contact(c);
       if (first_hit_[c] <= n_steps) return;
-      const Checker::Rows rows = checker_.StepRows(c);
+      const CollisionChecker::Rows rows = collisions_.StepRows(c);
       clearance_[c] =
           ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
-      if (checker_.CandidateBreaksLimits(c)) return;
+      if (limits_.CandidateBreaksLimits(c)) return;
       scorer_.ExactCost(c);
       best = c;
       best_clr = clearance_[c];
       return;
     }
-    const Checker::Rows rows = checker_.StepRows(c);
+    const CollisionChecker::Rows rows = collisions_.StepRows(c);
     const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
     if (clr < best_clr) return;
     if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
       if (!Cheaper(ws_, c, best)) return;
     }
-    if (checker_.FirstCollision(checker_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+    if (collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
         n_steps) {
       return;
     }
-    if (checker_.CandidateBreaksLimits(c)) return;
+    if (limits_.CandidateBreaksLimits(c)) return;
     scorer_.ExactCost(c);
     best = c;
     best_clr = clr;
@@ -252,20 +258,20 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
 }
 
 void LeastHarm::Contact(int c) {
-  const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
+  const StepStates steps = collisions_.StepsOf(c, 0.0, 1.0);
   int& lon_hit = lon_hit_[ws_.cand_lon[c]];
   int& lat_hit = lat_hit_[ws_.cand_lat[c]];
   // A step before latest_ that collides: the ones its bundles' last candidates hit at first.
   int hit = 0;
   if (latest_ > 1) {
     for (const int j : {lon_hit, lat_hit}) {
-      if (j >= 1 && j < latest_ && checker_.CollidesAt(steps, j, 0.0, 1.0, false)) {
+      if (j >= 1 && j < latest_ && collisions_.CollidesAt(steps, j, 0.0, 1.0, false)) {
         hit = j;
         break;
       }
     }
     for (int j = latest_ - 1; hit == 0 && j >= 1; --j) {
-      if (checker_.CollidesAt(steps, j, 0.0, 1.0, false)) hit = j;
+      if (collisions_.CollidesAt(steps, j, 0.0, 1.0, false)) hit = j;
     }
   }
   if (hit > 0) {
@@ -273,7 +279,7 @@ void LeastHarm::Contact(int c) {
     known_[c] = 2;
     ++bounded_;
   } else {  // none before latest_: the first one from there on
-    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false, latest_);
+    first_hit_[c] = collisions_.FirstCollision(steps, 0.0, 1.0, nullptr, false, latest_);
     known_[c] = 1;
     if (first_hit_[c] > ws_.n_steps) return;
     latest_ = std::max(latest_, first_hit_[c]);
@@ -303,7 +309,7 @@ int LeastHarm::CheapestFeasible(std::vector<BoundIndex>::iterator first,
       scorer_.ExactCost(c);
       if (!Cheaper(ws_, c, best)) continue;
     }
-    if (checker_.CandidateBreaksLimits(c)) continue;
+    if (limits_.CandidateBreaksLimits(c)) continue;
     scorer_.ExactCost(c);
     best = c;
   }
@@ -398,8 +404,8 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
     }
     const int c = order[r];
     if (known_[c]) continue;
-    const StepStates steps = checker_.StepsOf(c, 0.0, 1.0);
-    first_hit_[c] = checker_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
+    const StepStates steps = collisions_.StepsOf(c, 0.0, 1.0);
+    first_hit_[c] = collisions_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
     clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(ws_, steps) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:
@@ -421,10 +427,10 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
       }
       const int c = order[r];
       if (lane_line) {
-        if (checker_.CandidateBreaksLimits(c)) continue;
+        if (limits_.CandidateBreaksLimits(c)) continue;
       } else {
-        checker_.FillTicks(ws_.Candidate(c));
-        if (checker_.Violation(nullptr, false) > 0) continue;
+        ws_.FillTicks(ws_.Candidate(c));
+        if (limits_.Violation(nullptr, false) > 0) continue;
       }
       ws_.TakeWinner(c);
       return true;

@@ -14,7 +14,8 @@
 #endif
 
 #include "frenetic/traj/frenet.h"
-#include "plan/search/checks.h"
+#include "plan/search/collisions.h"
+#include "plan/search/limits.h"
 #include "plan/search/scoring.h"
 #include "plan/search/settings.h"
 #include "plan/search/workspace.h"
@@ -25,7 +26,7 @@ namespace frenetic::plan::search {
 // horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - ws.car_sep_s,
 // |dd| - ws.car_sep_d), < 0 on overlap.
 double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr);
-// The same from the states at the collision-check steps (state_at(tick), Checker::StepsOf).
+// The same from the states at the collision-check steps (state_at(tick), CollisionChecker::StepsOf).
 template <typename StateAt>
 double ClearanceAt(const Workspace& ws, StateAt state_at) {
   double worst = 1e9;
@@ -140,9 +141,10 @@ inline double ClearanceAbove(const Workspace& ws, const double* s, const double*
 
 class LeastHarm {
  public:
-  // `ws`, `scorer`, `checker` and `clock` must outlive this; sized for ws's largest candidate
+  // `ws`, `scorer`, the checkers and `clock` must outlive this; sized for ws's largest candidate
   // set.
-  LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+  LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
+            CollisionChecker& collisions,
             const CycleClock& clock);
 
   // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
@@ -201,7 +203,8 @@ class LeastHarm {
   const Settings& cfg_;
   Workspace& ws_;
   Scorer& scorer_;
-  Checker& checker_;
+  LimitChecker& limits_;
+  CollisionChecker& collisions_;
   const CycleClock& clock_;
   // Per candidate: first collision step and clearance on bare boxes (ChooseByRanking; known_:
   // BestClear measured them already), and an upper bound of the clearance (BestClear).

@@ -1,8 +1,9 @@
 // The `search` planner. Werling, Ziegler, Kammel, Thrun, "Optimal Trajectory Generation for
 // Dynamic Street Scenarios in a Frenet Frame", ICRA 2010: 1-D longitudinal and lateral bundles,
 // every pair scored, lazy hard checks in cost order, a backup that always exists. This file is
-// the cycle's orchestration; the stages live in search/*.h (context, lattice, scoring, checks,
-// least_harm, refiner, fallback, continuity) and share one Workspace.
+// the cycle's orchestration; the stages live in search/*.h (context, lattice, scoring,
+// limits, collisions, selection, least_harm, refiner, fallback, continuity) and share one
+// Workspace.
 #include "plan/search/planner.h"
 
 #include <algorithm>
@@ -17,7 +18,8 @@
 #include "frenetic/plan/predictor.h"
 #include "frenetic/traj/frenet.h"
 #include "plan/predictor_options.h"
-#include "plan/search/checks.h"
+#include "plan/search/collisions.h"
+#include "plan/search/limits.h"
 #include "plan/search/context.h"
 #include "plan/search/continuity.h"
 #include "plan/search/fallback.h"
@@ -76,11 +78,13 @@ class SearchPlanner : public Planner {
         ws_(cfg_),
         lattice_(cfg_, *predictor_, ws_),
         scorer_(cfg_, *costs_, ws_, timer_),
-        checker_(cfg_, *line_, ws_),
+        limits_(cfg_, *line_, ws_),
+        collisions_(cfg_, ws_),
         tracer_(cfg_, ws_, scorer_, *costs_, *line_, *predictor_),
-        selection_(cfg_, ws_, scorer_, checker_, tracer_, timer_),
-        least_harm_(cfg_, ws_, scorer_, checker_, timer_),
-        refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, checker_, timer_),
+        selection_(cfg_, ws_, scorer_, limits_, collisions_, tracer_, timer_),
+        least_harm_(cfg_, ws_, scorer_, limits_, collisions_, timer_),
+        refiner_(cfg_, config.refine_algorithm(), ws_, lattice_, scorer_, limits_, collisions_,
+                 timer_),
         continuity_(cfg_, *line_, ws_, timer_),
         lane_ends_(*road_) {
     per_term_.assign(costs_->size(), 0.0);
@@ -172,7 +176,7 @@ class SearchPlanner : public Planner {
     predictor_->Observe(lane_ends_.With(t.sensor_fusion, start.s), start.s, sim_time_, t.futures,
                         start.d);
     search::BuildContext(cfg_, *road_, *predictor_, ws_);
-    continuity_.SetXyPrefix(checker_);
+    continuity_.SetXyPrefix(limits_);
     sum.ms_prepare = Elapsed();
 
     bool found = false;       // a candidate passed every check
@@ -220,19 +224,19 @@ class SearchPlanner : public Planner {
     }
     const double t_out = Elapsed();
     if (found || least_harm) {
-      checker_.FillTicks(ws_.winner);
+      ws_.FillTicks(ws_.winner);
       sum.winner_lane = ws_.lat[ws_.winner_lat].lane;
       sum.winner_end_speed = ws_.winner.lon.At(ws_.winner.lon.duration).v;
       sum.winner_duration = ws_.winner.lon.duration;
       RecordDecision(sum.winner_lane);
       continuity_.RememberWinner(sum.winner_lane, sum.winner_end_speed, sum.winner_duration);
       EvaluateWinnerCosts();
-    } else if (over_budget && search::ContinuePrevious(ws_, checker_)) {
+    } else if (over_budget && search::ContinuePrevious(ws_, collisions_)) {
       // Cut short (a loaded machine): last cycle's winner, still collision-free, is a better
       // answer than braking, which invites the car behind into the ego's boot.
       sum.winner_lane = ws_.prev_target_lane;
     } else {
-      search::BuildFallback(cfg_, ws_, checker_);
+      search::BuildFallback(cfg_, ws_, collisions_);
       ws_.have_prev_traj = false;
     }
     continuity_.Store(result_);
@@ -309,7 +313,8 @@ class SearchPlanner : public Planner {
   search::Workspace ws_;
   search::Lattice lattice_;
   search::Scorer scorer_;
-  search::Checker checker_;
+  search::LimitChecker limits_;
+  search::CollisionChecker collisions_;
   search::Tracer tracer_;
   search::Selection selection_;
   search::LeastHarm least_harm_;

@@ -15,12 +15,14 @@ nlopt_algorithm AlgorithmFromName(const std::string& name) {
 }  // namespace
 
 Refiner::Refiner(const Settings& cfg, const std::string& algorithm, Workspace& ws,
-                 const Lattice& lattice, Scorer& scorer, Checker& checker, const CycleClock& clock)
+                 const Lattice& lattice, Scorer& scorer, LimitChecker& limits,
+                 CollisionChecker& collisions, const CycleClock& clock)
     : cfg_(cfg),
       ws_(ws),
       lattice_(lattice),
       scorer_(scorer),
-      checker_(checker),
+      limits_(limits),
+      collisions_(collisions),
       clock_(clock),
       opt_(nlopt_create(AlgorithmFromName(algorithm), 4)) {
   // NLopt evaluates at most refine.max_iterations points; one more for the start.
@@ -79,8 +81,8 @@ double Refiner::Objective(unsigned n, const double* x, double* grad, void* data)
   double v = self->scorer_.CostOf(tr, ws.lon[ws.winner_lon], ws.lat[ws.winner_lat]);
   if (!self->constraints_ok_) {
     // Algorithms without constraint support get the limits as a steep penalty.
-    self->checker_.FillTicks(tr);
-    v += 1e3 * std::max(0.0, self->checker_.Violation(nullptr));
+    self->ws_.FillTicks(tr);
+    v += 1e3 * std::max(0.0, self->limits_.Violation(nullptr));
   }
   seen.f = v;
   seen.has_f = true;
@@ -93,8 +95,8 @@ double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data
   auto* self = static_cast<Refiner*>(data);
   Eval& seen = self->Entry(x);
   if (seen.has_g) return seen.g;
-  self->checker_.FillTicksForLimits(self->FromParams(x));
-  seen.g = self->checker_.Violation(nullptr);
+  self->ws_.FillTicksForLimits(self->FromParams(x));
+  seen.g = self->limits_.Violation(nullptr);
   seen.has_g = true;
   return seen.g;
 }
@@ -155,7 +157,7 @@ void Refiner::Refine(PlanSummary& sum) {
     if (std::memcmp(&start, &ws_.winner, sizeof(start)) == 0) {
       Eval& e = Entry(x);
       e.f = before;
-      e.g = checker_.CandidateViolation(ws_.winner_index, nullptr);
+      e.g = limits_.CandidateViolation(ws_.winner_index, nullptr);
       e.has_f = e.has_g = true;
     }
   }
@@ -165,11 +167,11 @@ void Refiner::Refine(PlanSummary& sum) {
   if (r < 0 || !Finite(best) || best >= before) return;
   // Safety re-check of the refined trajectory; keep the unrefined winner if it fails.
   const traj::FrenetTrajectory refined = FromParams(x);
-  checker_.FillTicks(refined);
+  ws_.FillTicks(refined);
   const Eval* seen = Find(x);  // the result is a point NLopt evaluated
   const double violation =
-      seen != nullptr && seen->has_g ? seen->g : checker_.Violation(nullptr);
-  if (violation > 0 || checker_.Collides()) return;
+      seen != nullptr && seen->has_g ? seen->g : limits_.Violation(nullptr);
+  if (violation > 0 || collisions_.Collides()) return;
   ws_.winner = refined;
   sum.refine_cost_after = seen != nullptr && seen->has_f && constraints_ok_
                               ? seen->f

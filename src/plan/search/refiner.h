@@ -12,7 +12,8 @@
 
 #include "frenetic/plan/planner.h"
 #include "frenetic/traj/frenet.h"
-#include "plan/search/checks.h"
+#include "plan/search/collisions.h"
+#include "plan/search/limits.h"
 #include "plan/search/lattice.h"
 #include "plan/search/scoring.h"
 #include "plan/search/settings.h"
@@ -25,7 +26,8 @@ class Refiner {
   // `algorithm`: an NLopt algorithm name (nlopt_algorithm_from_string); unknown names fall back
   // to NLOPT_LN_COBYLA. Everything referenced must outlive the refiner.
   Refiner(const Settings& cfg, const std::string& algorithm, Workspace& ws, const Lattice& lattice,
-          Scorer& scorer, Checker& checker, const CycleClock& clock);
+          Scorer& scorer, LimitChecker& limits, CollisionChecker& collisions,
+          const CycleClock& clock);
   ~Refiner();
   Refiner(const Refiner&) = delete;
   Refiner& operator=(const Refiner&) = delete;
@@ -62,7 +64,8 @@ class Refiner {
   Workspace& ws_;
   const Lattice& lattice_;
   Scorer& scorer_;
-  Checker& checker_;
+  LimitChecker& limits_;
+  CollisionChecker& collisions_;
   const CycleClock& clock_;
   nlopt_opt opt_ = nullptr;
   bool constraints_ok_ = false;

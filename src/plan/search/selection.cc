@@ -6,9 +6,16 @@
 
 namespace frenetic::plan::search {
 
-Selection::Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+Selection::Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
+                     CollisionChecker& collisions,
                      Tracer& tracer, const CycleClock& clock)
-    : cfg_(cfg), ws_(ws), scorer_(scorer), checker_(checker), tracer_(tracer), clock_(clock) {
+    : cfg_(cfg),
+      ws_(ws),
+      scorer_(scorer),
+      limits_(limits),
+      collisions_(collisions),
+      tracer_(tracer),
+      clock_(clock) {
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   popped_.assign(ws_.order.capacity(), 0);
@@ -43,10 +50,10 @@ bool Selection::Select(bool none_passed_before, PlanSummary* summary, bool* over
     // it collides is all the walk needs.
     int hit_car = -1, hit = ws_.n_steps + 1;
     if (r < traced) {
-      hit = checker_.FirstCollision(checker_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
+      hit = collisions_.FirstCollision(collisions_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
                                     ws_.CheckSteps(c));
     } else {
-      hit = checker_.CandidateCollides(c) ? 1 : hit;
+      hit = collisions_.CandidateCollides(c) ? 1 : hit;
     }
     if (hit <= ws_.n_steps) {
       ++sum.rejections[static_cast<int>(Reject::kCollision)];
@@ -55,7 +62,7 @@ bool Selection::Select(bool none_passed_before, PlanSummary* summary, bool* over
       continue;
     }
     Reject why = Reject::kCount;
-    if (checker_.CandidateViolation(c, &why) > 0) {
+    if (limits_.CandidateViolation(c, &why) > 0) {
       ++sum.rejections[static_cast<int>(why)];
       tracer_.Add(r, false, static_cast<int>(why));
       continue;
@@ -88,7 +95,7 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
   // Whether c passes the hard limits (counted as feasible or rejected).
   const auto within_limits = [&](int c) {
     Reject why = Reject::kCount;
-    if (checker_.CandidateViolation(c, &why) > 0) {
+    if (limits_.CandidateViolation(c, &why) > 0) {
       ++sum.rejections[static_cast<int>(why)];
       return false;
     }
@@ -98,7 +105,7 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
   // Whether c collides (counted as checked, and as rejected when it does).
   const auto collides = [&](int c) {
     ++sum.candidates_checked;
-    if (!checker_.CandidateCollides(c)) return false;
+    if (!collisions_.CandidateCollides(c)) return false;
     ++sum.rejections[static_cast<int>(Reject::kCollision)];
     return true;
   };

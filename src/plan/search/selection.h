@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "frenetic/plan/planner.h"
-#include "plan/search/checks.h"
+#include "plan/search/collisions.h"
+#include "plan/search/limits.h"
 #include "plan/search/scoring.h"
 #include "plan/search/settings.h"
 #include "plan/search/tracer.h"
@@ -23,9 +24,10 @@ inline constexpr int kTracedRanksMin = 4;
 
 class Selection {
  public:
-  // `ws`, `scorer`, `checker`, `tracer` and `clock` must outlive this; sized for ws's largest
+  // `ws`, `scorer`, the checkers, `tracer` and `clock` must outlive this; sized for ws's largest
   // candidate set.
-  Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, Checker& checker,
+  Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
+            CollisionChecker& collisions,
             Tracer& tracer, const CycleClock& clock);
 
   // The hard checks of a cycle: the cheapest candidate that passes every check is taken as
@@ -59,7 +61,8 @@ class Selection {
   const Settings& cfg_;
   Workspace& ws_;
   Scorer& scorer_;
-  Checker& checker_;
+  LimitChecker& limits_;
+  CollisionChecker& collisions_;
   Tracer& tracer_;
   const CycleClock& clock_;
   std::vector<std::pair<double, int>> rest_;   // candidates: a heap by bound

@@ -84,4 +84,22 @@ bool Workspace::SwerveEndsInside(int i, int j) const {
          across <= r.d_hi && lo.v >= r.v_lo && lo.v <= r.v_hi && h >= r.h_lo && h <= r.h_hi;
 }
 
+void Workspace::FillTicks(const traj::FrenetTrajectory& tr, double t0) {
+  for (int i = 1; i <= n_ticks; ++i) {
+    const traj::FrenetState st = tr.At(t0 + i * kTickSeconds);
+    tk_s[i] = st.s;
+    tk_sd[i] = st.s_d;
+    tk_sdd[i] = st.s_dd;
+    tk_d[i] = st.d;
+    tk_dd[i] = st.d_d;
+    tk_ddd[i] = st.d_dd;
+  }
+}
+
+void Workspace::FillTicksForLimits(const traj::FrenetTrajectory& tr) {
+  const auto time = [](int t) { return 0.0 + t * kTickSeconds; };  // FillTicks' time
+  tr.lon.Sample(1, n_ticks + 1, time, tk_s.data(), tk_sd.data(), nullptr);
+  tr.lat.Sample(1, n_ticks + 1, time, tk_d.data(), tk_dd.data(), nullptr);
+}
+
 }  // namespace frenetic::plan::search

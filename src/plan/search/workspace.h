@@ -62,6 +62,12 @@ struct Workspace {
   traj::FrenetTrajectory Candidate(int c) const {
     return {lon[cand_lon[c]].traj, lat[cand_lat[c]].traj};
   }
+  // Samples a trajectory at every tick of the check horizon, t0 + i ticks (s), into tk_*
+  // [1, n_ticks].
+  void FillTicks(const traj::FrenetTrajectory& tr, double t0 = 0);
+  // FillTicks' s, s' and d (and d'), what LimitChecker::Violation reads, with the same values;
+  // the other rows are left as they were.
+  void FillTicksForLimits(const traj::FrenetTrajectory& tr);
   // Makes candidate c the cycle's winner.
   void TakeWinner(int c) {
     winner_index = c;
@@ -150,7 +156,7 @@ struct Workspace {
   std::vector<int> order;
   int sorted = 0;
 
-  // One trajectory sampled at every tick of the check horizon, [1, n_ticks] (Checker::FillTicks,
+  // One trajectory sampled at every tick of the check horizon, [1, n_ticks] (FillTicks,
   // the fallback); what the hard checks read and what Output stores.
   std::vector<double> tk_s, tk_sd, tk_sdd, tk_d, tk_dd, tk_ddd;
 

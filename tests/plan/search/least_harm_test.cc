@@ -160,8 +160,8 @@ int ReferenceChoice(Stages& st) {
   std::vector<int> hit(ws.cand_cost.size());
   std::vector<double> room(ws.cand_cost.size());
   for (const int c : order) {
-    const StepStates steps = st.checker.StepsOf(c, 0.0, 1.0);
-    hit[c] = st.checker.FirstCollision(steps, 0.0, 1.0, nullptr, false);
+    const StepStates steps = st.collisions.StepsOf(c, 0.0, 1.0);
+    hit[c] = st.collisions.FirstCollision(steps, 0.0, 1.0, nullptr, false);
     room[c] = hit[c] > ws.n_steps ? ClearanceAt(ws, steps) : 0.0;
   }
   std::sort(order.begin(), order.end(), [&](int a, int b) {
@@ -171,8 +171,8 @@ int ReferenceChoice(Stages& st) {
   });
   for (const bool lane_line : {true, false}) {
     for (const int c : order) {
-      st.checker.FillTicks(ws.Candidate(c));
-      if (st.checker.Violation(nullptr, lane_line) <= 0) return c;
+      st.ws.FillTicks(ws.Candidate(c));
+      if (st.limits.Violation(nullptr, lane_line) <= 0) return c;
     }
   }
   return -1;
@@ -253,13 +253,13 @@ TEST(SearchLeastHarmTest, ClearEnoughIsTheCheapestThatPassesAfterTheLazyCheck) {
     int expected = -1;
     for (const int c : st.ws.order) {
       if (expected >= 0 && !Cheaper(st.ws, c, expected)) continue;
-      if (st.checker.FirstCollision(st.checker.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
+      if (st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
           st.ws.n_steps) {
         continue;
       }
-      const Checker::Rows rows = st.checker.StepRows(c);
+      const CollisionChecker::Rows rows = st.collisions.StepRows(c);
       if (!(ClearanceAbove(st.ws, rows.s, rows.d, 0.5) >= 0.5)) continue;
-      if (st.checker.CandidateBreaksLimits(c)) continue;
+      if (st.limits.CandidateBreaksLimits(c)) continue;
       expected = c;
     }
     if (expected < 0) continue;  // then the harm ranking decides (tested above)
@@ -305,11 +305,11 @@ TEST(SearchLeastHarmTest, LatestFeasibleContactWhenTheLatestOnesBreakLimits) {
     int latest = 0;
     for (const int c : st.ws.order) {
       const int hit =
-          st.checker.FirstCollision(st.checker.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+          st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
       if (hit <= st.ws.n_steps) latest = std::max(latest, hit);
     }
     const int chosen =
-        st.checker.FirstCollision(st.checker.StepsOf(expected, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+        st.collisions.FirstCollision(st.collisions.StepsOf(expected, 0.0, 1.0), 0.0, 1.0, nullptr, false);
     earlier_group += chosen <= st.ws.n_steps && chosen < latest;
   }
   EXPECT_GE(earlier_group, 5) << "the scenes do not reach an earlier contact group";

@@ -27,12 +27,12 @@ bool TakeFirstFeasible(Stages& st) {
     st.scorer.SortUpTo(r);
     const int c = ws.order[r];
     const traj::FrenetTrajectory tr = ws.Candidate(c);
-    if (st.checker.FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0) <=
+    if (st.collisions.FirstCollision([&tr](int i) { return tr.At(i * kTickSeconds); }, 1.0) <=
         ws.n_steps) {
       continue;
     }
-    st.checker.FillTicks(tr);
-    if (st.checker.Violation(nullptr) > 0) continue;
+    st.ws.FillTicks(tr);
+    if (st.limits.Violation(nullptr) > 0) continue;
     ws.TakeWinner(c);
     return true;
   }
@@ -72,9 +72,9 @@ TEST(SearchRefinerTest, NeverReturnsACostlierOrInfeasibleWinner) {
     EXPECT_LE(after, before) << "scene " << i;
     EXPECT_EQ(sum.refine_cost_after, after) << "scene " << i;
     improved += after < before;
-    st.checker.FillTicks(st.ws.winner);
-    EXPECT_LE(st.checker.Violation(nullptr), 0) << "scene " << i;
-    EXPECT_FALSE(st.checker.Collides()) << "scene " << i;
+    st.ws.FillTicks(st.ws.winner);
+    EXPECT_LE(st.limits.Violation(nullptr), 0) << "scene " << i;
+    EXPECT_FALSE(st.collisions.Collides()) << "scene " << i;
   }
   EXPECT_GE(refined, 4);
   EXPECT_GE(improved, 1) << "the refinement should find something in these scenes";

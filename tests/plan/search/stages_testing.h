@@ -15,7 +15,8 @@
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
-#include "plan/search/checks.h"
+#include "plan/search/collisions.h"
+#include "plan/search/limits.h"
 #include "plan/search/context.h"
 #include "plan/search/continuity.h"
 #include "plan/search/lattice.h"
@@ -67,9 +68,10 @@ struct Stages {
         clock([this] { return now_ms; }),
         lattice(cfg, *predictor, ws),
         scorer(cfg, *costs, ws, clock),
-        checker(cfg, *line, ws),
-        least_harm(cfg, ws, scorer, checker, clock),
-        refiner(cfg, config.refine_algorithm(), ws, lattice, scorer, checker, clock),
+        limits(cfg, *line, ws),
+        collisions(cfg, ws),
+        least_harm(cfg, ws, scorer, limits, collisions, clock),
+        refiner(cfg, config.refine_algorithm(), ws, lattice, scorer, limits, collisions, clock),
         continuity(cfg, *line, ws, clock) {}
 
   // The sensor_fusion row of a scene car.
@@ -80,7 +82,7 @@ struct Stages {
   }
 
   // A cycle's start without kept points: observes `cars`, builds the context and gives the
-  // checker the start point as the XY prefix.
+  // limit checks the start point as the XY prefix.
   void Prepare(const traj::FrenetState& start, const std::vector<SceneCar>& cars = {}) {
     ws.start = start;
     ws.kept = 0;
@@ -94,7 +96,7 @@ struct Stages {
     const map::CartesianPose p = line->ToCartesian(start.s, start.d);
     prefix_x = p.x;
     prefix_y = p.y;
-    checker.SetXyPrefix(&prefix_x, &prefix_y, 1, nullptr, nullptr, 0);
+    limits.SetXyPrefix(&prefix_x, &prefix_y, 1, nullptr, nullptr, 0);
   }
 
   // Writes ws.tk_* from an acceleration profile a(t) (m/s^2 along s) at constant d, from
@@ -126,7 +128,8 @@ struct Stages {
   CycleClock clock;
   Lattice lattice;
   Scorer scorer;
-  Checker checker;
+  LimitChecker limits;
+  CollisionChecker collisions;
   LeastHarm least_harm;
   Refiner refiner;
   Continuity continuity;

@@ -1,9 +1,8 @@
-// The search planner's hard checks (filters with a named reason, never costs): a candidate is
-// sampled at every 0.02 s tick of the check horizon; then off-road, never backwards and the
-// simulator's lane-line timer on d as the simulator reads it, and its speed, acceleration and
-// jerk limits on the XY path (history | kept points | the ticks, feasibility.h); and collisions
-// with the predicted traffic as oriented boxes inflated by the safety margins (headway to a car
-// ahead, room for a car behind in another lane).
+// The search planner's collision checks: a candidate against the predicted traffic at every
+// collision step of the check horizon, as oriented boxes inflated by the safety margins
+// (headway to a car ahead, room for a car behind in another lane), with per-bundle samples
+// and reach masks so that the many candidates of a bundle share the work. The limit checks are
+// limits.h.
 #pragma once
 
 #include <algorithm>
@@ -13,34 +12,13 @@
 #include <limits>
 #include <vector>
 
-#include "frenetic/map/reference_line.h"
-#include "frenetic/plan/feasibility.h"
-#include "frenetic/plan/planner.h"
 #include "frenetic/traj/box.h"
 #include "frenetic/traj/frenet.h"
+#include "plan/search/bundle_rows.h"
 #include "plan/search/settings.h"
 #include "plan/search/workspace.h"
 
 namespace frenetic::plan::search {
-
-// Whether read d in [lo, hi] (m) comes within kStraddle of a lane line: the simulator's
-// lane-line timer runs then.
-inline bool StraddlesRead(const Settings& cfg, double lo, double hi) {
-  for (int l = 1; l < cfg.num_lanes; ++l) {
-    const double line = l * cfg.lane_width;
-    if (hi > line - kStraddle && lo < line + kStraddle) return true;
-  }
-  return false;
-}
-// Whether the simulator may read d within kStraddle of a lane line for a point with s in
-// [s0, s1] and d in [d0, d1] (it reads d from chords: ReferenceLine::ChordOffset). Never on a
-// road that is not uniform: the lane-line timer is the Udacity simulator's.
-inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, double s0, double s1,
-                      double d0, double d1) {
-  if (!cfg.uniform_road) return false;  // the Udacity simulator's timer only
-  const map::ReferenceLine::OffsetRange r = line.ChordOffset(s0, s1, 0.5 * (d0 + d1));
-  return StraddlesRead(cfg, d0 + r.lo, d1 + r.hi);
-}
 
 // A candidate's states at the collision-check steps, as FirstCollision asks for them (a tick
 // index j * collision_step): s, s', d and d' (the second derivatives read 0), the values
@@ -75,40 +53,14 @@ class StepStates {
   int step_;
 };
 
-class Checker {
+class CollisionChecker {
  public:
-  // `line` and `ws` must outlive the checker; the check reads the traffic and the start state
-  // of ws and the ticks ws.tk_*.
-  Checker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws);
+  // `ws` must outlive the checker; it reads the traffic and the start state of ws and, for
+  // Collides, the ticks ws.tk_* (Workspace::FillTicks).
+  CollisionChecker(const Settings& cfg, Workspace& ws);
 
-  // Samples a trajectory at every tick of the check horizon, t0 + i ticks (s), into ws.tk_*
-  // [1, n_ticks].
-  void FillTicks(const traj::FrenetTrajectory& tr, double t0 = 0);
-  // FillTicks' s, s' and d (and d'), what Violation reads, with the same values; the other
-  // rows are left as they were.
-  void FillTicksForLimits(const traj::FrenetTrajectory& tr);
-  // The XY path's part common to every candidate of the cycle, the driven history then the
-  // kept points (oldest first), measured once.
-  void SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n, const double* kept_x,
-                   const double* kept_y, int kept);
-
-  // The worst normalised excess over all limits of the ticks (<= 0: feasible), and the first
-  // reason (kCount when feasible; reason may be null). lane_line: include the lane-line timer
-  // (the least-harm choice may drop it: a collision is worse). NaN counts as a violation.
-  double Violation(Reject* reason, bool lane_line = true);
-
-  // Candidate c's Violation(reason) (lane-line timer included) after FillTicks of it,
-  // remembered for its trajectory until the next SetXyPrefix: the least-harm choice asks again
-  // about candidates the lazy check has measured. Measured on its bundles' ticks: ws.tk_* are
-  // left as they are.
-  double CandidateViolation(int c, Reject* reason);
-  // Whether candidate c breaks a limit: CandidateViolation(c, nullptr) > 0, the same answer,
-  // but the Frenet checks stop at the first limit found broken (the lane-line timer of a car
-  // long astride a line, say), so that no worst excess or reason is known then (a later
-  // CandidateViolation measures it all).
-  bool CandidateBreaksLimits(int c);
-
-  // Oriented-box overlap of the ticks with every car over the check horizon (inflated boxes).
+  // Oriented-box overlap of the ticks ws.tk_* with every car over the check horizon (inflated
+  // boxes).
   bool Collides() const {
     return FirstCollision(
                [this](int i) {
@@ -180,57 +132,14 @@ class Checker {
   int FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
                   double behind_scale) const;
 
-  // Row of bundle trajectory `tr` (slot i) in s / sd, sampled at the steps unless kept; true
+  // Row i of `rows` (lon_steps_ or lat_steps_) holds `tr` at the steps (unless kept); true
   // when sampled anew.
-  bool SampleSteps(const traj::Trajectory1d& tr, int i, std::vector<traj::Trajectory1d>& key,
-                   std::vector<char>& have, std::vector<double>& p, std::vector<double>& v);
-
-  // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the
-  // simulator may read it there.
-  struct ReadRange {
-    double lo, hi;
-  };
-  ReadRange ReadBetween(const double* s, const double* d, int prev, int i) const;
-  // On a road that is not uniform: how far (m) the read d range of ticks with s from s0 to s1
-  // comes past the road's edges there, less the ego's half width and edge_margin (> 0: off the
-  // road; no lane there counts as far off).
-  double EdgeExcess(double s0, double s1, const ReadRange& read) const;
-
-  // What Violation reads of the ticks [1, n_ticks]: s, s', d, and the centre line at s when
-  // known (null: from the line, or from lon bundle slot lon_slot's row when that is >= 0,
-  // sampled there on first use: a candidate the Frenet checks reject does not need it).
-  struct Ticks {
-    const double *s, *sd, *d;
-    const map::CentrePoint* centre;
-    int lon_slot = -1;
-    int n = 0;  // the ticks [1, n] are measured (0: all, n_ticks)
-  };
-  // Appends the ticks to the XY prefix; returns the path length.
-  int BuildXyPath(const Ticks& ticks);
-  // Violation of `ticks` (ws.tk_*, or a candidate's bundle rows). any: a positive value as soon
-  // as one limit is found broken (not the worst, and no reason).
-  double Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any = false);
-  // CandidateViolation's work: Measure of candidate c's bundle ticks, through the verdicts.
-  double CandidateMeasure(int c, Reject* reason, bool any);
-  // Bundle trajectory `tr` (slot i) at every tick [1, n_ticks], FillTicks' values, in the rows
-  // of p / v / a unless kept; true when sampled anew.
-  struct TickRows {
-    std::vector<traj::Trajectory1d> key;
-    std::vector<char> have;
-    std::vector<double> p, v, a;
-  };
-  bool SampleTicks(const traj::Trajectory1d& tr, int i, TickRows& rows);
+  bool SampleSteps(const traj::Trajectory1d& tr, int i, BundleRows& rows);
 
   const Settings& cfg_;
-  const map::ReferenceLine& line_;
   Workspace& ws_;
-  XyChecker xy_;
-  std::vector<double> chk_x_, chk_y_;  // the XY path: prefix | ticks
-  // StepsOf: per bundle slot, the trajectory sampled, whether sampled, and the samples
-  // ([slot * (n_steps + 1) + j]).
-  std::vector<traj::Trajectory1d> lon_key_, lat_key_;
-  std::vector<char> lon_have_, lat_have_;
-  std::vector<double> lon_s_, lon_sd_, lat_d_, lat_dd_;
+  // Per bundle slot, the trajectory at the steps (p, v: s and s', or d and d').
+  BundleRows lon_steps_, lat_steps_;
   // Per bundle slot and step, the cars passing the lateral (lat) and the longitudinal (lon)
   // reach tests, with what they were computed for.
   struct LonNearKey {
@@ -259,19 +168,6 @@ class Checker {
   // The lateral reach masks CandidateCollides uses for lon slot i and lat slot k: lat_tight_'s
   // row, or lat_near_'s when the narrower test does not apply.
   const std::uint64_t* TightLatNear(int i, int k);
-  int first_new_ = 0;                  // the first tick's index in chk_x_ / chk_y_
-  // CandidateViolation's verdicts per candidate index, with what they were measured for: the
-  // trajectory, the XY prefix (prefix_stamp_, counted by SetXyPrefix) and the start's
-  // lane-line count.
-  struct Verdict {
-    traj::FrenetTrajectory tr;
-    std::uint64_t prefix_stamp = 0;
-    int straddle = 0;
-    Reject why = Reject::kCount;
-    double worst = 0;
-    bool any = false;  // measured with Measure(..., any): only worst > 0 is known
-  };
-  std::vector<Verdict> verdicts_;
   // CandidateCollides: per lon slot, the last step and car hit, and the traffic they were for.
   struct LastHit {
     std::uint64_t stamp = 0;
@@ -279,17 +175,12 @@ class Checker {
   };
   std::vector<LastHit> last_hit_;      // two per lon slot, the latest first
   std::vector<LastHit> lat_last_hit_;  // one per lat slot
-  // CandidateViolation's ticks per bundle slot, and the centre line at the lon ones.
-  TickRows lon_ticks_, lat_ticks_;
-  std::vector<map::CentrePoint> lon_centre_;
-  std::vector<char> lon_centre_have_;  // lon_centre_'s row is the one of lon_ticks_' row
-  std::uint64_t prefix_stamp_ = 1;
 };
 
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=
 // step_v_max; rounded products and sums are monotone), so a car farther along s than
 // ws.reach_s_base + widest fails its reach test anyway. Only with non-negative factors.
-inline double Checker::Widest(double s_d, double margin_scale, double behind_scale) const {
+inline double CollisionChecker::Widest(double s_d, double margin_scale, double behind_scale) const {
   const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
                        cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
   if (!bounded) return std::numeric_limits<double>::infinity();
@@ -299,12 +190,12 @@ inline double Checker::Widest(double s_d, double margin_scale, double behind_sca
        margin_scale * cfg_.margin_s});
 }
 
-inline double Checker::ReachS(double s_d, double margin_scale, double behind_scale) const {
+inline double CollisionChecker::ReachS(double s_d, double margin_scale, double behind_scale) const {
   return ws_.reach_s_base + Widest(s_d, margin_scale, behind_scale);
 }
 
 // FirstCollision's ego at one step.
-struct Checker::StepEgo {
+struct CollisionChecker::StepEgo {
   traj::OrientedBox box;
   double s_d = 0;  // the state's s'
   double vs, vd;   // the heading's velocity (s', d') with s' at least 0.5
@@ -322,13 +213,13 @@ struct Checker::StepEgo {
   }
 };
 
-inline Checker::StepEgo Checker::EgoAt(const traj::FrenetState& st, double margin_scale,
+inline CollisionChecker::StepEgo CollisionChecker::EgoAt(const traj::FrenetState& st, double margin_scale,
                                        double behind_scale) const {
   return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.ego_length, 0.5 * cfg_.ego_width}, st.s_d,
           std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
 }
 
-inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
+inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
                             double behind_scale) const {
   const traj::OrientedBox& ego = e.box;
   const int at = c * (ws_.n_steps + 1) + j;
@@ -376,7 +267,7 @@ inline bool Checker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
 }
 
 template <typename StateAt>
-int Checker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
+int CollisionChecker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
                          double behind_scale) const {
   const std::uint64_t near = state_at.Near(j) & cars;
   if (near == 0) return -1;  // no car within reach at this step: nothing to test
@@ -389,7 +280,7 @@ int Checker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, dou
 }
 
 template <typename StateAt>
-int Checker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
+int CollisionChecker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
                             int* car_hit, bool ghosts, int from, int to) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
   const std::uint64_t cars = CarMask(ghosts);

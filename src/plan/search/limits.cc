@@ -1,0 +1,193 @@
+#include "plan/search/limits.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace frenetic::plan::search {
+
+LimitChecker::LimitChecker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
+    : cfg_(cfg),
+      line_(line),
+      ws_(ws),
+      xy_(kHistory + 64 + static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds)) +
+              cfg.output_points,
+          cfg.vehicle) {
+  const int path_cap = kHistory + cfg.output_points + ws_.n_ticks + 8;
+  chk_x_.assign(path_cap, 0.0);
+  chk_y_.assign(path_cap, 0.0);
+  const std::size_t n_lon = ws_.lon.capacity(), n_lat = ws_.lat.capacity();
+  verdicts_.resize(ws_.order.capacity());
+  lon_ticks_.Resize(n_lon, ws_.n_ticks + 1, true);
+  lat_ticks_.Resize(n_lat, ws_.n_ticks + 1, true);
+  lon_centre_.resize(n_lon * (ws_.n_ticks + 1));
+  lon_centre_have_.assign(n_lon, 0);
+}
+
+void LimitChecker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n,
+                          const double* kept_x, const double* kept_y, int kept) {
+  int n = 0;
+  for (int i = 0; i < hist_n; ++i, ++n) {
+    chk_x_[n] = hist_x[i];
+    chk_y_[n] = hist_y[i];
+  }
+  for (int i = 0; i < kept; ++i, ++n) {
+    chk_x_[n] = kept_x[i];
+    chk_y_[n] = kept_y[i];
+  }
+  first_new_ = n;
+  xy_.SetPrefix(chk_x_.data(), chk_y_.data(), n);
+  ++prefix_stamp_;
+}
+
+LimitChecker::ReadRange LimitChecker::ReadBetween(const double* s, const double* d, int prev, int i) const {
+  const double d_lo = std::min(d[prev], d[i]), d_hi = std::max(d[prev], d[i]);
+  const map::ReferenceLine::OffsetRange r =
+      line_.ChordOffset(std::min(s[prev], s[i]), std::max(s[prev], s[i]), 0.5 * (d_lo + d_hi));
+  return {d_lo + r.lo, d_hi + r.hi};
+}
+
+double LimitChecker::EdgeExcess(double s0, double s1, const ReadRange& read) const {
+  // The bins of the workspace's edge table that [s0, s1] overlaps (clamped to the table).
+  const int bins = static_cast<int>(ws_.edge_lo.size());
+  const double x0 = (std::min(s0, s1) - ws_.edge_s0) / Workspace::kEdgeBin;
+  const double x1 = (std::max(s0, s1) - ws_.edge_s0) / Workspace::kEdgeBin;
+  if (!(x0 == x0) || !(x1 == x1)) return 1e9;  // NaN s: off any road
+  const int b0 = static_cast<int>(std::clamp(std::floor(x0), 0.0, bins - 1.0));
+  const int b1 = static_cast<int>(std::clamp(std::floor(x1), 0.0, bins - 1.0));
+  double lo = -1e9, hi = 1e9;
+  for (int b = b0; b <= b1; ++b) {
+    if (!(ws_.edge_lo[b] == ws_.edge_lo[b])) return 1e9;  // no lane there
+    lo = std::max(lo, ws_.edge_lo[b]);
+    hi = std::min(hi, ws_.edge_hi[b]);
+  }
+  const double inset = 0.5 * cfg_.ego_width + cfg_.edge_margin;
+  return std::max(lo + inset - read.lo, read.hi - (hi - inset));
+}
+
+double LimitChecker::CandidateViolation(int c, Reject* reason) {
+  return CandidateMeasure(c, reason, false);
+}
+
+bool LimitChecker::CandidateBreaksLimits(int c) { return CandidateMeasure(c, nullptr, true) > 0; }
+
+double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
+  const traj::FrenetTrajectory tr = ws_.Candidate(c);
+  Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
+  if (v != nullptr && (any || !v->any) && v->prefix_stamp == prefix_stamp_ &&
+      v->straddle == ws_.straddle_at_start && std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
+    if (reason != nullptr) *reason = v->why;
+    return v->worst;
+  }
+  // FillTicks' values, from the bundles' rows: the candidates of a bundle share its ticks and
+  // the centre line there.
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const auto time = [](int t) { return 0.0 + t * kTickSeconds; };  // FillTicks' time
+  if (lon_ticks_.Sample(tr.lon, i, time)) lon_centre_have_[i] = 0;
+  lat_ticks_.Sample(tr.lat, k, time);
+  const int w = ws_.n_ticks + 1;
+  Reject why = Reject::kCount;
+  const double worst = Measure(&why, true,
+                               {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w],
+                                nullptr, i, ws_.CheckTicks(c)},
+                               any);
+  // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
+  const bool partial = any && worst > 0;
+  if (reason != nullptr) *reason = why;
+  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst, partial};
+  return worst;
+}
+
+int LimitChecker::BuildXyPath(const Ticks& ticks) {
+  int n = first_new_;
+  const int n_ticks = ticks.n > 0 ? ticks.n : ws_.n_ticks;
+  for (int i = 1; i <= n_ticks; ++i, ++n) {
+    // ToCartesian's x and y without its heading and curvature.
+    const map::CentrePoint p = ticks.centre != nullptr ? ticks.centre[i] : line_.Centre(ticks.s[i]);
+    chk_x_[n] = p.OffsetX(ticks.d[i]);
+    chk_y_[n] = p.OffsetY(ticks.d[i]);
+  }
+  return n;
+}
+
+double LimitChecker::Violation(Reject* reason, bool lane_line) {
+  return Measure(reason, lane_line, {ws_.tk_s.data(), ws_.tk_sd.data(), ws_.tk_d.data(), nullptr});
+}
+
+double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any) {
+  const int n_ticks = ticks.n > 0 ? ticks.n : ws_.n_ticks;
+  const double* tk_s = ticks.s;
+  const double* tk_d = ticks.d;
+  double worst = -1e9;
+  Reject why = Reject::kCount;
+  auto take = [&](double v, Reject r) {
+    if (!(v <= worst)) {  // NaN counts as a violation
+      worst = Finite(v) ? v : 1e9;
+      why = r;
+    }
+  };
+  // d as the simulator reads it (from chords), bounded every 5 ticks over the s swept since
+  // the previous check point.
+  // The lane-line timer runs on, from the start state's count, while the read d may be astride
+  // a line; a trajectory still astride at its end would stay there.
+  // On a uniform road, the range of d read against d_min / d_max; on another, the largest
+  // excess over the road's edges (EdgeExcess).
+  double dmin = 1e9, dmax = -1e9, sdmin = 1e9, off_road = -1e9;
+  int straddle = ws_.straddle_at_start, worst_straddle = straddle;
+  for (int i = 1; i <= n_ticks; ++i) sdmin = std::min(sdmin, ticks.sd[i]);
+  for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
+       prev = i, i = std::min(i + 5, n_ticks)) {
+    const ReadRange read = ReadBetween(tk_s, tk_d, prev, i);
+    if (cfg_.uniform_road) {
+      dmin = std::min(dmin, read.lo);
+      dmax = std::max(dmax, read.hi);
+      straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
+      worst_straddle = std::max(worst_straddle, straddle);
+    } else {
+      off_road = std::max(off_road, EdgeExcess(tk_s[prev], tk_s[i], read));
+    }
+    if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.d_min - dmin > 0 ||
+                dmax - cfg_.d_max > 0 || off_road > 0)) {
+      if (reason != nullptr) *reason = Reject::kCount;  // unknown: not measured in full
+      return 1.0;  // a limit is broken (which one is worst is not known)
+    }
+    if (i == n_ticks) break;
+  }
+  if (straddle > 0) worst_straddle = 1 << 20;
+  if (cfg_.uniform_road) off_road = std::max(cfg_.d_min - dmin, dmax - cfg_.d_max);
+  take(off_road / cfg_.lane_width, Reject::kOffRoad);
+  if (lane_line) {
+    take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
+         Reject::kLaneLine);
+  }
+  take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
+  if (worst > 0) {                      // already infeasible: skip the XY conversion
+    if (reason != nullptr) *reason = why;
+    return worst;
+  }
+  Ticks xy_ticks = ticks;
+  if (ticks.lon_slot >= 0) {
+    const int i = ticks.lon_slot, w = ws_.n_ticks + 1;  // the whole row, for every candidate
+    if (!lon_centre_have_[i]) {
+      for (int t = 1; t <= ws_.n_ticks; ++t) lon_centre_[i * w + t] = line_.Centre(ticks.s[t]);
+      lon_centre_have_[i] = 1;
+    }
+    xy_ticks.centre = &lon_centre_[i * w];
+  }
+  const int n = BuildXyPath(xy_ticks);
+  const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
+  take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
+  take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
+  take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
+  if (cfg_.vehicle.any()) {
+    // A vehicle's limits count as acceleration (steering angle: lateral; forward) and jerk
+    // (the steering rate) limits.
+    if (cfg_.vehicle.max_steer > 0) take(m.steer_ratio - 1.0, Reject::kAcceleration);
+    if (cfg_.vehicle.max_accel > 0) take(m.forward_accel_ratio - 1.0, Reject::kAcceleration);
+    if (cfg_.vehicle.max_steer_rate > 0) take(m.steer_rate_ratio - 1.0, Reject::kJerk);
+  }
+  if (reason != nullptr) *reason = worst > 0 ? why : Reject::kCount;
+  return worst;
+}
+
+}  // namespace frenetic::plan::search

@@ -1,0 +1,149 @@
+// The search planner's limit checks (LimitChecker): each limit rejects with its own reason, the
+// lane-line timer, and the early answer agrees with the full one.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "plan/search/stages_testing.h"
+
+namespace frenetic::plan::search {
+namespace {
+
+using testing::Stages;
+
+constexpr double kS = 800;
+
+TEST(LimitCheckerTest, SteadyDrivingIsFeasible) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  st.WriteTicks(kS, 20, 6.0, [](double) { return 0.0; });
+  Reject why = Reject::kSpeed;
+  EXPECT_LE(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kCount);
+}
+
+TEST(LimitCheckerTest, EachLimitRejectsWithItsReason) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  Reject why = Reject::kCount;
+  // 25 m/s is over 49.5 mph.
+  st.WriteTicks(kS, 25, 6.0, [](double) { return 0.0; });
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kSpeed);
+  // Braking that ramps to 11 m/s^2 over 1.5 s and back (jerk ~7 m/s^3): too hard.
+  auto ramp = [](double peak) {
+    return [peak](double t) {
+      const double k = peak / 1.5;
+      return t < 1.5 ? -k * t : t < 3.0 ? -peak + k * (t - 1.5) : 0.0;
+    };
+  };
+  st.WriteTicks(kS, 22, 6.0, ramp(11));
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kAcceleration);
+  st.WriteTicks(kS, 22, 6.0, ramp(7));
+  EXPECT_LE(st.limits.Violation(&why), 0) << "7 m/s^2 is within the limit";
+  // Off the road on the right.
+  st.WriteTicks(kS, 20, 11.8, [](double) { return 0.0; });
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kOffRoad);
+  // Backwards.
+  st.WriteTicks(kS, -1, 6.0, [](double) { return 0.0; });
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kSpeed);
+  // A NaN is a violation, never a pass.
+  st.WriteTicks(kS, 20, 6.0, [](double) { return 0.0; });
+  st.ws.tk_d[100] = NAN;
+  EXPECT_GT(st.limits.Violation(&why), 0);
+}
+
+TEST(LimitCheckerTest, JerkRejectsWithItsReason) {
+  REQUIRE_UDACITY_MAP();
+  // The simulator's acceleration is a magnitude, so with equal limits a jerk excess comes with
+  // an acceleration one: a lower jerk limit isolates it.
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Set("limits.max_jerk", 4).ok());
+  Stages st(config);
+  st.Prepare({kS, 20, 0, 6.0, 0, 0});
+  // After a second of cruising (the jerk windows need the history), 6 m/s^2 of braking.
+  st.WriteTicks(kS, 20, 6.0, [](double t) { return t < 1 ? 0.0 : t < 2.5 ? -6.0 : 0.0; });
+  Reject why = Reject::kCount;
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kJerk);
+  st.WriteTicks(kS, 20, 6.0, [](double t) { return t < 1 ? 0.0 : t < 2.5 ? -3.0 : 0.0; });
+  EXPECT_LE(st.limits.Violation(&why), 0);
+}
+
+TEST(LimitCheckerTest, LaneLineTimerCountsFromTheStartAndCanBeLeftOut) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  st.Prepare({kS, 20, 0, 4.0, 0, 0});
+  // Astride the lane line to the end of the horizon: it would stay there.
+  st.WriteTicks(kS, 20, 4.0, [](double) { return 0.0; });
+  Reject why = Reject::kCount;
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kLaneLine);
+  EXPECT_LE(st.limits.Violation(&why, /*lane_line=*/false), 0);
+  // Astride for a second, then a smooth move into the lane (2.5 s): fine from a fresh timer,
+  // not with 2.5 s already counted.
+  for (int i = 1; i <= st.ws.n_ticks; ++i) {
+    const double u = std::clamp((i * kTickSeconds - 1.0) / 2.5, 0.0, 1.0);
+    st.ws.tk_d[i] = 4.0 + 2.0 * u * u * u * (10 - 15 * u + 6 * u * u);
+  }
+  st.ws.straddle_at_start = 0;
+  EXPECT_LE(st.limits.Violation(&why), 0);
+  st.ws.straddle_at_start = 125;
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kLaneLine);
+  // The helpers agree: the line at 4 m is within kStraddle of 4.5, not of 5.
+  EXPECT_TRUE(StraddlesRead(st.cfg, 4.5, 4.5));
+  EXPECT_FALSE(StraddlesRead(st.cfg, 5.0, 5.0));
+}
+
+// The least-harm choice asks only whether a candidate breaks a limit, and the Frenet checks
+// stop at the first one found broken: the answer is CandidateViolation's, and a verdict cut
+// short that way is measured in full when the reason is asked for later.
+TEST(LimitCheckerTest, BreaksLimitsAgreesWithTheFullViolation) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  int broken = 0, cut_short_then_full = 0, total = 0;
+  // Astride a line and in a lane, slow and fast, with the lane-line count fresh, near and past
+  // its limit.
+  for (const double d0 : {4.0, 5.2, 6.0, 9.9}) {
+    for (const double v0 : {8.0, 21.5}) {
+      for (const int straddle : {0, 120, 130, 200}) {
+        st.Prepare({kS, v0, 0, d0, 0, 0});
+        st.ws.straddle_at_start = straddle;
+        st.lattice.Generate();
+        ASSERT_TRUE(st.scorer.Score());
+        const int n = static_cast<int>(st.ws.order.size());
+        std::vector<char> breaks(n);
+        for (int c = 0; c < n; ++c) breaks[c] = st.limits.CandidateBreaksLimits(c);
+        for (int c = 0; c < n; ++c) {
+          Reject why = Reject::kCount, why_ref = Reject::kCount;
+          const double worst = st.limits.CandidateViolation(c, &why);
+          st.ws.FillTicks(st.ws.Candidate(c));
+          const double worst_ref = st.limits.Violation(&why_ref);
+          ASSERT_EQ(breaks[c] != 0, worst_ref > 0) << "candidate " << c;
+          EXPECT_EQ(worst, worst_ref) << "candidate " << c;
+          EXPECT_EQ(why, why_ref) << "candidate " << c;
+          broken += breaks[c];
+          cut_short_then_full += breaks[c] && why == Reject::kLaneLine && straddle >= 120;
+          ++total;
+        }
+      }
+    }
+  }
+  EXPECT_GT(broken, total / 10);
+  EXPECT_LT(broken, total);
+  EXPECT_GT(cut_short_then_full, 0);
+}
+
+}  // namespace
+}  // namespace frenetic::plan::search
