@@ -164,6 +164,7 @@ LatTraj Lattice::MakeLat(int lane, double offset, double T, double delay) const 
 
 LatTraj Lattice::MakeSwerve(int goal, double d, double d_d, double T, double d_dd) const {
   LatTraj l;
+  l.kind = LatKind::kSwerve;
   l.goal = goal;
   l.traj.duration = T;
   const traj::FrenetState& s0 = ws_.start;
@@ -266,6 +267,7 @@ void Lattice::AddPasses() {
     const int own = ws_.prev_lat_lane;
     if (elapsed < prev.duration - kPassResolve) {
       LatTraj l;
+      l.kind = LatKind::kPass;
       l.lane = own;
       l.traj = prev;
       l.traj.duration = prev.duration - elapsed;
@@ -295,6 +297,7 @@ void Lattice::AddPasses() {
     for (const double hold : kPassHold) {
       for (const double back : kPassBack) {
         LatTraj l;
+        l.kind = LatKind::kPass;
         l.lane = own;
         const double d_out = ws_.lane_center[oncoming], d_own = ws_.lane_center[own];
         l.traj.duration = out;
@@ -558,7 +561,7 @@ void Lattice::Generate() {
   for (int i = 0; i < static_cast<int>(ws_.lon.size()); ++i) {
     for (int j = 0; j < static_cast<int>(ws_.lat.size()); ++j) {
       if (ws_.lon[i].lane >= 0 && ws_.lon[i].lane != ws_.lat[j].lane) continue;
-      if (ws_.lat[j].goal >= 0 && !ws_.SwerveEndsInside(i, j)) continue;
+      if (ws_.lat[j].swerve() && !ws_.SwerveEndsInside(i, j)) continue;
       ws_.cand_lon.push_back(i);
       ws_.cand_lat.push_back(j);
     }

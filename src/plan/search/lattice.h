@@ -26,17 +26,24 @@ struct LonTraj {
   double jerk2 = 0;
 };
 
-// One lateral move of the bundle: to `lane`'s centre plus `offset` (m); a swerve into goal
-// region `goal` (>= 0), crossing it turned at the end of the move (Lattice::AddSwerves); or a
-// pass, out into the oncoming lane and back to `lane` (Lattice::AddPasses).
+// What a lateral move of the bundle is.
+enum class LatKind {
+  kLane,    // to `lane`'s centre plus `offset` (m); keeping the lane is one (Lattice::MakeLat)
+  kSwerve,  // into goal region `goal`, crossing it turned at the move's end (AddSwerves)
+  kPass,    // out into the oncoming lane and back to `lane`: the trajectory's second move
+            // (back_duration > 0; AddPasses)
+};
+
+// One lateral move of the bundle.
 struct LatTraj {
   traj::Trajectory1d traj;
-  int lane = 0;
-  double offset = 0;
+  LatKind kind = LatKind::kLane;
+  int lane = 0;       // the lane it ends in (a swerve: the lane nearest its end)
+  double offset = 0;  // m from that lane's centre at the end
   double jerk2 = 0;
-  int goal = -1;
-  // A pass: out into the oncoming lane and back (the trajectory's second move).
-  bool pass() const { return traj.back_duration > 0; }
+  int goal = -1;  // a swerve's goal region (its index in the cycle's goals); -1 otherwise
+  bool swerve() const { return kind == LatKind::kSwerve; }
+  bool pass() const { return kind == LatKind::kPass; }
 };
 
 // m/s: the fastest a vehicle can be T s after v0 at its forward acceleration limit: the

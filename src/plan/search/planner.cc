@@ -207,7 +207,7 @@ class SearchPlanner : public Planner {
       // A swerve into a goal region is taken as it is: its checks end at the region
       // (Workspace::CheckTicks), the refinement's run over the whole horizon; and a pass, which
       // the refinement's single move cannot express.
-      if (found && cfg_.refine && refiner_.available() && ws_.lat[ws_.winner_lat].goal < 0 &&
+      if (found && cfg_.refine && refiner_.available() && !ws_.lat[ws_.winner_lat].swerve() &&
           !ws_.lat[ws_.winner_lat].pass()) {
         // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
         // asks for none beyond the cycle's.

@@ -66,14 +66,14 @@ Workspace::Workspace(const Settings& cfg) {
 
 int Workspace::CheckTicks(int c) const {
   const int j = cand_lat[c];
-  if (lat[j].goal < 0 || lat[j].goal >= num_goals) return n_ticks;
+  if (!lat[j].swerve() || lat[j].goal >= num_goals) return n_ticks;
   const int ticks = static_cast<int>(std::floor(lat[j].traj.end_time() / kTickSeconds + 1e-6));
   return ticks < 1 || ticks >= n_ticks ? n_ticks : ticks;
 }
 
 bool Workspace::SwerveEndsInside(int i, int j) const {
   const LatTraj& l = lat[j];
-  if (l.goal < 0 || l.goal >= num_goals) return false;
+  if (!l.swerve() || l.goal >= num_goals) return false;
   const double T = l.traj.end_time();
   const cost::GoalRegion& r = goals[l.goal];
   const traj::State1d lo = lon[i].traj.At(T);

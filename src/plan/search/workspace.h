@@ -50,7 +50,7 @@ struct Workspace {
   // only with the lon trajectories that put it in its goal region there, SwerveEndsInside): the
   // run ends at its goal, and what would follow leaves the lane turned.
   int CheckTicks(int c) const;
-  // Whether lon trajectory i with swerve j (lat[j].goal >= 0) is inside the swerve's goal region
+  // Whether lon trajectory i with swerve j (lat[j].swerve()) is inside the swerve's goal region
   // at the swerve's end: time, s, d, speed and heading.
   bool SwerveEndsInside(int i, int j) const;
   int CheckSteps(int c) const {

@@ -390,7 +390,7 @@ TEST(SearchLatticeTest, SwervesIntoARegionCrossedTurnedEndInsideItAndAreCheckedU
   int swerves = 0, paired = 0;
   for (size_t j = 0; j < ws.lat.size(); ++j) {
     const LatTraj& l = ws.lat[j];
-    if (l.goal < 0) continue;
+    if (!l.swerve()) continue;
     ++swerves;
     EXPECT_EQ(l.goal, 0);
     const traj::State1d end = l.traj.At(l.traj.end_time());
@@ -402,7 +402,7 @@ TEST(SearchLatticeTest, SwervesIntoARegionCrossedTurnedEndInsideItAndAreCheckedU
   EXPECT_GT(swerves, 0);
   for (size_t c = 0; c < ws.cand_lon.size(); ++c) {
     const LatTraj& l = ws.lat[ws.cand_lat[c]];
-    if (l.goal < 0) {
+    if (!l.swerve()) {
       EXPECT_EQ(ws.CheckTicks(static_cast<int>(c)), ws.n_ticks);
       continue;
     }
@@ -421,7 +421,7 @@ TEST(SearchLatticeTest, SwervesIntoARegionCrossedTurnedEndInsideItAndAreCheckedU
   // Turned less than kTurnedHeading: a region kept in a lane, no swerve.
   ws.goals[0].h_lo = 0.5 * cost::kTurnedHeading;
   st.lattice.Generate();
-  for (const LatTraj& l : ws.lat) EXPECT_LT(l.goal, 0);
+  for (const LatTraj& l : ws.lat) EXPECT_FALSE(l.swerve());
 }
 
 // A swerve that ended between two of the problem's steps, its goal not met: it goes on as it
@@ -452,7 +452,7 @@ TEST(SearchLatticeTest, ASwerveThatEndedBeforeItsGoalGoesOnOneStepAtATime) {
   st.lattice.Generate();
   int late = 0;
   for (const LatTraj& l : ws.lat) {
-    if (l.goal < 0 || std::abs(l.traj.duration - 0.1) > 1e-12) continue;
+    if (!l.swerve() || std::abs(l.traj.duration - 0.1) > 1e-12) continue;
     ++late;
     const traj::State1d end = l.traj.At(0.1);
     EXPECT_NEAR(end.p, ws.start.d + 4.0 * 0.1 + 0.5 * 2.0 * 0.01, 1e-9);
@@ -464,7 +464,7 @@ TEST(SearchLatticeTest, ASwerveThatEndedBeforeItsGoalGoesOnOneStepAtATime) {
   ws.prev_elapsed = 2.0;
   st.lattice.Generate();
   for (const LatTraj& l : ws.lat) {
-    EXPECT_FALSE(l.goal >= 0 && std::abs(l.traj.duration - 0.1) < 1e-12);
+    EXPECT_FALSE(l.swerve() && std::abs(l.traj.duration - 0.1) < 1e-12);
   }
 }
 
