@@ -161,7 +161,7 @@ const std::uint64_t* CollisionChecker::TightLatNear(int i, int k) {
   if (tight_stamp_ != stamp) {
     // A cap on the margins that holds for every lon slot of ordinary speeds (the margin grows
     // with the ego's s' ahead and shrinks with it behind: the ends of the range bound it).
-    const double top = std::max(cfg_.max_speed, ws_.start.s_d) + 5.0;
+    const double top = std::max(cfg_.limits.max_speed, ws_.start.s_d) + 5.0;
     tight_margin_ = std::max(Widest(0.0, 1.0, 1.0), Widest(top, 1.0, 1.0));
     // The car's extent along d in HitsAt (its box's half length times |heading's d| plus its
     // half width times heading's s), with the margin at most tight_margin_.
@@ -169,7 +169,7 @@ const std::uint64_t* CollisionChecker::TightLatNear(int i, int k) {
       for (int j = 1; j <= n_steps; ++j) {
         const int at = car * w + j;
         car_extent_d_[at] = (ws_.car_hl[car] + tight_margin_) * std::abs(ws_.step_dir_d[at]) +
-                            (ws_.car_hw[car] + cfg_.margin_d) * ws_.step_dir_s[at];
+                            (ws_.car_hw[car] + cfg_.check.margin_d) * ws_.step_dir_s[at];
       }
     }
     tight_stamp_ = stamp;
@@ -191,7 +191,7 @@ const std::uint64_t* CollisionChecker::TightLatNear(int i, int k) {
     // |d'| / sqrt(0.25 + d'^2) =: u, and the extent at most hl u + hw sqrt(1 - u^2) while u
     // is below hl / r, r (the half diagonal) past it. Plus HitsAt's 1 mm, and 1e-9 m for the
     // rounding of both sides; a d' that is not finite keeps every car.
-    const double hl = 0.5 * cfg_.ego_length, hw = 0.5 * cfg_.ego_width;
+    const double hl = 0.5 * cfg_.check.ego_length, hw = 0.5 * cfg_.check.ego_width;
     const double r = std::hypot(hl, hw);
     for (int j = 1; j <= n_steps; ++j) {
       const double vd = lat_steps_.v[k * w + j];

@@ -181,13 +181,13 @@ class CollisionChecker {
 // step_v_max; rounded products and sums are monotone), so a car farther along s than
 // ws.reach_s_base + widest fails its reach test anyway. Only with non-negative factors.
 inline double CollisionChecker::Widest(double s_d, double margin_scale, double behind_scale) const {
-  const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.margin_s >= 0 &&
-                       cfg_.headway_min >= 0 && cfg_.margin_behind >= 0 && cfg_.behind_time >= 0;
+  const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.check.margin_s >= 0 &&
+                       cfg_.check.headway_min >= 0 && cfg_.check.margin_behind >= 0 && cfg_.check.behind_time >= 0;
   if (!bounded) return std::numeric_limits<double>::infinity();
   return std::max(
-      {margin_scale * std::max(cfg_.margin_s, cfg_.headway_min * std::max(s_d, 0.0)),
-       behind_scale * (cfg_.margin_behind + cfg_.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
-       margin_scale * cfg_.margin_s});
+      {margin_scale * std::max(cfg_.check.margin_s, cfg_.check.headway_min * std::max(s_d, 0.0)),
+       behind_scale * (cfg_.check.margin_behind + cfg_.check.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
+       margin_scale * cfg_.check.margin_s});
 }
 
 inline double CollisionChecker::ReachS(double s_d, double margin_scale, double behind_scale) const {
@@ -215,7 +215,7 @@ struct CollisionChecker::StepEgo {
 
 inline CollisionChecker::StepEgo CollisionChecker::EgoAt(const traj::FrenetState& st, double margin_scale,
                                        double behind_scale) const {
-  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.ego_length, 0.5 * cfg_.ego_width}, st.s_d,
+  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.check.ego_length, 0.5 * cfg_.check.ego_width}, st.s_d,
           std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
 }
 
@@ -233,7 +233,7 @@ inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double marg
   // its lane needs more room than a mere non-overlap (the seeds' rule: 15 m behind).
   // A car ahead needs room to brake behind it: headway_min at the ego's speed.
   const bool behind_other_lane =
-      cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.lane_width;
+      cs < ego.cx && std::abs(ws_.car_d0[c] - ws_.start.d) > 0.5 * cfg_.road.lane_width;
   // A car behind in another lane needs room to react and brake when it closes in.
   const double closing = std::max(0.0, ws_.step_v[at] - e.s_d);
   // The headway to a car ahead is kept in full while the ego is in its lane and tapers
@@ -244,11 +244,11 @@ inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double marg
       std::clamp((sep_d - std::abs(cd - ego.cy)) / (sep_d - kFollowerLateral), 0.0, 1.0);
   // An oncoming car (moving the other way: a two-way road's other lane) is passed, not
   // followed: no headway.
-  double margin = margin_scale * cfg_.margin_s;
+  double margin = margin_scale * cfg_.check.margin_s;
   if (cs >= ego.cx && ws_.step_v[at] >= 0) {
-    margin = margin_scale * std::max(cfg_.margin_s, inside * cfg_.headway_min * e.s_d);
+    margin = margin_scale * std::max(cfg_.check.margin_s, inside * cfg_.check.headway_min * e.s_d);
   } else if (behind_other_lane) {  // (only ever behind: cs < ego.cx)
-    margin = behind_scale * (cfg_.margin_behind + cfg_.behind_time * closing);
+    margin = behind_scale * (cfg_.check.margin_behind + cfg_.check.behind_time * closing);
   }
   if (std::abs(cs - ego.cx) > ws_.reach_s_base + ws_.car_reach_s[c] + margin ||
       std::abs(cd - ego.cy) > ws_.reach_d + ws_.car_reach_d[c]) {
@@ -257,7 +257,7 @@ inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double marg
   const double cu = ws_.step_dir_s[at], cw = ws_.step_dir_d[at];  // the car's unit heading
   e.Direction();
   const traj::OrientedBox car{cs, cd, 0.0, ws_.car_hl[c] + margin,
-                              ws_.car_hw[c] + margin_scale * cfg_.margin_d};
+                              ws_.car_hw[c] + margin_scale * cfg_.check.margin_d};
   // The d axis separates the boxes when their extents along it do not reach (most cars
   // alongside, in the next lane): a gap over 1 mm is one Overlap finds on its axes too.
   const double reach_d = ego.half_length * std::abs(e.dir_d) + ego.half_width * e.dir_s +

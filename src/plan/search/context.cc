@@ -22,13 +22,13 @@ constexpr double kUdacityHalfDiagonal = 2.6832815729997477;
 // left bends, udacity-sim.md §5.3 and §9.3), reads the ego inside its lane over the next
 // stretch: clear of the lane lines' +-0.8 m bands (the 3 s timer) and of the road edges.
 void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws) {
-  const double ahead = std::max(ws.start.s_d, 10.0) * cfg.score_horizon + 20.0;
-  const int last = cfg.num_lanes - 1;
+  const double ahead = std::max(ws.start.s_d, 10.0) * cfg.score.horizon + 20.0;
+  const int last = cfg.road.num_lanes - 1;
   for (int l = 0; l <= last; ++l) {
     const map::ReferenceLine::OffsetRange r =
         line.ChordOffset(ws.start.s - 10.0, ws.start.s + ahead, ws.lane_nominal[l]);
-    const double lo_read = l == 0 ? cfg.d_min : l * cfg.lane_width + kLaneLineBand;
-    const double hi_read = l == last ? cfg.d_max : (l + 1) * cfg.lane_width - kLaneLineBand;
+    const double lo_read = l == 0 ? cfg.limits.d_min : l * cfg.road.lane_width + kLaneLineBand;
+    const double hi_read = l == last ? cfg.limits.d_max : (l + 1) * cfg.road.lane_width - kLaneLineBand;
     const double lo = lo_read - r.lo, hi = hi_read - r.hi;
     ws.lane_center[l] = lo <= hi ? std::clamp(ws.lane_nominal[l], lo, hi) : 0.5 * (lo + hi);
   }
@@ -42,7 +42,7 @@ void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace&
 void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
   const double s0 = ws.start.s;
   const double look = s0 + std::clamp(ws.start.s_d * kLaneLookahead, 0.0, kMaxLaneLookahead);
-  for (int l = 0; l < cfg.num_lanes; ++l) {
+  for (int l = 0; l < cfg.road.num_lanes; ++l) {
     const map::Road::Span now = road.LaneAt(l, s0), ahead = road.LaneAt(l, look);
     ws.lane_exists[l] = now.exists;
     ws.lane_oncoming[l] = road.Oncoming(l);
@@ -52,13 +52,13 @@ void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
     if (now.exists) {
       ws.lane_nominal[l] = ahead.exists ? ahead.centre() : now.centre();
     } else {
-      ws.lane_nominal[l] = l == 0 ? 0.0 : ws.lane_nominal[l - 1] + cfg.lane_width;
+      ws.lane_nominal[l] = l == 0 ? 0.0 : ws.lane_nominal[l - 1] + cfg.road.lane_width;
     }
     ws.lane_center[l] = ws.lane_nominal[l];
   }
   const map::Road::Span edges = road.EdgesAt(s0);
   ws.road_left = edges.exists ? edges.left : 0.0;
-  ws.road_right = edges.exists ? edges.right : cfg.num_lanes * cfg.lane_width;
+  ws.road_right = edges.exists ? edges.right : cfg.road.num_lanes * cfg.road.lane_width;
   // The edge table: the tightest edges over each bin, from its two ends (borders are linear
   // between stations; a lane that ends shows at the bin holding its end).
   ws.edge_s0 = s0 - Workspace::kEdgeBehind;
@@ -77,7 +77,7 @@ void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
 
 int LaneOf(const Settings& cfg, const Workspace& ws, double d) {
   int best = -1;
-  for (int l = 0; l < cfg.num_lanes; ++l) {
+  for (int l = 0; l < cfg.road.num_lanes; ++l) {
     if (!ws.lane_exists[l]) continue;
     if (best < 0 || std::abs(d - ws.lane_center[l]) < std::abs(d - ws.lane_center[best])) best = l;
   }
@@ -91,16 +91,16 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   const int n_samples = ws.n_samples, n_steps = ws.n_steps;
   cost::CostContext& c = ws.ctx;
   c.num_samples = n_samples;
-  c.dt = cfg.score_dt;
-  c.lane_width = cfg.lane_width;
-  c.num_lanes = cfg.num_lanes;
-  c.car_length = cfg.car_length;
-  c.car_width = cfg.car_width;
+  c.dt = cfg.score.dt;
+  c.lane_width = cfg.road.lane_width;
+  c.num_lanes = cfg.road.num_lanes;
+  c.car_length = cfg.check.car_length;
+  c.car_width = cfg.check.car_width;
   c.start_s = start.s;
   c.start_d = start.d;
   c.start_speed = start.s_d;
   c.oncoming_right = -std::numeric_limits<double>::infinity();
-  if (cfg.uniform_road) {
+  if (cfg.road.uniform) {
     LaneCentres(cfg, line, ws);
   } else {
     RoadLanes(cfg, road, ws);  // and c.oncoming_right
@@ -111,7 +111,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   c.lane_before_change = ws.lane_before_change;
   // Lane speed limits: the XY speed of an offset curve is s' (1 + kappa d) with d to the right
   // and kappa positive to the left, so the outer lane of a left bend is faster in XY.
-  const double reach = cfg.max_speed * cfg.score_horizon + 20;
+  const double reach = cfg.limits.max_speed * cfg.score.horizon + 20;
   double kmax = 0, kmin = 0;
   for (double ds = -10; ds <= reach; ds += 2.0) {
     const double k = line.At(start.s + ds).kappa;
@@ -120,7 +120,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
       kmin = std::min(kmin, k);
     }
   }
-  if (cfg.curve_prefilter) {
+  if (cfg.check.curve_prefilter) {
     // Each bin's largest |kappa|, from its two ends and its middle (the line's curvature
     // changes over tens of metres).
     ws.kappa_s0 = start.s - Workspace::kEdgeBehind;
@@ -134,17 +134,17 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     }
     ws.max_abs_d = std::max(std::abs(ws.road_left), std::abs(ws.road_right));
   }
-  for (int l = 0; l < cfg.num_lanes; ++l) {
+  for (int l = 0; l < cfg.road.num_lanes; ++l) {
     c.lane_center[l] = ws.lane_center[l];
     const double d = ws.lane_center[l];
     const double factor = std::max({1.0, 1.0 + kmax * d, 1.0 + kmin * d});
     // A little below the cap: lateral motion and the splice add a few cm/s in XY.
-    c.lane_speed_limit[l] = std::min(cfg.max_speed, road.SpeedLimit(l)) / factor - 0.05;
+    c.lane_speed_limit[l] = std::min(cfg.limits.max_speed, road.SpeedLimit(l)) / factor - 0.05;
   }
   // Previous choice at this cycle's sample times.
   if (ws.have_prev_traj) {
     for (int k = 0; k < n_samples; ++k) {
-      const traj::FrenetState p = ws.prev_traj.At(k * cfg.score_dt + ws.prev_elapsed);
+      const traj::FrenetState p = ws.prev_traj.At(k * cfg.score.dt + ws.prev_elapsed);
       ws.prev_s[k] = p.s;
       ws.prev_d[k] = p.d;
     }
@@ -165,7 +165,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
     const TrackedCar& car = cars[i];
     const double hl = 0.5 * car.length, hw = 0.5 * car.width;
-    const double sep_s = 0.5 * cfg.ego_length + hl;
+    const double sep_s = 0.5 * cfg.check.ego_length + hl;
     if (cfg.followers_react && car.s < -sep_s && std::abs(car.d - start.d) < kFollowerLateral) {
       continue;
     }
@@ -174,12 +174,12 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     ws.car_hl[nc] = hl;
     ws.car_hw[nc] = hw;
     ws.car_sep_s[nc] = sep_s;
-    ws.car_sep_d[nc] = 0.5 * cfg.ego_width + hw;
+    ws.car_sep_d[nc] = 0.5 * cfg.check.ego_width + hw;
     const Predictor::Prediction at_start = predictor.Predict(i, ws.t_keep);
     ws.car_s0[nc] = start.s + at_start.s;  // at the start instant, in the start's s frame
     ws.car_d0[nc] = at_start.d;
     for (int k = 0; k < n_samples; ++k) {
-      const Predictor::Prediction p = predictor.Predict(i, ws.t_keep + k * cfg.score_dt);
+      const Predictor::Prediction p = predictor.Predict(i, ws.t_keep + k * cfg.score.dt);
       ws.car_s[nc * n_samples + k] = start.s + p.s;
       ws.car_d[nc * n_samples + k] = p.d;
       ws.car_v[nc * n_samples + k] = p.v;
@@ -205,7 +205,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   // FirstCollision's broad reaches: the Udacity footprints' 8 and 5 m, scaled up with the
   // half diagonals of the ego and of each car when they are larger: a base for a car of the
   // Udacity footprint, and per car what its own size adds (a truck's reach is not every car's).
-  const double ego_diag = std::hypot(0.5 * cfg.ego_length, 0.5 * cfg.ego_width);
+  const double ego_diag = std::hypot(0.5 * cfg.check.ego_length, 0.5 * cfg.check.ego_width);
   auto scale = [&](double car_diag) {
     return std::max(1.0, (ego_diag + car_diag) / (2 * kUdacityHalfDiagonal));
   };
@@ -236,14 +236,14 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   c.car_v = ws.car_v.data();
   c.car_half_length = ws.car_hl.data();
   c.car_half_width = ws.car_hw.data();
-  c.max_half_length = 0.5 * cfg.car_length;
-  c.max_half_width = 0.5 * cfg.car_width;
+  c.max_half_length = 0.5 * cfg.check.car_length;
+  c.max_half_width = 0.5 * cfg.check.car_width;
   for (int i = 0; i < real; ++i) {
     c.max_half_length = std::max(c.max_half_length, ws.car_hl[i]);
     c.max_half_width = std::max(c.max_half_width, ws.car_hw[i]);
   }
-  c.ego_length = cfg.ego_length;
-  c.ego_width = cfg.ego_width;
+  c.ego_length = cfg.check.ego_length;
+  c.ego_width = cfg.check.ego_width;
   c.num_goals = ws.num_goals;
   c.goals = ws.goals;
 }

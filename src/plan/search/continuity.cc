@@ -17,7 +17,7 @@ Continuity::Continuity(const Settings& cfg, const map::ReferenceLine& line, Work
     : cfg_(cfg), line_(line), ws_(ws), clock_(clock) {
   for (auto* v :
        {&plan_s_, &plan_sd_, &plan_sdd_, &plan_d_, &plan_dd_, &plan_ddd_, &plan_x_, &plan_y_}) {
-    v->assign(cfg_.output_points + 1, 0.0);
+    v->assign(cfg_.continuity.output_points + 1, 0.0);
   }
   hist_x_.assign(kHistory, 0.0);
   hist_y_.assign(kHistory, 0.0);
@@ -38,13 +38,13 @@ Continuity::Sync Continuity::Synchronise(const Telemetry& t, bool prev_ok, bool 
   const int n_prev = prev_ok ? static_cast<int>(t.previous_path_x.size()) : -1;
   if (have_plan_ && n_prev > 0 && n_prev <= plan_n_) {
     r.consumed = plan_n_ - n_prev;
-    const double tol = cfg_.resync_tolerance;
+    const double tol = cfg_.continuity.resync_tolerance;
     r.synced = std::abs(t.previous_path_x[0] - plan_x_[r.consumed]) < tol &&
                std::abs(t.previous_path_y[0] - plan_y_[r.consumed]) < tol &&
                std::abs(t.previous_path_x[n_prev - 1] - plan_x_[plan_n_ - 1]) < tol &&
                std::abs(t.previous_path_y[n_prev - 1] - plan_y_[plan_n_ - 1]) < tol;
   }
-  if (!r.synced && !ego_ok && have_plan_ && plan_n_ > cfg_.keep_points + 1) {
+  if (!r.synced && !ego_ok && have_plan_ && plan_n_ > cfg_.continuity.keep_points + 1) {
     // Unusable telemetry: carry on along our own plan as if one tick passed.
     r.consumed = 1;
     r.synced = true;
@@ -77,10 +77,10 @@ bool Continuity::Relevant(double x, double y, double ego_x, double ego_y) const 
 // vanished, and every relevant car is where constant velocity put it (position error plus
 // one second of velocity error below replan_deviation). Any doubt replans.
 bool Continuity::CanReuse(const Telemetry& t, int consumed) const {
-  if (!can_reuse_ || cfg_.replan_min_ticks <= 1) return false;
+  if (!can_reuse_ || cfg_.continuity.replan_min_ticks <= 1) return false;
   const int ticks = ticks_since_search_ + consumed;
-  if (ticks >= cfg_.replan_min_ticks) return false;
-  if (plan_n_ - consumed < std::max(kMinPathPoints, cfg_.keep_points + 1)) return false;
+  if (ticks >= cfg_.continuity.replan_min_ticks) return false;
+  if (plan_n_ - consumed < std::max(kMinPathPoints, cfg_.continuity.keep_points + 1)) return false;
   const double dt = ticks * kTickSeconds;
   for (const SensorCar& c : t.sensor_fusion) {
     if (!Finite(c.x) || !Finite(c.y) || !Finite(c.vx) || !Finite(c.vy)) return false;
@@ -97,7 +97,7 @@ bool Continuity::CanReuse(const Telemetry& t, int consumed) const {
     const double ex = c.x - (old->x + old->vx * dt), ey = c.y - (old->y + old->vy * dt);
     const double evx = c.vx - old->vx, evy = c.vy - old->vy;
     const double error = std::hypot(ex, ey) + std::hypot(evx, evy) * 1.0;
-    if (!(error < cfg_.replan_deviation)) return false;
+    if (!(error < cfg_.continuity.replan_deviation)) return false;
   }
   // A relevant car of the snapshot that is no longer reported vanished.
   for (int i = 0; i < snap_n_; ++i) {
@@ -194,7 +194,7 @@ void Continuity::SetXyPrefix(LimitChecker& limits) const {
 
 void Continuity::Store(PlanResult& result) {
   const int kept = ws_.kept;
-  const int new_points = cfg_.output_points - kept;
+  const int new_points = cfg_.continuity.output_points - kept;
   for (int i = 1; i <= new_points; ++i) {
     const int k = kept + i - 1;
     plan_s_[k] = ws_.tk_s[i];
@@ -207,7 +207,7 @@ void Continuity::Store(PlanResult& result) {
     plan_x_[k] = p.x;
     plan_y_[k] = p.y;
   }
-  plan_n_ = cfg_.output_points;
+  plan_n_ = cfg_.continuity.output_points;
   plan_start_index_ = kept > 0 ? kept - 1 : -1;
   // Last resort against NaN from anywhere: repeat the last finite point.
   double lx = 0, ly = 0;
@@ -252,13 +252,13 @@ traj::FrenetState Continuity::MeasuredStart(const Telemetry& t, bool ego_ok) con
     const double along = std::isfinite(stretch) && stretch > 0.5 ? 1.0 / stretch : 1.0;
     start = {f.s, v * std::cos(rel) * along, 0.0, f.d, -v * std::sin(rel), 0.0};
   } else {
-    start = {0.0, 0.0, 0.0, ws_.lane_center[std::min(1, cfg_.num_lanes - 1)], 0.0, 0.0};
+    start = {0.0, 0.0, 0.0, ws_.lane_center[std::min(1, cfg_.road.num_lanes - 1)], 0.0, 0.0};
   }
   if (!start.IsFinite()) start = {0.0, 0.0, 0.0, ws_.lane_center[0], 0.0, 0.0};
   // s' and d' from the measured heading can be off on the very first tick; the lattice
   // starts from rest in d' to avoid sweeping across the road.
   start.d_d = std::clamp(start.d_d, -2.0, 2.0);
-  start.s_d = std::clamp(start.s_d, 0.0, cfg_.max_speed);
+  start.s_d = std::clamp(start.s_d, 0.0, cfg_.limits.max_speed);
   return start;
 }
 

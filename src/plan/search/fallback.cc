@@ -18,17 +18,17 @@ bool ContinuePrevious(Workspace& ws, const CollisionChecker& collisions) {
 
 void BuildFallback(const Settings& cfg, Workspace& ws, const CollisionChecker& collisions) {
   const traj::FrenetState& start = ws.start;
-  const double levels[3] = {cfg.fallback_decel,
-                            std::min(2 * cfg.fallback_decel, 0.75 * cfg.max_accel),
-                            0.9 * cfg.max_accel};
+  const double levels[3] = {cfg.fallback.decel,
+                            std::min(2 * cfg.fallback.decel, 0.75 * cfg.limits.max_accel),
+                            0.9 * cfg.limits.max_accel};
   const int lane = LaneOf(cfg, ws, start.d);
   traj::Trajectory1d lat;
   lat.poly = traj::SolveQuintic(start.d, start.d_d, start.d_dd, ws.lane_center[lane], 0, 0,
-                                cfg.fallback_lat_duration);
-  lat.duration = cfg.fallback_lat_duration;
+                                cfg.fallback.lat_duration);
+  lat.duration = cfg.fallback.lat_duration;
   for (int level = 0; level < 3; ++level) {
     const double decel = levels[level];
-    const double jerk = std::min(cfg.fallback_jerk, 0.8 * cfg.max_jerk);
+    const double jerk = std::min(cfg.fallback.jerk, 0.8 * cfg.limits.max_jerk);
     double s = start.s, v = std::max(start.s_d, 0.0), a = start.s_dd;
     for (int i = 1; i <= ws.n_ticks; ++i) {
       // Aim at -decel, but ease off near standstill so a reaches 0 when v does.

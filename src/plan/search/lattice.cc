@@ -61,11 +61,11 @@ void Lattice::AddLon(const LonTraj& l) {
   ws_.lon.push_back(l);
   ws_.lon.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
   const int n = ws_.n_samples;
-  const double dt = cfg_.score_dt;
+  const double dt = cfg_.score.dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
                 &ws_.lon_sdd[i * n]);
   ws_.lon_near_have[i] = 0;  // its masks: when first needed (Scorer::InputFor)
-  if (cfg_.curve_prefilter && TooFastForTheCurve(i)) ws_.lon.pop_back();
+  if (cfg_.check.curve_prefilter && TooFastForTheCurve(i)) ws_.lon.pop_back();
 }
 
 bool Lattice::TooFastForTheCurve(int i) const {
@@ -76,9 +76,9 @@ bool Lattice::TooFastForTheCurve(int i) const {
   // lateral one kCurveSlack above the limit at a sample fails it. From the second sample on
   // (the first is the present state), within the check horizon.
   const int n = ws_.n_samples;
-  const double limit = (1 + kCurveSlack) * cfg_.max_accel;
+  const double limit = (1 + kCurveSlack) * cfg_.limits.max_accel;
   const int bins = static_cast<int>(ws_.abs_kappa.size());
-  for (int k = 1; k < n && k * cfg_.score_dt <= cfg_.check_horizon + 1e-9; ++k) {
+  for (int k = 1; k < n && k * cfg_.score.dt <= cfg_.check.horizon + 1e-9; ++k) {
     const double v = ws_.lon_sd[i * n + k];
     const int b = static_cast<int>(std::floor((ws_.lon_s[i * n + k] - ws_.kappa_s0) / Workspace::kEdgeBin));
     if (b < 0 || b >= bins) continue;
@@ -94,7 +94,7 @@ void Lattice::AddLat(const LatTraj& l) {
   ws_.lat.push_back(l);
   ws_.lat.back().jerk2 = l.traj.JerkSquared();
   const int n = ws_.n_samples;
-  const double dt = cfg_.score_dt;
+  const double dt = cfg_.score.dt;
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
                 &ws_.lat_ddd[i * n]);
   NearLat(ws_, ws_.lat_d.data() + i * n, ws_.lat_near.data() + 2 * i * n);
@@ -118,10 +118,10 @@ LonTraj Lattice::MakeLon(cost::LonKind kind, int lane, double param, double T, i
       const Predictor::Prediction lead_at = predictor_.Predict(lead, ws_.t_keep + T);
       const double s_lead = ws_.start.s + lead_at.s;
       // follow_d0 is between the centres of two configured cars: longer ones need more.
-      const double longer = 0.5 * (predictor_.cars()[lead].length - cfg_.car_length) +
-                            0.5 * (cfg_.ego_length - cfg_.car_length);
+      const double longer = 0.5 * (predictor_.cars()[lead].length - cfg_.check.car_length) +
+                            0.5 * (cfg_.check.ego_length - cfg_.check.car_length);
       const double target =
-          s_lead - (cfg_.follow_d0 + cfg_.follow_tau * lead_at.v) - param - longer;
+          s_lead - (cfg_.grid.follow_d0 + cfg_.grid.follow_tau * lead_at.v) - param - longer;
       l.traj.poly = traj::SolveQuintic(s0.s, s0.s_d, s0.s_dd, target, lead_at.v, 0.0, T);
       break;
     }
@@ -198,7 +198,7 @@ void Lattice::AddSwerves() {
     if (!(h >= r.h_lo && h <= r.h_hi)) h = 0.5 * (r.h_lo + r.h_hi);
     const double sign = turned;
     const double from_side = right ? 0.25 : 0.75;  // coming from smaller d when moving right
-    for (double T = kSwerveStep; T <= cfg_.score_horizon + 1e-9; T += kSwerveStep) {
+    for (double T = kSwerveStep; T <= cfg_.score.horizon + 1e-9; T += kSwerveStep) {
       if (T < r.t_lo || T > r.t_hi) continue;
       const double s_est = s0.s + s0.s_d * T;
       const double reach = kSwerveReachAccel * T * T;  // the lon bundle's spread about s_est
@@ -280,7 +280,7 @@ void Lattice::AddPasses() {
       AddLat(MakeLat(own, 0.0, prev.end_time() - elapsed));
     }
   }
-  if (!cfg_.passes) return;
+  if (!cfg_.grid.passes) return;
   // A goal crossed turned is reached by a swerve (AddSwerves), which a pass never ends in.
   for (int g = 0; g < ws_.num_goals; ++g) {
     if (cost::CrossedTurned(ws_.goals[g]) != 0) return;
@@ -316,7 +316,7 @@ int Lattice::Leader(int lane) const {
   int best = -1;
   double best_s = 1e18;
   for (int c = 0; c < ws_.ctx.num_cars; ++c) {
-    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.road.lane_width) continue;
     if (ws_.car_s0[c] <= ws_.start.s) continue;
     if (ws_.car_s0[c] < best_s) {
       best_s = ws_.car_s0[c];
@@ -331,17 +331,17 @@ int Lattice::Leader(int lane) const {
 void Lattice::AddBraking() {
   const double v0 = std::max(ws_.start.s_d, 0.0);
   if (v0 < 1.0) return;
-  for (int bi = 0; bi < cfg_.brake_decels; ++bi) {
-    const double a = Linspace(cfg_.brake_min_decel, cfg_.brake_max_decel, cfg_.brake_decels, bi);
-    for (int ti = 0; ti < cfg_.brake_targets; ++ti) {
+  for (int bi = 0; bi < cfg_.brake.decels; ++bi) {
+    const double a = Linspace(cfg_.brake.min_decel, cfg_.brake.max_decel, cfg_.brake.decels, bi);
+    for (int ti = 0; ti < cfg_.brake.targets; ++ti) {
       // Target speeds from standstill up to (but not including) the current speed.
-      const double target = v0 * ti / cfg_.brake_targets;
+      const double target = v0 * ti / cfg_.brake.targets;
       AddLon(MakeLon(cost::LonKind::kBraking, -1, a, (v0 - target) / a));
     }
   }
 }
 
-// Into the gaps between consecutive cars of `lane` (the cfg_.gap_targets nearest the ego along
+// Into the gaps between consecutive cars of `lane` (the cfg_.grid.gap_targets nearest the ego along
 // s): a following trajectory of the car ahead whose end point is the gap's middle at T, kept
 // clear of both cars (their footprints and margin_s), at its speed. A merge into a line of
 // traffic needs such a slot; the following law alone puts the ego its own gap behind a car.
@@ -349,7 +349,7 @@ void Lattice::AddGapTargets(int lane, double T) {
   int cars[kMaxCars];
   int n = 0;
   for (int c = 0; c < ws_.ctx.num_cars && n < kMaxCars; ++c) {
-    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.road.lane_width) continue;
     // Insertion by s at the start instant (ties: index).
     int k = n++;
     while (k > 0 && ws_.car_s0[cars[k - 1]] > ws_.car_s0[c]) {
@@ -374,17 +374,17 @@ void Lattice::AddGapTargets(int lane, double T) {
     }
     gaps[k] = i;
   }
-  for (int g = 0; g < std::min(m, cfg_.gap_targets); ++g) {
+  for (int g = 0; g < std::min(m, cfg_.grid.gap_targets); ++g) {
     const int ahead = cars[gaps[g]], behind = cars[gaps[g] - 1];
     const Predictor::Prediction pa = predictor_.Predict(ws_.car_index[ahead], ws_.t_keep + T);
     const Predictor::Prediction pb = predictor_.Predict(ws_.car_index[behind], ws_.t_keep + T);
-    const double lo = pb.s + ws_.car_sep_s[behind] + cfg_.margin_s;
-    const double hi = pa.s - ws_.car_sep_s[ahead] - cfg_.margin_s;
+    const double lo = pb.s + ws_.car_sep_s[behind] + cfg_.check.margin_s;
+    const double hi = pa.s - ws_.car_sep_s[ahead] - cfg_.check.margin_s;
     if (!(hi > lo)) continue;
     // The following law's target, shifted (param) to the gap's middle.
-    const double longer = 0.5 * (predictor_.cars()[ws_.car_index[ahead]].length - cfg_.car_length) +
-                          0.5 * (cfg_.ego_length - cfg_.car_length);
-    const double law = pa.s - (cfg_.follow_d0 + cfg_.follow_tau * pa.v) - longer;
+    const double longer = 0.5 * (predictor_.cars()[ws_.car_index[ahead]].length - cfg_.check.car_length) +
+                          0.5 * (cfg_.check.ego_length - cfg_.check.car_length);
+    const double law = pa.s - (cfg_.grid.follow_d0 + cfg_.grid.follow_tau * pa.v) - longer;
     AddLon(MakeLon(cost::LonKind::kFollowing, lane, law - 0.5 * (lo + hi), T,
                    ws_.car_index[ahead]));
   }
@@ -403,18 +403,18 @@ void Lattice::AddAccelerating(const bool reachable[], double vmax) {
     const double ds = ws_.car_s0[c] - ws_.start.s;
     if (ds > -kAccelFreeBehind && ds < kAccelFreeAhead) return;
   }
-  for (int l = -1; l < cfg_.num_lanes; ++l) {
+  for (int l = -1; l < cfg_.road.num_lanes; ++l) {
     double target = vmax;
     if (l >= 0) {
-      if (!cfg_.lane_limit_speeds || !reachable[l] ||
+      if (!cfg_.grid.lane_limit_speeds || !reachable[l] ||
           ws_.ctx.lane_speed_limit[l] >= vmax - kLaneLimitStep) {
         continue;
       }
       target = ws_.ctx.lane_speed_limit[l];
     }
     if (target - v0 < kAccelMinGain) continue;
-    for (int ai = 0; ai < cfg_.accels; ++ai) {
-      const double a = Linspace(cfg_.accel_min, cfg_.accel_max, cfg_.accels, ai);
+    for (int ai = 0; ai < cfg_.grid.accels; ++ai) {
+      const double a = Linspace(cfg_.grid.accel_min, cfg_.grid.accel_max, cfg_.grid.accels, ai);
       AddLon(MakeLon(cost::LonKind::kAccelerating, l, a, (target - v0) / a));
     }
   }
@@ -438,7 +438,7 @@ int Lattice::Alongside(int lane) const {
   int best = -1;
   double best_ds = kAlongside;
   for (int c = 0; c < ws_.ctx.num_cars; ++c) {
-    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.lane_width) continue;
+    if (std::abs(ws_.car_d0[c] - ws_.lane_center[lane]) > 0.6 * cfg_.road.lane_width) continue;
     const double ds = std::abs(ws_.car_s0[c] - ws_.start.s);
     if (ds < best_ds) {
       best_ds = ds;
@@ -456,29 +456,29 @@ void Lattice::Generate() {
   ws_.cand_lat.clear();
   // Lanes within reach (grid.lane_reach lane widths): the current one and its neighbours.
   bool reachable[cost::kMaxLanes] = {};
-  for (int l = 0; l < cfg_.num_lanes; ++l) {
+  for (int l = 0; l < cfg_.road.num_lanes; ++l) {
     reachable[l] = ws_.lane_exists[l] &&
-                   std::abs(ws_.lane_center[l] - start.d) <= cfg_.lane_reach * cfg_.lane_width;
+                   std::abs(ws_.lane_center[l] - start.d) <= cfg_.grid.lane_reach * cfg_.road.lane_width;
   }
   double vmax = 0;
-  for (int l = 0; l < cfg_.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
+  for (int l = 0; l < cfg_.road.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
   // The end speeds' grid reaches no higher than the ego can speed up to within the longest
   // duration (its steps stay as fine where it can go, however high the top speed).
-  const double vgrid = std::min(vmax, ReachableSpeed(cfg_.vehicle, cfg_.max_accel, std::max(start.s_d, 0.0), cfg_.max_duration));
-  for (int di = 0; di < cfg_.durations; ++di) {
-    const double T = Linspace(cfg_.min_duration, cfg_.max_duration, cfg_.durations, di);
-    for (int vi = 0; vi < cfg_.speeds; ++vi) {
+  const double vgrid = std::min(vmax, ReachableSpeed(cfg_.vehicle, cfg_.limits.max_accel, std::max(start.s_d, 0.0), cfg_.grid.max_duration));
+  for (int di = 0; di < cfg_.grid.durations; ++di) {
+    const double T = Linspace(cfg_.grid.min_duration, cfg_.grid.max_duration, cfg_.grid.durations, di);
+    for (int vi = 0; vi < cfg_.grid.speeds; ++vi) {
       // Velocity keeping to end speeds from 0 to the fastest lane's limit.
-      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vgrid, cfg_.speeds, vi), T));
+      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vgrid, cfg_.grid.speeds, vi), T));
     }
     // ...and to each slower lane's own limit (the outer lanes of a bend, where the XY speed is
     // s' (1 + kappa d)): the grid's step would otherwise leave such a lane up to a whole step
     // (2 m/s) below its limit, and the ego driving a bend well under the speed limit.
-    for (int l = 0; l < cfg_.num_lanes && cfg_.lane_limit_speeds; ++l) {
+    for (int l = 0; l < cfg_.road.num_lanes && cfg_.grid.lane_limit_speeds; ++l) {
       if (!reachable[l] || ws_.ctx.lane_speed_limit[l] >= vmax - kLaneLimitStep) continue;
       AddLon(MakeLon(cost::LonKind::kVelocityKeeping, l, ws_.ctx.lane_speed_limit[l], T));
     }
-    if (cfg_.stop) {
+    if (cfg_.grid.stop) {
       AddLon(MakeLon(cost::LonKind::kStopping, -1, 0.5 * start.s_d * T, T));
     }
     // A goal region one may stand in (its speeds reach down to rest): stopping in its middle,
@@ -496,7 +496,7 @@ void Lattice::Generate() {
       AddBraking();
       AddAccelerating(reachable, vmax);
     }
-    for (int l = 0; l < cfg_.num_lanes; ++l) {
+    for (int l = 0; l < cfg_.road.num_lanes; ++l) {
       if (!reachable[l]) continue;
       // Follow the lane's leader, and yield to (drop behind) the car alongside, which the
       // delayed lane changes below need to pass behind it (Apollo's yield samples).
@@ -504,28 +504,28 @@ void Lattice::Generate() {
       for (int k = 0; k < 2; ++k) {
         const int lead = targets[k];
         if (lead < 0 || (k == 1 && lead == targets[0])) continue;
-        for (int g = 0; g < cfg_.follow_gaps; ++g) {
+        for (int g = 0; g < cfg_.grid.follow_gaps; ++g) {
           // Longer time gaps are extra distance on top of the base law.
-          const double extra = g * cfg_.follow_tau_step * ws_.car_v[lead * ws_.n_samples];
+          const double extra = g * cfg_.grid.follow_tau_step * ws_.car_v[lead * ws_.n_samples];
           AddLon(MakeLon(cost::LonKind::kFollowing, l, extra, T, ws_.car_index[lead]));
         }
       }
-      if (cfg_.gap_targets > 0) AddGapTargets(l, T);
+      if (cfg_.grid.gap_targets > 0) AddGapTargets(l, T);
     }
   }
   // Laterally at rest (keeping a lane): one duration stands for all for the own lane (they
   // coincide), and lane changes may also wait before they start.
   const bool at_rest = std::abs(start.d_d) < 0.2 && std::abs(start.d_dd) < 0.5;
-  for (int l = 0; l < cfg_.num_lanes; ++l) {
+  for (int l = 0; l < cfg_.road.num_lanes; ++l) {
     if (!reachable[l]) continue;
-    const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.lane_width;
+    const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.road.lane_width;
     const bool centred = own && at_rest && std::abs(ws_.lane_center[l] - start.d) < 0.1;
     const bool crawl_hold = own && at_rest && !centred && start.s_d < kCrawlSpeed;
-    for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat_durations); ++ti) {
+    for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
       const double T =
-          Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, cfg_.lat_durations, ti);
-      for (int oi = 0; oi < cfg_.lat_offsets; ++oi) {
-        const double off = (oi - cfg_.lat_offsets / 2) * cfg_.lat_offset_step;
+          Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti);
+      for (int oi = 0; oi < cfg_.lat.offsets; ++oi) {
+        const double off = (oi - cfg_.lat.offsets / 2) * cfg_.lat.offset_step;
         AddLat(MakeLat(l, off, T));
       }
     }
@@ -533,12 +533,12 @@ void Lattice::Generate() {
     // move across there turns the car far off the lane's heading for the little way it drives
     // (a queue), which a goal's orientation and the lanelets' borders mind.
     if (crawl_hold) {
-      AddLat(MakeLat(l, start.d - ws_.lane_center[l], cfg_.lat_max_duration));
+      AddLat(MakeLat(l, start.d - ws_.lane_center[l], cfg_.lat.max_duration));
     }
     if (!own && at_rest) {
-      const double T = Linspace(cfg_.lat_min_duration, cfg_.lat_max_duration, 3, 1);
-      for (int k = 1; k <= cfg_.lat_delays; ++k) {
-        AddLat(MakeLat(l, 0.0, T, k * cfg_.lat_delay_step));
+      const double T = Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, 3, 1);
+      for (int k = 1; k <= cfg_.lat.delays; ++k) {
+        AddLat(MakeLat(l, 0.0, T, k * cfg_.lat.delay_step));
       }
     }
     // The lateral move under way, to its planned end time: replanning with full durations
@@ -550,7 +550,7 @@ void Lattice::Generate() {
       const double remaining = prev.end_time() - ws_.prev_elapsed;
       if (wait > 0.05) {
         AddLat(MakeLat(l, ws_.prev_lat_offset, prev.duration, wait));
-      } else if (remaining > 0.3 && remaining < cfg_.lat_min_duration - 0.05) {
+      } else if (remaining > 0.3 && remaining < cfg_.lat.min_duration - 0.05) {
         AddLat(MakeLat(l, ws_.prev_lat_offset, remaining));
       }
     }

@@ -43,7 +43,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
 }
 
 bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
-  if (cfg_.clear_enough > 0) {
+  if (cfg_.check.clear_enough > 0) {
     const int c = CheapestClearEnough(over_budget);
     if (c >= 0) {
       ws_.TakeWinner(c);
@@ -107,7 +107,7 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
       continue;
     }
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
-    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.clear_enough) >= cfg_.clear_enough)) continue;
+    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough)) continue;
     clear_.push_back({scorer_.KnownBound(c), c});
     std::push_heap(clear_.begin(), clear_.end(), later);
   }

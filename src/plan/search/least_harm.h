@@ -164,7 +164,7 @@ class LeastHarm {
  private:
   // The first candidate in cost order that collides with no car on bare boxes (the room behind
   // kept, the predictor's ghosts left out, as BestClear tests), keeps at least
-  // cfg.clear_enough from every car (Clearance) and breaks no limit; -1 when none does (or the
+  // cfg.check.clear_enough from every car (Clearance) and breaks no limit; -1 when none does (or the
   // deadline cut it short: then *over_budget is set). Where the predictions are the traffic's
   // own future (recorded traffic), more room than enough buys nothing, and the clearest
   // candidate is mostly the one braking hardest, away from the goal.

@@ -10,10 +10,10 @@ LimitChecker::LimitChecker(const Settings& cfg, const map::ReferenceLine& line, 
     : cfg_(cfg),
       line_(line),
       ws_(ws),
-      xy_(kHistory + 64 + static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds)) +
-              cfg.output_points,
+      xy_(kHistory + 64 + static_cast<int>(std::ceil(cfg.check.horizon / kTickSeconds)) +
+              cfg.continuity.output_points,
           cfg.vehicle) {
-  const int path_cap = kHistory + cfg.output_points + ws_.n_ticks + 8;
+  const int path_cap = kHistory + cfg.continuity.output_points + ws_.n_ticks + 8;
   chk_x_.assign(path_cap, 0.0);
   chk_y_.assign(path_cap, 0.0);
   const std::size_t n_lon = ws_.lon.capacity(), n_lat = ws_.lat.capacity();
@@ -61,7 +61,7 @@ double LimitChecker::EdgeExcess(double s0, double s1, const ReadRange& read) con
     lo = std::max(lo, ws_.edge_lo[b]);
     hi = std::min(hi, ws_.edge_hi[b]);
   }
-  const double inset = 0.5 * cfg_.ego_width + cfg_.edge_margin;
+  const double inset = 0.5 * cfg_.check.ego_width + cfg_.limits.edge_margin;
   return std::max(lo + inset - read.lo, read.hi - (hi - inset));
 }
 
@@ -138,7 +138,7 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
   for (int prev = 1, i = std::min(5, n_ticks); n_ticks >= 1;
        prev = i, i = std::min(i + 5, n_ticks)) {
     const ReadRange read = ReadBetween(tk_s, tk_d, prev, i);
-    if (cfg_.uniform_road) {
+    if (cfg_.road.uniform) {
       dmin = std::min(dmin, read.lo);
       dmax = std::max(dmax, read.hi);
       straddle = StraddlesRead(cfg_, read.lo, read.hi) ? straddle + (i - prev) + (prev == 1) : 0;
@@ -146,16 +146,16 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
     } else {
       off_road = std::max(off_road, EdgeExcess(tk_s[prev], tk_s[i], read));
     }
-    if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.d_min - dmin > 0 ||
-                dmax - cfg_.d_max > 0 || off_road > 0)) {
+    if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.limits.d_min - dmin > 0 ||
+                dmax - cfg_.limits.d_max > 0 || off_road > 0)) {
       if (reason != nullptr) *reason = Reject::kCount;  // unknown: not measured in full
       return 1.0;  // a limit is broken (which one is worst is not known)
     }
     if (i == n_ticks) break;
   }
   if (straddle > 0) worst_straddle = 1 << 20;
-  if (cfg_.uniform_road) off_road = std::max(cfg_.d_min - dmin, dmax - cfg_.d_max);
-  take(off_road / cfg_.lane_width, Reject::kOffRoad);
+  if (cfg_.road.uniform) off_road = std::max(cfg_.limits.d_min - dmin, dmax - cfg_.limits.d_max);
+  take(off_road / cfg_.road.lane_width, Reject::kOffRoad);
   if (lane_line) {
     take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
          Reject::kLaneLine);
@@ -176,9 +176,9 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
   }
   const int n = BuildXyPath(xy_ticks);
   const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
-  take(m.max_speed / cfg_.max_speed - 1.0, Reject::kSpeed);
-  take(m.max_accel / cfg_.max_accel - 1.0, Reject::kAcceleration);
-  take(m.max_jerk / cfg_.max_jerk - 1.0, Reject::kJerk);
+  take(m.max_speed / cfg_.limits.max_speed - 1.0, Reject::kSpeed);
+  take(m.max_accel / cfg_.limits.max_accel - 1.0, Reject::kAcceleration);
+  take(m.max_jerk / cfg_.limits.max_jerk - 1.0, Reject::kJerk);
   if (cfg_.vehicle.any()) {
     // A vehicle's limits count as acceleration (steering angle: lateral; forward) and jerk
     // (the steering rate) limits.

@@ -21,8 +21,8 @@ namespace frenetic::plan::search {
 // Whether read d in [lo, hi] (m) comes within kStraddle of a lane line: the simulator's
 // lane-line timer runs then.
 inline bool StraddlesRead(const Settings& cfg, double lo, double hi) {
-  for (int l = 1; l < cfg.num_lanes; ++l) {
-    const double line = l * cfg.lane_width;
+  for (int l = 1; l < cfg.road.num_lanes; ++l) {
+    const double line = l * cfg.road.lane_width;
     if (hi > line - kStraddle && lo < line + kStraddle) return true;
   }
   return false;
@@ -32,7 +32,7 @@ inline bool StraddlesRead(const Settings& cfg, double lo, double hi) {
 // road that is not uniform: the lane-line timer is the Udacity simulator's.
 inline bool Straddles(const Settings& cfg, const map::ReferenceLine& line, double s0, double s1,
                       double d0, double d1) {
-  if (!cfg.uniform_road) return false;  // the Udacity simulator's timer only
+  if (!cfg.road.uniform) return false;  // the Udacity simulator's timer only
   const map::ReferenceLine::OffsetRange r = line.ChordOffset(s0, s1, 0.5 * (d0 + d1));
   return StraddlesRead(cfg, d0 + r.lo, d1 + r.hi);
 }

@@ -54,12 +54,12 @@ std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
   po.brake_horizon = config.value("prediction.brake_horizon");
   po.lateral_threshold = config.value("prediction.lateral_threshold");
   po.lane_change_ghosts = config.int_value("prediction.lane_change_ghosts") != 0;
-  po.lane_width = cfg.lane_width;
-  po.num_lanes = cfg.num_lanes;
-  po.car_length = cfg.car_length;
-  po.car_width = cfg.car_width;
+  po.lane_width = cfg.road.lane_width;
+  po.num_lanes = cfg.road.num_lanes;
+  po.car_length = cfg.check.car_length;
+  po.car_width = cfg.check.car_width;
   // The horizons the context samples predictions over, from the kept points' end.
-  po.future_horizon = std::max(cfg.score_horizon, cfg.check_horizon) + 1.0;
+  po.future_horizon = std::max(cfg.score.horizon, cfg.check.horizon) + 1.0;
   return config.int_value("prediction.manoeuvres") != 0
              ? MakeManoeuvrePredictor(std::move(road), po)
              : MakeConstantVelocityPredictor(std::move(road), po);
@@ -88,8 +88,8 @@ class SearchPlanner : public Planner {
         continuity_(cfg_, *line_, ws_, timer_),
         lane_ends_(*road_) {
     per_term_.assign(costs_->size(), 0.0);
-    result_.x.reserve(cfg_.output_points + 1);
-    result_.y.reserve(cfg_.output_points + 1);
+    result_.x.reserve(cfg_.continuity.output_points + 1);
+    result_.y.reserve(cfg_.continuity.output_points + 1);
     result_.summary.winner_costs.resize(costs_->size());
     for (int i = 0; i < costs_->size(); ++i) {
       result_.summary.winner_costs[i].name = costs_->name(i);
@@ -147,7 +147,7 @@ class SearchPlanner : public Planner {
     int kept = 0;
     double elapsed = 0;  // s between the previous start state and this one
     if (synced) {
-      kept = std::min(cfg_.keep_points, continuity_.plan_n() - consumed);
+      kept = std::min(cfg_.continuity.keep_points, continuity_.plan_n() - consumed);
       start = continuity_.KeepPoints(consumed, kept, &elapsed);
     } else {
       continuity_.Desync();
@@ -207,11 +207,11 @@ class SearchPlanner : public Planner {
       // A swerve into a goal region is taken as it is: its checks end at the region
       // (Workspace::CheckTicks), the refinement's run over the whole horizon; and a pass, which
       // the refinement's single move cannot express.
-      if (found && cfg_.refine && refiner_.available() && !ws_.lat[ws_.winner_lat].swerve() &&
+      if (found && cfg_.refine.enabled && refiner_.available() && !ws_.lat[ws_.winner_lat].swerve() &&
           !ws_.lat[ws_.winner_lat].pass()) {
         // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
         // asks for none beyond the cycle's.
-        const double refine_ms = std::isfinite(cfg_.refine_budget_ms) ? cfg_.refine_budget_ms : 0;
+        const double refine_ms = std::isfinite(cfg_.refine.budget_ms) ? cfg_.refine.budget_ms : 0;
         if (Elapsed() + refine_ms < 0.8 * cfg_.budget_ms) {
           const double t_ref = Elapsed();
           refiner_.Refine(sum);

@@ -26,12 +26,12 @@ Refiner::Refiner(const Settings& cfg, const std::string& algorithm, Workspace& w
       clock_(clock),
       opt_(nlopt_create(AlgorithmFromName(algorithm), 4)) {
   // NLopt evaluates at most refine.max_iterations points; one more for the start.
-  evals_seen_.reserve(std::max(cfg_.refine_iterations, 0) + 2);
+  evals_seen_.reserve(std::max(cfg_.refine.iterations, 0) + 2);
   if (opt_ != nullptr) {
     nlopt_set_min_objective(opt_, &Refiner::Objective, this);
     constraints_ok_ =
         nlopt_add_inequality_constraint(opt_, &Refiner::Constraint, this, 1e-6) == NLOPT_SUCCESS;
-    nlopt_set_maxeval(opt_, cfg_.refine_iterations);
+    nlopt_set_maxeval(opt_, cfg_.refine.iterations);
     // NLopt allocates its step array at the first call: here, not in the first refined cycle
     // (which may come long after warm-up, e.g. after a constant-acceleration start).
     const double step[4] = {1.0, 1.0, 1.0, 1.0};
@@ -120,16 +120,16 @@ void Refiner::Refine(PlanSummary& sum) {
       break;
     case cost::LonKind::kStopping:
       lo[0] = 0;
-      hi[0] = std::max(1.0, ws_.start.s_d * cfg_.max_duration);
+      hi[0] = std::max(1.0, ws_.start.s_d * cfg_.grid.max_duration);
       break;
     case cost::LonKind::kBraking:
     case cost::LonKind::kAccelerating:
       return;
   }
-  lo[1] = cfg_.min_duration;
-  hi[1] = cfg_.max_duration;
-  lo[2] = std::min(cfg_.lat_min_duration, db.traj.duration);
-  hi[2] = std::max(cfg_.lat_max_duration, db.traj.duration);
+  lo[1] = cfg_.grid.min_duration;
+  hi[1] = cfg_.grid.max_duration;
+  lo[2] = std::min(cfg_.lat.min_duration, db.traj.duration);
+  hi[2] = std::max(cfg_.lat.max_duration, db.traj.duration);
   lo[3] = -0.5;
   hi[3] = 0.5;
   for (int i = 0; i < 4; ++i) x[i] = std::clamp(x[i], lo[i], hi[i]);
@@ -144,7 +144,7 @@ void Refiner::Refine(PlanSummary& sum) {
   for (int i = 0; i < 4; ++i) step[i] = std::max(1e-3, 0.1 * (hi[i] - lo[i]));
   nlopt_set_initial_step(opt_, step);
   const double remaining = 0.8 * cfg_.budget_ms - clock_.Elapsed();
-  const double maxtime_ms = std::min(cfg_.refine_budget_ms, remaining);
+  const double maxtime_ms = std::min(cfg_.refine.budget_ms, remaining);
   // 0 switches NLopt's clock off: pinned deadlines leave refine.max_iterations as the bound.
   nlopt_set_maxtime(opt_, std::isfinite(maxtime_ms) ? std::max(1e-3, maxtime_ms) * 1e-3 : 0.0);
   evals_ = 0;

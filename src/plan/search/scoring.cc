@@ -248,7 +248,7 @@ bool Scorer::ResolveAll() {
 cost::CostInput Scorer::SampleForCost(const traj::FrenetTrajectory& tr, const LonTraj& lbase,
                                       const LatTraj& dbase) {
   for (int k = 0; k < ws_.n_samples; ++k) {
-    const traj::FrenetState st = tr.At(k * cfg_.score_dt);
+    const traj::FrenetState st = tr.At(k * cfg_.score.dt);
     ref_s_[k] = st.s;
     ref_sd_[k] = st.s_d;
     ref_sdd_[k] = st.s_dd;

@@ -25,61 +25,111 @@ inline constexpr int kMaxStraddleTicks = 135;  // ticks
 
 inline bool Finite(double v) { return std::isfinite(v); }
 
-// Every key the search planner reads, by its config name (see config/planner.yaml), and what it
-// takes from the road. A pinned deadline (PlannerConfig::PinDeadlines) reads as an infinite
-// budget_ms / refine_budget_ms.
+// Every key the search planner reads, grouped as in config/planner.yaml (the key in brackets),
+// and what it takes from the road. SI units. A pinned deadline (PlannerConfig::PinDeadlines)
+// reads as an infinite budget_ms / refine.budget_ms.
 struct Settings {
-  double max_speed, max_accel, max_jerk, d_min, d_max;  // m/s, m/s^2, m/s^3, m, m
-  // The road's: its typical lane width and its lane count (clamped to [1, cost::kMaxLanes]), and
-  // whether it is the Udacity layout (map::Road::uniform: d_min / d_max as the simulator reads
-  // d, the lane-line timer, outer_inset); on any other road the ego stays edge_margin inside
-  // its edges.
-  double lane_width, outer_inset;
-  int num_lanes;
-  bool uniform_road;
-  double edge_margin;  // m
-  double ego_length, ego_width;  // m: the ego's footprint (check.car_* are the other cars')
+  struct Limits {
+    double max_speed = 0;    // m/s (limits.max_speed_mph, converted)
+    double max_accel = 0;    // m/s^2, on the XY path (limits.max_accel)
+    double max_jerk = 0;     // m/s^3, on the XY path (limits.max_jerk)
+    double d_min = 0;        // m: the smallest d the simulator may read on a uniform road
+    double d_max = 0;        // m: the largest
+    double edge_margin = 0;  // m the ego stays inside the edges of any other road
+  };
+  // The road's (map::Road), else road.* on the configured uniform road.
+  struct Road {
+    double lane_width = 0;   // m: its typical lane width
+    double outer_inset = 0;  // m: the outer lanes' centres moved in (road.outer_lane_inset)
+    int num_lanes = 1;       // clamped to [1, cost::kMaxLanes]
+    bool uniform = true;     // the Udacity layout: d_min / d_max, the lane-line timer
+  };
+  struct Continuity {
+    int keep_points = 0;            // points of the last path kept before a new plan
+    int output_points = 0;          // points sent
+    double resync_tolerance = 0;    // m: previous_path is ours when its ends are this near
+    int replan_min_ticks = 0;       // fewer driven points than this: the last plan re-sent
+    double replan_deviation = 0;    // m: ...unless a car moved this far from its prediction
+  };
+  // The longitudinal lattice (grid.*).
+  struct Grid {
+    int speeds = 0;                  // end speeds of velocity keeping
+    bool lane_limit_speeds = false;  // and each lane's own limit
+    int durations = 0;               // durations between min_duration and max_duration (s)
+    double min_duration = 0, max_duration = 0;
+    int follow_gaps = 0;             // following: extra gaps behind the leader
+    int gap_targets = 0;             // gaps between a lane's cars aimed into, per lane (0: none)
+    double follow_d0 = 0;            // m: following's standstill gap
+    double follow_tau = 0;           // s: its time gap, follow_tau_step apart per extra gap
+    double follow_tau_step = 0;
+    bool stop = false;               // stopping trajectories
+    int accels = 0;                  // constant accelerations between accel_min and accel_max
+    double accel_min = 0, accel_max = 0;  // m/s^2 (grid.min_accel, grid.max_accel)
+    double lane_reach = 0;           // lane widths: lanes whose centre is this near are targets
+    bool passes = false;             // passes on a two-way road's oncoming lane (AddPasses)
+  };
+  // Constant-deceleration braking (grid.brake_*).
+  struct Brake {
+    int decels = 0;   // decelerations between min_decel and max_decel (m/s^2)
+    int targets = 0;  // end speeds braked to
+    double min_decel = 0, max_decel = 0;
+  };
+  // The lateral moves (grid.lat_*).
+  struct Lateral {
+    int durations = 0;  // between min_duration and max_duration (s)
+    double min_duration = 0, max_duration = 0;
+    int offsets = 0;         // offsets from a lane's centre, offset_step (m) apart
+    double offset_step = 0;
+    int delays = 0;          // delayed starts, delay_step (s) apart
+    double delay_step = 0;
+  };
+  struct Score {
+    double dt = 0;       // s between scoring samples
+    double horizon = 0;  // s scored
+  };
+  struct Check {
+    double ego_length = 0, ego_width = 0;  // m: the ego's footprint
+    double car_length = 0, car_width = 0;  // m: the other cars' (when a row has none)
+    double horizon = 0;                    // s checked on the XY path
+    double collision_dt = 0;               // s between collision-check steps
+    double margin_s = 0, margin_d = 0;     // m added to every car's box
+    double margin_behind = 0;  // m of room for a car behind in another lane...
+    double behind_time = 0;    // ...plus this many s of its closing speed
+    double headway_min = 0;    // s of headway to a car ahead
+    double clear_enough = 0;   // m: least harm takes the cheapest this clear (0: off)
+    // Longitudinal trajectories whose v^2 kappa along the line clearly exceeds
+    // limits.max_accel are not candidates (Lattice::AddLon).
+    bool curve_prefilter = false;
+  };
+  struct Refine {
+    bool enabled = false;   // NLopt on the winner (refine.enabled)
+    int iterations = 0;     // refine.max_iterations
+    double budget_ms = 0;   // ms (infinite when pinned)
+  };
+  // Keep-lane braking when nothing else is left.
+  struct Fallback {
+    double decel = 0;         // m/s^2
+    double jerk = 0;          // m/s^3
+    double lat_duration = 0;  // s back to the lane's centre
+  };
+
+  Limits limits;
+  Road road;
   VehicleLimits vehicle;  // vehicle.*: a real vehicle's steering and forward limits (0: none)
-  int keep_points, output_points;
-  double resync_tolerance;
-  int replan_min_ticks;
-  double replan_deviation;
-  int speeds, durations;
-  bool lane_limit_speeds;
-  double min_duration, max_duration;
-  int follow_gaps;
-  int gap_targets;  // gaps between a lane's cars the lattice aims into, per lane (0: none)
-  double follow_d0, follow_tau, follow_tau_step;
-  bool stop;
-  int brake_decels, brake_targets;
-  double brake_min_decel, brake_max_decel;
-  int accels;
-  double accel_min, accel_max;  // grid.min_accel, grid.max_accel
-  int lat_durations;
-  double lat_min_duration, lat_max_duration;
-  int lat_offsets;
-  double lat_offset_step;
-  double lane_reach;          // lane widths: lanes whose centre is this near are targets
-  int lat_delays;
-  bool passes;  // passes on a two-way road's oncoming lane (Lattice::AddPasses)
-  double lat_delay_step;
-  double score_dt, score_horizon;
-  double check_horizon, collision_dt, car_length, car_width, margin_s, margin_d, margin_behind;
-  double headway_min, behind_time;
-  double clear_enough;  // m (check.clear_enough; 0: off)
-  // check.curve_prefilter: longitudinal trajectories whose v^2 kappa along the line clearly
-  // exceeds limits.max_accel are not candidates (Lattice::AddLon).
-  bool curve_prefilter;
-  bool followers_react;  // a car right behind brakes for the ego (prediction.followers_react)
-  bool refine;
-  int refine_iterations;
-  double refine_budget_ms;
-  double fallback_decel, fallback_jerk, fallback_lat_duration;
-  double budget_ms;
+  Continuity continuity;
+  Grid grid;
+  Brake brake;
+  Lateral lat;
+  Score score;
+  Check check;
+  bool followers_react = false;  // a car right behind brakes for the ego (prediction.*)
+  Refine refine;
+  Fallback fallback;
+  double budget_ms = 0;  // ms per cycle (infinite when pinned)
 
   // On the configured uniform road (road.num_lanes x road.lane_width).
   explicit Settings(const PlannerConfig& c);
-  Settings(const PlannerConfig& c, const map::Road& road);
+  Settings(const PlannerConfig& c, const map::Road& on);
 };
 
 }  // namespace frenetic::plan::search

@@ -30,7 +30,7 @@ void Tracer::Add(int rank, bool winner, int reject, int car, double t) {
     ct.reject_time = t;
   }
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
-  for (double tt = 0; tt <= cfg_.score_horizon + 1e-9; tt += 0.25) {
+  for (double tt = 0; tt <= cfg_.score.horizon + 1e-9; tt += 0.25) {
     const traj::FrenetState st = tr.At(tt);
     const map::CartesianPose p = line_.ToCartesian(st.s, st.d);
     ct.x.push_back(p.x);

@@ -9,27 +9,27 @@ namespace frenetic::plan::search {
 
 Workspace::Workspace(const Settings& cfg) {
   // The uniform road's lanes (another road's are read each cycle, BuildContext).
-  for (int l = 0; l < cfg.num_lanes; ++l) {
-    lane_nominal[l] = lane_center[l] = (l + 0.5) * cfg.lane_width;
+  for (int l = 0; l < cfg.road.num_lanes; ++l) {
+    lane_nominal[l] = lane_center[l] = (l + 0.5) * cfg.road.lane_width;
     lane_exists[l] = true;
   }
-  road_right = cfg.num_lanes * cfg.lane_width;
-  if (cfg.num_lanes > 1) {
-    lane_nominal[cfg.num_lanes - 1] -= cfg.outer_inset;
-    lane_center[cfg.num_lanes - 1] -= cfg.outer_inset;
+  road_right = cfg.road.num_lanes * cfg.road.lane_width;
+  if (cfg.road.num_lanes > 1) {
+    lane_nominal[cfg.road.num_lanes - 1] -= cfg.road.outer_inset;
+    lane_center[cfg.road.num_lanes - 1] -= cfg.road.outer_inset;
   }
 
-  n_samples = static_cast<int>(std::floor(cfg.score_horizon / cfg.score_dt + 1e-9)) + 1;
-  n_ticks = static_cast<int>(std::ceil(cfg.check_horizon / kTickSeconds));
-  n_ticks = std::max(n_ticks, cfg.output_points);
+  n_samples = static_cast<int>(std::floor(cfg.score.horizon / cfg.score.dt + 1e-9)) + 1;
+  n_ticks = static_cast<int>(std::ceil(cfg.check.horizon / kTickSeconds));
+  n_ticks = std::max(n_ticks, cfg.continuity.output_points);
   // The lattice's largest bundles (Lattice::Generate), with a little slack.
-  const int max_lon = (cfg.speeds + cfg.num_lanes) * cfg.durations + cfg.durations +
-                      2 * cfg.num_lanes * cfg.follow_gaps * cfg.durations +
-                      cfg.num_lanes * cfg.gap_targets * cfg.durations +
-                      cfg.brake_decels * cfg.brake_targets + cost::kMaxGoalRegions * cfg.durations +
-                      cfg.accels * (cfg.num_lanes + 1) + 9;
+  const int max_lon = (cfg.grid.speeds + cfg.road.num_lanes) * cfg.grid.durations + cfg.grid.durations +
+                      2 * cfg.road.num_lanes * cfg.grid.follow_gaps * cfg.grid.durations +
+                      cfg.road.num_lanes * cfg.grid.gap_targets * cfg.grid.durations +
+                      cfg.brake.decels * cfg.brake.targets + cost::kMaxGoalRegions * cfg.grid.durations +
+                      cfg.grid.accels * (cfg.road.num_lanes + 1) + 9;
   const int max_lat =
-      cfg.num_lanes * (cfg.lat_durations + 1 + cfg.lat_delays) * cfg.lat_offsets + kMaxSwerves +
+      cfg.road.num_lanes * (cfg.lat.durations + 1 + cfg.lat.delays) * cfg.lat.offsets + kMaxSwerves +
       kMaxPasses + 9;
   lon.reserve(max_lon);
   lat.reserve(max_lat);
@@ -45,14 +45,14 @@ Workspace::Workspace(const Settings& cfg) {
     v->assign(kMaxCars, 0.0);
   }
   const int edge_bins =
-      static_cast<int>(std::ceil((cfg.max_speed * std::max(cfg.check_horizon, cfg.score_horizon) +
+      static_cast<int>(std::ceil((cfg.limits.max_speed * std::max(cfg.check.horizon, cfg.score.horizon) +
                                   kEdgeBehind + kEdgeAhead) / kEdgeBin)) + 2;
   edge_lo.assign(edge_bins, 0.0);
   edge_hi.assign(edge_bins, 0.0);
   abs_kappa.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
-  collision_step = std::max(1, static_cast<int>(std::lround(cfg.collision_dt / kTickSeconds)));
+  collision_step = std::max(1, static_cast<int>(std::lround(cfg.check.collision_dt / kTickSeconds)));
   n_steps = n_ticks / collision_step;
   for (auto* v : {&step_s, &step_d, &step_v, &step_vd, &step_dir_s, &step_dir_d})
     v->assign(kMaxCars * (n_steps + 1), 0.0);

@@ -87,12 +87,12 @@ TEST(CollisionCheckerTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
   // Cutting into a lane in front of a car there at the same speed, half the room behind
   // (margin_behind) away: bare boxes clear, but the room behind (kept even at margin scale 0)
   // is not. A metre beyond the room it is.
-  const double tight = st.cfg.car_length + 0.5 * st.cfg.margin_behind;
-  ASSERT_GT(0.5 * st.cfg.margin_behind, 1.0);
+  const double tight = st.cfg.check.car_length + 0.5 * st.cfg.check.margin_behind;
+  ASSERT_GT(0.5 * st.cfg.check.margin_behind, 1.0);
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - tight, 2.0, 20}});
   EXPECT_LT(st.collisions.FirstCollision(steady(kS, 20, 2.0), 0.0, 1.0), none);
   EXPECT_EQ(st.collisions.FirstCollision(steady(kS, 20, 2.0), 0.0, 0.0), none);
-  const double roomy = st.cfg.car_length + st.cfg.margin_behind + 1.0;
+  const double roomy = st.cfg.check.car_length + st.cfg.check.margin_behind + 1.0;
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS - roomy, 2.0, 20}});
   EXPECT_EQ(st.collisions.FirstCollision(steady(kS, 20, 2.0), 0.0, 1.0), none);
   // The same car in the ego's own lane at the start is its follower's business.

@@ -39,8 +39,8 @@ TEST(SearchContinuityTest, FindsTheConsumedPointsAndNoticesALostSync) {
   Telemetry none;
   EXPECT_FALSE(st.continuity.Synchronise(none, true, false).synced) << "no plan yet";
   const PlanResult plan = StorePlan(st);
-  ASSERT_EQ(plan.x.size(), static_cast<size_t>(st.cfg.output_points));
-  EXPECT_EQ(st.continuity.plan_n(), st.cfg.output_points);
+  ASSERT_EQ(plan.x.size(), static_cast<size_t>(st.cfg.continuity.output_points));
+  EXPECT_EQ(st.continuity.plan_n(), st.cfg.continuity.output_points);
   for (const int consumed : {1, 3, 40}) {
     const Continuity::Sync s = st.continuity.Synchronise(Driven(plan, consumed), true, true);
     EXPECT_TRUE(s.synced) << consumed;
@@ -93,7 +93,7 @@ TEST(SearchContinuityTest, ReusesThePlanUntilTooManyPointsOrTheTrafficChanges) {
   const Telemetry searched = Driven(plan, 1);
   st.continuity.SearchDone(searched, /*can_reuse=*/true);
   EXPECT_TRUE(st.continuity.CanReuse(Driven(plan, 1), 1));
-  EXPECT_FALSE(st.continuity.CanReuse(Driven(plan, 4), st.cfg.replan_min_ticks))
+  EXPECT_FALSE(st.continuity.CanReuse(Driven(plan, 4), st.cfg.continuity.replan_min_ticks))
       << "replan_min_ticks points driven";
   PlanResult reused;
   st.continuity.ReusePlan(1, reused);
@@ -155,7 +155,7 @@ TEST(SearchContinuityTest, StoresTheKeptPointsThenTheTicksInXy) {
   REQUIRE_UDACITY_MAP();
   Stages st;
   const PlanResult first = StorePlan(st);
-  for (int k = 0; k < st.cfg.output_points; ++k) {
+  for (int k = 0; k < st.cfg.continuity.output_points; ++k) {
     const map::CartesianPose p = st.line->ToCartesian(st.ws.tk_s[k + 1], st.ws.tk_d[k + 1]);
     ASSERT_EQ(first.x[k], p.x) << k;
     ASSERT_EQ(first.y[k], p.y) << k;
@@ -171,7 +171,7 @@ TEST(SearchContinuityTest, StoresTheKeptPointsThenTheTicksInXy) {
   const map::CartesianPose p = st.line->ToCartesian(st.ws.tk_s[1], st.ws.tk_d[1]);
   EXPECT_EQ(second.x[6], p.x);
   EXPECT_EQ(second.y[6], p.y);
-  EXPECT_EQ(st.continuity.plan_n(), st.cfg.output_points);
+  EXPECT_EQ(st.continuity.plan_n(), st.cfg.continuity.output_points);
 }
 
 }  // namespace

@@ -68,7 +68,7 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
     return c;
   };
   Stages off(with(0)), on(with(1));
-  off.cfg.max_accel = on.cfg.max_accel = 0.5;  // below the config's range: a test-only limit
+  off.cfg.limits.max_accel = on.cfg.limits.max_accel = 0.5;  // below the config's range: a test-only limit
   PrepareCentred(off, 20);
   PrepareCentred(on, 20);
   off.lattice.Generate();
@@ -79,7 +79,7 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
   const int n = ws.n_samples;
   int near_limit = 0;
   for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
-    for (int k = 1; k < n && k * on.cfg.score_dt <= on.cfg.check_horizon + 1e-9; ++k) {
+    for (int k = 1; k < n && k * on.cfg.score.dt <= on.cfg.check.horizon + 1e-9; ++k) {
       const double s = ws.lon_s[i * n + k], v = ws.lon_sd[i * n + k];
       const int b = static_cast<int>(std::floor((s - ws.kappa_s0) / Workspace::kEdgeBin));
       ASSERT_TRUE(b >= 0 && b < static_cast<int>(ws.abs_kappa.size()));
@@ -100,21 +100,21 @@ TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   const Workspace& ws = st.ws;
   const Settings& c = st.cfg;
   // Per duration every end speed and a stop; braking once: levels x targets.
-  EXPECT_EQ(Count(ws, cost::LonKind::kVelocityKeeping), c.speeds * c.durations);
-  EXPECT_EQ(Count(ws, cost::LonKind::kStopping), c.durations);
-  EXPECT_EQ(Count(ws, cost::LonKind::kBraking), c.brake_decels * c.brake_targets);
+  EXPECT_EQ(Count(ws, cost::LonKind::kVelocityKeeping), c.grid.speeds * c.grid.durations);
+  EXPECT_EQ(Count(ws, cost::LonKind::kStopping), c.grid.durations);
+  EXPECT_EQ(Count(ws, cost::LonKind::kBraking), c.brake.decels * c.brake.targets);
   EXPECT_EQ(Count(ws, cost::LonKind::kFollowing), 0);
-  EXPECT_EQ(Count(ws, cost::LonKind::kAccelerating), c.accels);  // below the limit: runs up
+  EXPECT_EQ(Count(ws, cost::LonKind::kAccelerating), c.grid.accels);  // below the limit: runs up
   ASSERT_EQ(ws.lon.size(), 90u) << "the shipped grid: 12 x 6 + 6 + 3 x 3 + 3";
   // Own lane centred and at rest: one move; each neighbour: every duration plus the delays.
   int per_lane[3] = {};
   for (const LatTraj& l : ws.lat) ++per_lane[l.lane];
   EXPECT_EQ(per_lane[1], 1);
-  EXPECT_EQ(per_lane[0], c.lat_durations * c.lat_offsets + c.lat_delays);
-  EXPECT_EQ(per_lane[2], c.lat_durations * c.lat_offsets + c.lat_delays);
+  EXPECT_EQ(per_lane[0], c.lat.durations * c.lat.offsets + c.lat.delays);
+  EXPECT_EQ(per_lane[2], c.lat.durations * c.lat.offsets + c.lat.delays);
   int delayed = 0;
   for (const LatTraj& l : ws.lat) delayed += l.traj.delay > 0;
-  EXPECT_EQ(delayed, 2 * c.lat_delays);
+  EXPECT_EQ(delayed, 2 * c.lat.delays);
   // No lane-bound longitudinal trajectory: every pair is a candidate, lon-major.
   ASSERT_EQ(ws.cand_lon.size(), ws.lon.size() * ws.lat.size());
   EXPECT_EQ(ws.cand_lon[1], 0);
@@ -164,7 +164,7 @@ TEST(SearchLatticeTest, AtACrawlOffTheCentreItHoldsItsD) {
       holds += std::abs(l.traj.At(l.traj.end_time()).p - d) < 1e-9;
     }
     EXPECT_EQ(holds, speed < 2.0 ? 1 : 0) << speed << " m/s";
-    EXPECT_EQ(own, speed < 2.0 ? 1 : st.cfg.lat_durations * st.cfg.lat_offsets) << speed << " m/s";
+    EXPECT_EQ(own, speed < 2.0 ? 1 : st.cfg.lat.durations * st.cfg.lat.offsets) << speed << " m/s";
   }
 }
 
@@ -173,7 +173,7 @@ TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
   Stages st;
   PrepareCentred(st, 20, /*d_d=*/1.0);
   st.lattice.Generate();
-  EXPECT_EQ(st.ws.lat.size(), 3u * st.cfg.lat_durations * st.cfg.lat_offsets);
+  EXPECT_EQ(st.ws.lat.size(), 3u * st.cfg.lat.durations * st.cfg.lat.offsets);
   for (const LatTraj& l : st.ws.lat) {
     EXPECT_EQ(l.traj.delay, 0);
     EXPECT_DOUBLE_EQ(l.traj.poly.V(0), 1.0) << "a move starts from the current d'";
@@ -188,7 +188,7 @@ TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
   st.lattice.Generate();
   const Workspace& ws = st.ws;
   const Settings& c = st.cfg;
-  ASSERT_EQ(Count(ws, cost::LonKind::kFollowing), c.durations * c.follow_gaps);
+  ASSERT_EQ(Count(ws, cost::LonKind::kFollowing), c.grid.durations * c.grid.follow_gaps);
   const double follow_d0 = st.config.value("grid.follow_d0");
   const double follow_tau = st.config.value("grid.follow_tau");
   int following_pairs = 0;
@@ -199,7 +199,7 @@ TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
     EXPECT_EQ(ws.lat[ws.cand_lat[i]].lane, 1) << "following is bound to the leader's lane";
   }
   // Only the own lane's single move pairs with them.
-  EXPECT_EQ(following_pairs, c.durations * c.follow_gaps);
+  EXPECT_EQ(following_pairs, c.grid.durations * c.grid.follow_gaps);
   // (No constant-acceleration run: the leader is within 100 m.)
   EXPECT_EQ(ws.cand_lon.size(), 87u * ws.lat.size() + following_pairs);
   for (const LonTraj& l : ws.lon) {
@@ -227,7 +227,7 @@ TEST(SearchLatticeTest, YieldsToACarAlongsideInTheNeighbourLane) {
       ++yield;
     }
   }
-  EXPECT_EQ(yield, st.cfg.durations * st.cfg.follow_gaps);
+  EXPECT_EQ(yield, st.cfg.grid.durations * st.cfg.grid.follow_gaps);
 }
 
 TEST(SearchLatticeTest, GapTargetsEndBetweenTwoCarsOfTheNeighbourLane) {
@@ -253,7 +253,7 @@ TEST(SearchLatticeTest, GapTargetsEndBetweenTwoCarsOfTheNeighbourLane) {
     if (std::abs(s - 0.5 * (ahead + far)) < 0.05) ++in_gaps;
     EXPECT_NEAR(l.traj.At(T).v, 18, 1e-3);
   }
-  EXPECT_EQ(in_gaps, 2 * st.cfg.durations);
+  EXPECT_EQ(in_gaps, 2 * st.cfg.grid.durations);
   // None without the setting.
   Stages off(GridOnly());
   PrepareCentred(off, 20, 0, cars);
@@ -294,18 +294,18 @@ TEST(SearchLatticeTest, RunsUpToTheLimitAtConstantAccelerationBelowIt) {
   const Settings& c = st.cfg;
   const double* lim = st.ws.ctx.lane_speed_limit;
   const double vmax = std::max({lim[0], lim[1], lim[2]});
-  ASSERT_EQ(Count(st.ws, cost::LonKind::kAccelerating), c.accels);
+  ASSERT_EQ(Count(st.ws, cost::LonKind::kAccelerating), c.grid.accels);
   double top = 0;
   for (const LonTraj& l : st.ws.lon) {
     if (l.kind != cost::LonKind::kAccelerating) continue;
     EXPECT_EQ(l.lane, -1);
-    EXPECT_GE(l.param, c.accel_min);
-    EXPECT_LE(l.param, c.accel_max);
+    EXPECT_GE(l.param, c.grid.accel_min);
+    EXPECT_LE(l.param, c.grid.accel_max);
     EXPECT_NEAR(l.traj.duration, vmax / l.param, 1e-9);
     EXPECT_NEAR(l.traj.At(l.traj.duration).v, vmax, 1e-9);
     top = std::max(top, l.param);
   }
-  EXPECT_DOUBLE_EQ(top, c.accel_max);
+  EXPECT_DOUBLE_EQ(top, c.grid.accel_max);
   Stages fast(GridOnly());
   PrepareCentred(fast, vmax - 0.5);
   fast.lattice.Generate();
@@ -320,7 +320,7 @@ TEST(SearchLatticeTest, RunsUpToTheLimitAtConstantAccelerationBelowIt) {
   Stages far(GridOnly());
   PrepareCentred(far, 0.0, 0, {{kS + 110, 10.0, 20.0}});
   far.lattice.Generate();
-  EXPECT_EQ(Count(far.ws, cost::LonKind::kAccelerating), c.accels);
+  EXPECT_EQ(Count(far.ws, cost::LonKind::kAccelerating), c.grid.accels);
 }
 
 // On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets
@@ -341,7 +341,7 @@ TEST(SearchLatticeTest, SlowerLanesOfABendGetTheirOwnLimit) {
   const double* lim = ws.ctx.lane_speed_limit;
   const double vmax = std::max({lim[0], lim[1], lim[2]});
   int slower = 0;
-  for (int l = 0; l < c.num_lanes; ++l) slower += lim[l] < vmax - 0.05;
+  for (int l = 0; l < c.road.num_lanes; ++l) slower += lim[l] < vmax - 0.05;
   ASSERT_GT(slower, 0);
   int bound = 0;
   for (size_t i = 0; i < ws.lon.size(); ++i) {
@@ -351,7 +351,7 @@ TEST(SearchLatticeTest, SlowerLanesOfABendGetTheirOwnLimit) {
     EXPECT_LT(lim[l.lane], vmax - 0.05);
     EXPECT_NEAR(l.traj.poly.V(l.traj.duration), lim[l.lane], 1e-9);
   }
-  EXPECT_EQ(bound, slower * c.durations);
+  EXPECT_EQ(bound, slower * c.grid.durations);
   for (size_t k = 0; k < ws.cand_lon.size(); ++k) {
     const LonTraj& l = ws.lon[ws.cand_lon[k]];
     if (l.lane >= 0) {
@@ -365,7 +365,7 @@ TEST(SearchLatticeTest, SlowerLanesOfABendGetTheirOwnLimit) {
   Stages plain(off);
   plain.Prepare({bend, 20, 0, 6.0, 0, 0});
   plain.lattice.Generate();
-  EXPECT_EQ(Count(plain.ws, cost::LonKind::kVelocityKeeping), c.speeds * c.durations);
+  EXPECT_EQ(Count(plain.ws, cost::LonKind::kVelocityKeeping), c.grid.speeds * c.grid.durations);
 }
 
 // A goal region crossed turned: swerves into it, each paired only with the lon trajectories that

@@ -55,10 +55,10 @@ TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
   tr.lon.duration = 5;
   tr.lat.poly.c[0] = 6.0;
   tr.lat.duration = 5;
-  EXPECT_NEAR(Clearance(st.ws, tr), 4.0 - st.cfg.car_width, 1e-6);
+  EXPECT_NEAR(Clearance(st.ws, tr), 4.0 - st.cfg.check.car_width, 1e-6);
   // 30 m ahead in the same lane: the longitudinal gap minus a car length.
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS + 30, 6.0, 20}});
-  EXPECT_NEAR(Clearance(st.ws, tr), 30.0 - st.cfg.car_length, 1e-6);
+  EXPECT_NEAR(Clearance(st.ws, tr), 30.0 - st.cfg.check.car_length, 1e-6);
 }
 
 TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {

@@ -66,7 +66,7 @@ TEST(SearchRefinerTest, NeverReturnsACostlierOrInfeasibleWinner) {
     if (lb.kind == cost::LonKind::kBraking || lb.kind == cost::LonKind::kAccelerating) continue;
     ++refined;
     EXPECT_GT(sum.refine_iterations, 0) << "scene " << i;
-    EXPECT_LE(sum.refine_iterations, st.cfg.refine_iterations + 1) << "scene " << i;
+    EXPECT_LE(sum.refine_iterations, st.cfg.refine.iterations + 1) << "scene " << i;
     EXPECT_EQ(sum.refine_cost_before, before) << "scene " << i;
     const double after = st.scorer.CostOf(st.ws.winner, lb, db);
     EXPECT_LE(after, before) << "scene " << i;
