@@ -22,10 +22,10 @@
 #include <string_view>
 #include <vector>
 
+#include "frenetic/drive/drive_report.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/record/replica.h"
 #include "frenetic/record/writer.h"
-#include "frenetic/sim/drive_report.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 

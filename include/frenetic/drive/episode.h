@@ -15,10 +15,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/drive/drive_report.h"
+#include "frenetic/eval/incident_judge.h"
+#include "frenetic/eval/oracle.h"
 #include "frenetic/plan/planner.h"
-#include "frenetic/sim/drive_report.h"
-#include "frenetic/sim/incident_judge.h"
-#include "frenetic/sim/oracle.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 
@@ -35,8 +35,8 @@ struct EpisodeLimits {
   Status Validate() const;
 };
 
-class RecordWriter;      // sim/record.h
-class IncidentRecorder;  // sim/incident_recorder.h
+class RecordWriter;      // drive/record.h
+class IncidentRecorder;  // eval/incident_recorder.h
 
 class Episode {
  public:

@@ -1,6 +1,6 @@
 // The lines are formatted on the record::Writer's thread from copies of the exchange's values
 // (the planning thread only copies).
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/record.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "frenetic/sim/episode.h"
+#include "frenetic/drive/episode.h"
 
 #include <spdlog/spdlog.h>
 
@@ -11,8 +11,8 @@
 #include <optional>
 #include <thread>
 
-#include "frenetic/sim/incident_recorder.h"
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/record.h"
+#include "frenetic/eval/incident_recorder.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/precision.h"
 #include "frenetic/wire/protocol.h"
