@@ -24,7 +24,7 @@ struct ConnectOptions {
   // When set, the drive is recorded as an in-process one is (drive/record.h), with the planner's
   // internals absent: header, one line per exchange, footer.
   sim::RecordWriter* record = nullptr;
-  // Judge every incident (sim::Episode::EnableJudging); unset: off.
+  // Judge every incident (sim::JudgeObserver, drive/evaluators.h); unset: off.
   std::optional<sim::JudgeOptions> judge;
 };
 
