@@ -51,7 +51,7 @@ configure_and_build() {
 # A separate build with AddressSanitizer + UndefinedBehaviorSanitizer (plus float-to-int overflow,
 # which -fsanitize=undefined leaves out) of the library test suites
 # (not the executable's end-to-end tests, the tuner or the benchmarks, which the Release run covers).
-ASAN_TEST_MODULES=(yaml map traj cost plan wire net record sim report commonroad)
+ASAN_TEST_MODULES=(yaml map traj cost plan wire net record sim eval drive report commonroad)
 configure_and_build_asan() {
   local dir="$FRENETIC_ROOT/build-asan" generator=() targets=()
   command -v ninja >/dev/null && generator=(-G Ninja)

@@ -14,12 +14,12 @@
 
 #include "apps/commands.h"
 #include "apps/drive_connect.h"
+#include "frenetic/drive/episode.h"
+#include "frenetic/drive/record.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/record/plan_json.h"
-#include "frenetic/sim/episode.h"
-#include "frenetic/sim/record.h"
 #include "frenetic/sim/scenario.h"
 #include "frenetic/sim/world.h"
 #include "frenetic/units.h"
@@ -199,7 +199,7 @@ int Drive(const DriveArgs& a) {
     record = std::move(writer).value();
     options.record = record.get();
     // A replica traces the candidates on the record's thread, so the planner that drives does
-    // not (sim/record.h); with wall-clock deadlines only the planner itself knows its search.
+    // not (drive/record.h); with wall-clock deadlines only the planner itself knows its search.
     if (auto replica = factory(); replica.ok() && !a.real_time_deadlines) {
       record->TraceByReplay(std::move(replica).value(), options.trace_candidates);
       options.trace_candidates = 0;
@@ -287,7 +287,7 @@ void RegisterDrive(CLI::App& app) {
                 "per 0.2 s block tried, a few ms for a typical incident");
   CLI::Option* oracle_flag = sub->add_flag("--oracle", args->oracle,
                 "After each episode, search how far a planner that knew the traffic's next 20 s "
-                "could have driven against it as it moved (src/sim/oracle.h): dynamic "
+                "could have driven against it as it moved (frenetic/eval/oracle.h): dynamic "
                 "programming over lanes, positions (0.5 m) and speeds (1 m/s steps up to 22.2 "
                 "m/s = 49.7 mph along the road) every 0.5 s, +4/-6 m/s^2 at most, lane changes "
                 "of 3 s (1 s astride), with the planner's margins (--oracle-headway, --oracle-room), in "

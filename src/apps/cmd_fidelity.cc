@@ -16,8 +16,9 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "frenetic/drive/traffic_runs.h"
+#include "frenetic/eval/fidelity.h"
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/sim/fidelity.h"
 #include "frenetic/sim/world.h"
 
 namespace frenetic::apps {

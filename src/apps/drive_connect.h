@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "frenetic/sim/drive_report.h"
-#include "frenetic/sim/episode.h"
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/drive_report.h"
+#include "frenetic/drive/episode.h"
+#include "frenetic/drive/record.h"
 #include "frenetic/sim/scenario.h"
 #include "frenetic/sim/world.h"
 #include "frenetic/status.h"
@@ -21,10 +21,10 @@ struct ConnectOptions {
   bool realtime = false;  // pace frames at simulated time (as the Unity simulator does)
   double timeout = 10.0;  // s for connecting and for each reply
   bool timing = true;     // false: round-trip times are reported and recorded as 0
-  // When set, the drive is recorded as an in-process one is (sim/record.h), with the planner's
+  // When set, the drive is recorded as an in-process one is (drive/record.h), with the planner's
   // internals absent: header, one line per exchange, footer.
   sim::RecordWriter* record = nullptr;
-  // Judge every incident (sim::Episode::EnableJudging); unset: off.
+  // Judge every incident (sim::JudgeObserver, drive/evaluators.h); unset: off.
   std::optional<sim::JudgeOptions> judge;
 };
 

@@ -5,8 +5,6 @@
 #include <limits>
 #include <vector>
 
-#include "frenetic/sim/drive_report.h"
-#include "frenetic/sim/episode.h"
 #include "frenetic/sim/scenario.h"
 #include "frenetic/units.h"
 #include "sim/sim_test_util.h"
@@ -138,28 +136,6 @@ TEST(DriveBreakdown, SplitsByLapAndSums) {
   EXPECT_EQ(t.lap, 2);
   EXPECT_NEAR(t.seconds, ticks * kDt, 1e-6);
   EXPECT_NEAR(t.distance_m, ticks * 22.0 * kDt, 1e-6);
-}
-
-TEST(DriveBreakdown, ADriveReportsItsBreakdown) {
-  FRENETIC_REQUIRE_UDACITY(world);
-  testing::KeepLanePlanner planner(world->line, 20.0);
-  EpisodeLimits limits;
-  limits.laps = 0;
-  limits.seconds = 60;
-  auto report = RunEpisode(world, Scenario(), 3, limits, planner, RunOptions{});
-  ASSERT_TRUE(report.ok()) << report.message();
-  // The parts are within the whole, and the whole is the drive.
-  const LapBreakdown& b = report->breakdown;
-  EXPECT_NEAR(b.seconds, report->sim_seconds, 1e-6);
-  EXPECT_NEAR(b.distance_m, report->distance_m, 1e-6);
-  EXPECT_EQ(b.at_limit_s, 0);  // 20 m/s is 44.7 mph
-  EXPECT_LE(b.following_open_s, b.following_s);
-  EXPECT_LE(b.following_s, b.seconds);
-  ASSERT_EQ(report->laps.size(), 1u);
-  const nlohmann::json j = report->ToJson();
-  ASSERT_TRUE(j.contains("breakdown"));
-  EXPECT_EQ(j["breakdown"]["laps"].size(), 1u);
-  EXPECT_NEAR(j["breakdown"]["seconds"].get<double>(), report->sim_seconds, 1e-6);
 }
 
 }  // namespace

@@ -72,7 +72,7 @@ const PALETTE = ["#1570ef", "#e04f16", "#12b76a", "#9e77ed", "#f79009", "#0e9384
 const state = { k: 0, playing: false, zoom: 3.0, rate: 4, detail: -1, showCandidates: true,
                 simTime: T.length ? T[0] : 0, lastFrame: 0 };
 
-// The judgement of an incident (drive's judging, sim/incident_judge.h): the footer's
+// The judgement of an incident (drive's judging, eval/incident_judge.h): the footer's
 // incident_log is in the same order as the exchanges' incidents. Null when not judged.
 function judgementOf(incident) {
   const log = D.footer && Array.isArray(D.footer.incident_log) ? D.footer.incident_log : [];

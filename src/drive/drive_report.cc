@@ -1,4 +1,4 @@
-#include "frenetic/sim/drive_report.h"
+#include "frenetic/drive/drive_report.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The incident judge's records and words: a case's recorded ticks, and the names and the one-line
 // description of its results (incident_judge.h).
-#include "frenetic/sim/incident_judge.h"
+#include "frenetic/eval/incident_judge.h"
 
 #include <spdlog/fmt/fmt.h>
 

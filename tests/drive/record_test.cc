@@ -1,7 +1,7 @@
 // The record writer: plain and gzip files of the same drive hold the same text, the candidates a
 // replica traces on the writer's thread are the ones the driving planner would have traced, and
 // write failures are reported. (The schema itself: episode_test.cc.)
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/record.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "frenetic/drive/episode.h"
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/sim/episode.h"
 #include "frenetic/sim/scenario.h"
-#include "sim_test_util.h"
+#include "sim/sim_test_util.h"
 
 namespace frenetic::sim {
 namespace {

@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/eval/incident_judge.h"
+#include "frenetic/eval/oracle.h"
 #include "frenetic/sim/drive_breakdown.h"
-#include "frenetic/sim/incident_judge.h"
 #include "frenetic/sim/incident_monitor.h"
-#include "frenetic/sim/oracle.h"
 #include "frenetic/units.h"
 
 namespace frenetic::sim {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "frenetic/sim/incident_judge.h"
+#include "frenetic/eval/incident_judge.h"
 #include "frenetic/sim/simulator.h"
 
 namespace frenetic::sim {

@@ -1,6 +1,6 @@
 // The judge's transposition table: a key is there once inserted, never before, and none is lost
 // when the table grows.
-#include "sim/key_set.h"
+#include "eval/key_set.h"
 
 #include <gtest/gtest.h>
 

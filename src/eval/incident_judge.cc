@@ -2,7 +2,7 @@
 // measured by the simulator's own code: IncidentMonitor, BoxesOverlap, ChordFrenet, and the
 // EgoCar's float32 speed and heading arithmetic, so "incident-free" means what the simulator
 // means; the rest of this file only proposes trajectories and orders them.
-#include "frenetic/sim/incident_judge.h"
+#include "frenetic/eval/incident_judge.h"
 
 #include <spdlog/fmt/fmt.h>
 
@@ -13,8 +13,8 @@
 #include <limits>
 #include <vector>
 
-#include "sim/incident_judge_internal.h"
-#include "sim/key_set.h"
+#include "eval/incident_judge_internal.h"
+#include "eval/key_set.h"
 
 namespace frenetic::sim {
 namespace judge {

@@ -1,6 +1,6 @@
 // Recordings, the protocol, Frenet and ego-motion checks of `frenetic fidelity`. The traffic
 // statistics are in fidelity_traffic.cc.
-#include "frenetic/sim/fidelity.h"
+#include "frenetic/eval/fidelity.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "frenetic/sim/incident_judge.h"
+#include "frenetic/eval/incident_judge.h"
 
 namespace frenetic::sim::judge {
 

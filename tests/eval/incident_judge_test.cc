@@ -1,6 +1,6 @@
 // The incident judge's power on scenes built with exactly one narrow escape, or none, and its
 // agreement with the simulator it judges for.
-#include "frenetic/sim/incident_judge.h"
+#include "frenetic/eval/incident_judge.h"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "eval/incident_judge_internal.h"
+#include "frenetic/eval/incident_recorder.h"
 #include "frenetic/sim/ego.h"
-#include "frenetic/sim/incident_recorder.h"
 #include "frenetic/sim/simulator.h"
-#include "sim/incident_judge_internal.h"
-#include "sim_test_util.h"
+#include "sim/sim_test_util.h"
 
 namespace frenetic::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "frenetic/sim/episode.h"
+#include "frenetic/drive/episode.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "drive/drive_test_util.h"
+#include "frenetic/drive/record.h"
+#include "frenetic/eval/oracle.h"
 #include "frenetic/record/plan_json.h"
-#include "frenetic/sim/record.h"
-#include "sim_test_util.h"
 
 namespace frenetic::sim {
 namespace {
@@ -258,6 +259,48 @@ TEST(RunEpisodes, JudgedVerdictsAddUp) {
   options.judge->budget_blocks = 0;
   EXPECT_FALSE(
       RunEpisodes(world, Scenario(), 3, 2, 2, EpisodeLimits{0, 0, 60, 60}, factory, options).ok());
+}
+
+TEST(DriveBreakdown, ADriveReportsItsBreakdown) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  testing::KeepLanePlanner planner(world->line, 20.0);
+  EpisodeLimits limits;
+  limits.laps = 0;
+  limits.seconds = 60;
+  auto report = RunEpisode(world, Scenario(), 3, limits, planner, RunOptions{});
+  ASSERT_TRUE(report.ok()) << report.message();
+  // The parts are within the whole, and the whole is the drive.
+  const LapBreakdown& b = report->breakdown;
+  EXPECT_NEAR(b.seconds, report->sim_seconds, 1e-6);
+  EXPECT_NEAR(b.distance_m, report->distance_m, 1e-6);
+  EXPECT_EQ(b.at_limit_s, 0);  // 20 m/s is 44.7 mph
+  EXPECT_LE(b.following_open_s, b.following_s);
+  EXPECT_LE(b.following_s, b.seconds);
+  ASSERT_EQ(report->laps.size(), 1u);
+  const nlohmann::json j = report->ToJson();
+  ASSERT_TRUE(j.contains("breakdown"));
+  EXPECT_EQ(j["breakdown"]["laps"].size(), 1u);
+  EXPECT_NEAR(j["breakdown"]["seconds"].get<double>(), report->sim_seconds, 1e-6);
+}
+
+TEST(RunEpisode, TheOracleNeverChangesTheDriveAndIsReported) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  testing::KeepLanePlanner planner(world->line, 15);
+  auto [plain, searched] = testing::DriveWithAndWithout(
+      world, planner, 5, 30, [](RunOptions& o) { o.oracle = OracleOptions(); });
+  ASSERT_TRUE(plain.ok() && searched.ok());
+  EXPECT_FALSE(plain->oracle_run);
+  ASSERT_TRUE(searched->oracle_run);
+  nlohmann::json j = searched->ToJson();
+  ASSERT_TRUE(j.contains("oracle"));
+  EXPECT_DOUBLE_EQ(j["oracle"]["mph"].get<double>(), searched->oracle.mph());
+  EXPECT_EQ(j["oracle"]["windows"].size(), searched->oracle.windows.size());
+  // 15 m/s kept from a standstill: the search is faster than that.
+  EXPECT_GT(searched->oracle.mph(), searched->oracle.driven_mph() + 1.0);
+  EXPECT_NEAR(searched->oracle.seconds, 30.0, 0.6);
+  j.erase("oracle");
+  EXPECT_EQ(j.dump(), plain->ToJson().dump());
+  EXPECT_NE(searched->ToText().find("oracle          "), std::string::npos);
 }
 
 }  // namespace

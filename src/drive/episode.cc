@@ -1,4 +1,4 @@
-#include "frenetic/sim/episode.h"
+#include "frenetic/drive/episode.h"
 
 #include <spdlog/spdlog.h>
 
@@ -11,11 +11,10 @@
 #include <optional>
 #include <thread>
 
-#include "frenetic/sim/incident_recorder.h"
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/evaluators.h"
+#include "frenetic/drive/record.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/precision.h"
-#include "frenetic/wire/protocol.h"
 
 namespace frenetic::sim {
 namespace {
@@ -28,6 +27,19 @@ double Percentile(std::vector<double> v, double q) {
   const std::size_t i = static_cast<std::size_t>(std::ceil(q * v.size())) - (q > 0 ? 1 : 0);
   return v[std::min(i, v.size() - 1)];
 }
+
+// RunOptions::progress as an observer: after every exchange.
+class ProgressObserver final : public EpisodeObserver {
+ public:
+  explicit ProgressObserver(const std::function<void(const Episode&)>& progress)
+      : progress_(progress) {}
+  void OnExchange(const Episode& episode, const Exchange& /*exchange*/) override {
+    progress_(episode);
+  }
+
+ private:
+  const std::function<void(const Episode&)>& progress_;
+};
 
 }  // namespace
 
@@ -63,10 +75,6 @@ DriveReport MakeReport(const Episode& ep, std::string_view planner,
   r.incident_log = m.log();
   r.laps = sim.breakdown().laps();
   r.breakdown = sim.breakdown().Total();
-  if (const auto* judged = ep.judgements(); judged != nullptr) {
-    r.judged = true;
-    r.judgements = *judged;
-  }
   return r;
 }
 
@@ -97,26 +105,35 @@ Episode::Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits)
 
 Episode::~Episode() = default;
 
-void Episode::EnableJudging(const JudgeOptions& options, bool timing) {
-  recorder_ = std::make_unique<IncidentRecorder>(*sim_, options, timing);
+void Episode::Attach(EpisodeObserver* observer) {
+  observers_.push_back(observer);
+  if (observer->wants_ticks()) tick_observers_.push_back(observer);
+  observer->OnStart(*this);
 }
 
-const std::vector<IncidentJudgement>* Episode::judgements() const {
-  return recorder_ ? &recorder_->judgements() : nullptr;
+Status Episode::Finish(DriveReport* report) {
+  Status first = Status::Ok();
+  for (EpisodeObserver* o : observers_) {
+    if (Status s = o->OnEnd(*this, report); !s.ok() && first.ok()) first = s;
+  }
+  return first;
 }
 
 void Episode::Advance(int ticks) {
-  if (!recorder_) {
+  // Tick by tick only for an observer that asks (the judge): the same ticks either way.
+  if (tick_observers_.empty()) {
     sim_->Advance(ticks);
     return;
   }
   for (int i = 0; i < ticks; ++i) {
     sim_->Advance(1);
-    recorder_->AfterTick();
+    for (EpisodeObserver* o : tick_observers_) o->OnTick(*sim_);
   }
 }
 
-Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
+Status Episode::Submit(std::span<const double> x, std::span<const double> y,
+                       const ExchangeReply& reply) {
+  const Exchange exchange{exchanges_, sim_->time(), sim_->monitor().log().size(), &reply};
   const TimingOptions& t = sim_->scenario().timing;
   int l_old = 0, l_new = 1;
   auto draw = [&](int lo, int hi) {
@@ -140,8 +157,8 @@ Status Episode::Submit(std::span<const double> x, std::span<const double> y) {
   Advance(l_new);
   ++exchanges_;
   CheckDone();
-  if (done() && recorder_) recorder_->Finish();
   sim_->GetTelemetry(&telemetry_);
+  for (EpisodeObserver* o : observers_) o->OnExchange(*this, exchange);
   return status;
 }
 
@@ -167,22 +184,31 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   if (options.judge) {
     if (Status s = options.judge->Validate(); !s.ok()) return s;
   }
+  if (options.oracle) {
+    if (Status s = options.oracle->Validate(); !s.ok()) return s;
+  }
   auto sim = Simulator::Create(std::move(world), scenario, seed);
   if (!sim.ok()) return sim.status();
   Episode ep(std::move(*sim), limits);
-  if (options.judge) ep.EnableJudging(*options.judge, options.timing);
+  // The observers, in RunOptions' order: the record's footer has what the others add.
+  std::optional<JudgeObserver> judge;
+  std::optional<OracleObserver> oracle;
+  if (options.judge) ep.Attach(&judge.emplace(*options.judge, options.timing));
+  if (options.oracle) ep.Attach(&oracle.emplace(*options.oracle));
   planner.Reset();
   plan::CycleTrace trace;
   RecordWriter* record = options.record;
   if (record != nullptr) {
     record->set_timing(options.timing);
     planner.set_trace(&trace, options.trace_candidates);
-    record->WriteHeader(ep.sim(), std::string(planner.name()), options.planner_config);
+    record->set_planner(std::string(planner.name()), options.planner_config);
+    ep.Attach(record);
   }
+  ProgressObserver progress(options.progress);
+  if (options.progress) ep.Attach(&progress);
   std::vector<double> plan_ms;
   plan_ms.reserve(20000);
   int fallbacks = 0, bad_paths = 0;
-  std::string telemetry_json;
   // The planner gets the telemetry as it arrives over the wire and the simulator the path as it
   // arrives back (wire/precision.h: float32 printed with 7 digits out, 10 digits back, a path
   // cut before its first unwritable point), so that this drive and the same seed through
@@ -193,28 +219,7 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   std::vector<double> path_x, path_y;
   path_x.reserve(256);
   path_y.reserve(256);
-  std::optional<OracleTrace> oracle;
-  std::vector<plan::SensorCar> oracle_cars;
-  auto sample = [&] {
-    const plan::Telemetry& t = ep.telemetry();
-    // A row at the seam may read s = d = 0 (udacity-sim.md §8.6): its Frenet from x, y instead.
-    oracle_cars.assign(t.sensor_fusion.begin(), t.sensor_fusion.end());
-    for (plan::SensorCar& c : oracle_cars) {
-      if (c.s != 0 || c.d != 0) continue;
-      const map::FrenetPoint f = ep.sim().world().line->ToFrenet(c.x, c.y, t.s);
-      c.s = f.s;
-      c.d = f.d;
-    }
-    oracle->Add(ep.sim().time(), t.s, t.d, t.speed, oracle_cars);
-  };
-  if (options.oracle) {
-    if (Status s = options.oracle->Validate(); !s.ok()) return s;
-    oracle.emplace(ep.sim().world().track.max_s);
-    sample();
-  }
   while (!ep.done()) {
-    const double t_sent = ep.sim().time();
-    if (record != nullptr) telemetry_json = wire::TelemetryToJson(ep.telemetry());
     wire::TelemetryAsReceived(ep.telemetry(), &received);
     trace.candidates.clear();
     const auto t0 = std::chrono::steady_clock::now();
@@ -226,8 +231,6 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
             : 0.0;
     plan_ms.push_back(ms);
     if (result.status != plan::PlanStatus::kOk) ++fallbacks;
-    const std::size_t first_incident = ep.sim().monitor().log().size();
-    const int index = ep.exchanges();
     wire::ControlAsReceived(result.x, result.y, &path_x, &path_y);
     if ((path_x.size() != result.x.size() || path_x.size() != result.y.size()) &&
         bad_paths++ == 0) {
@@ -235,24 +238,15 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
                    "serve would (warned once)",
                    result.x.size(), result.y.size(), path_x.size());
     }
-    (void)ep.Submit(path_x, path_y);  // the wire's path is always one the simulator accepts
-    if (oracle) sample();
-    if (record != nullptr) {
-      record->WriteExchange(index, t_sent, telemetry_json, result, &trace, ms, ep.sim(),
-                            first_incident, ep.last_l_old(), ep.last_l_new());
-    }
-    if (options.progress) options.progress(ep);
+    ExchangeReply reply;
+    reply.plan = &result;  // the record keeps the path as planned
+    reply.trace = &trace;
+    reply.ms = ms;
+    (void)ep.Submit(path_x, path_y, reply);  // the wire's path is always one the simulator accepts
   }
   if (record != nullptr) planner.set_trace(nullptr, 0);
   DriveReport report = MakeReport(ep, planner.name(), plan_ms, fallbacks);
-  if (oracle) {
-    report.oracle_run = true;
-    report.oracle = SearchOracle(*oracle, *options.oracle);
-  }
-  if (record != nullptr) {
-    record->WriteFooter(report);
-    if (Status s = record->status(); !s.ok()) return s;
-  }
+  if (Status s = ep.Finish(&report); !s.ok()) return s;
   return report;
 }
 

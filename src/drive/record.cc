@@ -1,10 +1,11 @@
 // The lines are formatted on the record::Writer's thread from copies of the exchange's values
 // (the planning thread only copies).
-#include "frenetic/sim/record.h"
+#include "frenetic/drive/record.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "frenetic/drive/episode.h"
 #include "frenetic/record/plan_json.h"
 #include "frenetic/record/schema.h"
 #include "frenetic/units.h"
@@ -129,6 +130,38 @@ void RecordWriter::TraceByReplay(std::unique_ptr<plan::Planner> replica, int max
   replica_ = replica ? std::make_shared<record::Replica>(std::move(replica), max_candidates,
                                                          writer_->path())
                      : nullptr;
+}
+
+void RecordWriter::set_planner(std::string name, nlohmann::json config,
+                               std::string connect_url) {
+  planner_name_ = std::move(name);
+  planner_config_ = std::move(config);
+  connect_url_ = std::move(connect_url);
+}
+
+void RecordWriter::OnStart(const Episode& episode) {
+  WriteHeader(episode.sim(), planner_name_, planner_config_, connect_url_);
+  telemetry_json_ = wire::TelemetryToJson(episode.telemetry());
+}
+
+void RecordWriter::OnExchange(const Episode& episode, const Exchange& exchange) {
+  const ExchangeReply& reply = *exchange.reply;
+  if (reply.plan != nullptr) {
+    WriteExchange(exchange.index, exchange.t_sent, telemetry_json_, *reply.plan, reply.trace,
+                  reply.ms, episode.sim(), exchange.first_incident, episode.last_l_old(),
+                  episode.last_l_new());
+  } else {
+    WriteRemoteExchange(exchange.index, exchange.t_sent, telemetry_json_, reply.path_x,
+                        reply.path_y, reply.kind, reply.ms, episode.sim(),
+                        exchange.first_incident, episode.last_l_old(), episode.last_l_new());
+  }
+  // The next exchange's telemetry, as the text sent.
+  if (!episode.done()) telemetry_json_ = wire::TelemetryToJson(episode.telemetry());
+}
+
+Status RecordWriter::OnEnd(const Episode& /*episode*/, DriveReport* report) {
+  WriteFooter(*report);
+  return status();
 }
 
 void RecordWriter::WriteHeader(const Simulator& sim, const std::string& planner_name,

@@ -1,4 +1,4 @@
-#include "frenetic/sim/oracle.h"
+#include "frenetic/eval/oracle.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,12 +1,10 @@
-#include "frenetic/sim/oracle.h"
+#include "frenetic/eval/oracle.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "frenetic/sim/episode.h"
-#include "sim_test_util.h"
 
 namespace frenetic::sim {
 namespace {
@@ -201,26 +199,6 @@ TEST(Oracle, TheEgoSAndTheCarsWrapWithTheTrack) {
   const OracleResult r = SearchOracle(trace, Lanes(1));
   EXPECT_NEAR(r.driven_m, 300.0, 1e-6);
   EXPECT_LE(r.distance_m, 300.0 + 40.0);
-}
-
-TEST(RunEpisode, TheOracleNeverChangesTheDriveAndIsReported) {
-  FRENETIC_REQUIRE_UDACITY(world);
-  testing::KeepLanePlanner planner(world->line, 15);
-  auto [plain, searched] = testing::DriveWithAndWithout(
-      world, planner, 5, 30, [](RunOptions& o) { o.oracle = OracleOptions(); });
-  ASSERT_TRUE(plain.ok() && searched.ok());
-  EXPECT_FALSE(plain->oracle_run);
-  ASSERT_TRUE(searched->oracle_run);
-  nlohmann::json j = searched->ToJson();
-  ASSERT_TRUE(j.contains("oracle"));
-  EXPECT_DOUBLE_EQ(j["oracle"]["mph"].get<double>(), searched->oracle.mph());
-  EXPECT_EQ(j["oracle"]["windows"].size(), searched->oracle.windows.size());
-  // 15 m/s kept from a standstill: the search is faster than that.
-  EXPECT_GT(searched->oracle.mph(), searched->oracle.driven_mph() + 1.0);
-  EXPECT_NEAR(searched->oracle.seconds, 30.0, 0.6);
-  j.erase("oracle");
-  EXPECT_EQ(j.dump(), plain->ToJson().dump());
-  EXPECT_NE(searched->ToText().find("oracle          "), std::string::npos);
 }
 
 }  // namespace

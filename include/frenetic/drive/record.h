@@ -1,8 +1,8 @@
 // The drive record (`frenetic drive --record run.jsonl.gz`, the format of record/schema.h): the
 // header from the simulator, one exchange line per exchange with the simulator's measures after
 // it, the footer from the drive's report, written by a record::Writer (its own thread, gzip
-// when the name ends in ".gz"). With timing off every time field is 0, so the same seed gives
-// byte-identical files.
+// when the name ends in ".gz") as an observer of the episode (episode_observer.h). With timing
+// off every time field is 0, so the same seed gives byte-identical files.
 //
 // The path sent (path.x/y) keeps 0.1 mm. Tracing the candidates costs the planner ~13% of its
 // time; with TraceByReplay a replica of the planner traces them on the writer's thread instead
@@ -22,33 +22,51 @@
 #include <string_view>
 #include <vector>
 
+#include "frenetic/drive/drive_report.h"
+#include "frenetic/drive/episode_observer.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/record/replica.h"
 #include "frenetic/record/writer.h"
-#include "frenetic/sim/drive_report.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 
 namespace frenetic::sim {
 
-class RecordWriter {
+class RecordWriter final : public EpisodeObserver {
  public:
   // Opens (truncates) the file, gzip-compressed when `path` ends in ".gz"; an error names it.
   static StatusOr<std::unique_ptr<RecordWriter>> Open(const std::string& path);
   // Writes what is queued, ends the stream and closes the file.
-  ~RecordWriter();
+  ~RecordWriter() override;
   RecordWriter(const RecordWriter&) = delete;
   RecordWriter& operator=(const RecordWriter&) = delete;
 
   // Candidates (and the candidate counts) are traced by `replica`, a planner made as the one
   // that drives (record::Replica): the driving planner then needs no trace
   // (sim::RunOptions::trace_candidates = 0) and only its timings are written. Call before
-  // WriteHeader.
+  // attaching.
   void TraceByReplay(std::unique_ptr<plan::Planner> replica, int max_candidates);
-  // `config` is the planner configuration (JSON object, or its text as a string).
-  // `connect_url` (the planner server of a drive over the network) is written when not empty.
+  // What the header names: the planner, its configuration (JSON object, or its text as a
+  // string) and `connect_url`, the planner server of a drive over the network (written when not
+  // empty). Call before attaching.
+  void set_planner(std::string name, nlohmann::json config, std::string connect_url = {});
+  // Waits until everything queued is in the file; Ok unless a write failed (the message names
+  // the file and why).
+  Status status() { return writer_->status(); }
+  void set_timing(bool timing) { timing_ = timing; }
+
+  // As an observer (Episode::Attach): the header at the start, a line per exchange (the
+  // in-process kind when the reply has a plan, else the remote kind), the footer from the report
+  // at the end (attach it after the observers that add to the report); OnEnd returns status().
+  void OnStart(const Episode& episode) override;
+  void OnExchange(const Episode& episode, const Exchange& exchange) override;
+  Status OnEnd(const Episode& episode, DriveReport* report) override;
+
+ private:
+  explicit RecordWriter(std::unique_ptr<record::Writer> writer);
+
   void WriteHeader(const Simulator& sim, const std::string& planner_name,
-                   const nlohmann::json& config, std::string_view connect_url = {});
+                   const nlohmann::json& config, std::string_view connect_url);
   // One exchange: the telemetry sent, the reply and how it was made, the metrics after it and
   // the incidents that started since the previous exchange (log indices [first, end)).
   // `telemetry_json` is wire::TelemetryToJson of the telemetry sent at simulated time t;
@@ -65,18 +83,14 @@ class RecordWriter {
                            std::size_t first_incident, int l_old, int l_new);
   // The last line: the stream is ended after it (later writes are ignored).
   void WriteFooter(const DriveReport& report);
-  // Waits until everything queued is in the file; Ok unless a write failed (the message names
-  // the file and why).
-  Status status() { return writer_->status(); }
-  void set_timing(bool timing) { timing_ = timing; }
-
- private:
-  explicit RecordWriter(std::unique_ptr<record::Writer> writer);
 
   std::unique_ptr<record::Writer> writer_;
   // Used on the writer's thread only, by the exchange lines (null: the planner traces).
   std::shared_ptr<record::Replica> replica_;
   bool timing_ = true;
+  std::string planner_name_, connect_url_;
+  nlohmann::json planner_config_;
+  std::string telemetry_json_;  // wire::TelemetryToJson of the telemetry being answered
 };
 
 }  // namespace frenetic::sim

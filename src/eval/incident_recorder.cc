@@ -1,4 +1,4 @@
-#include "frenetic/sim/incident_recorder.h"
+#include "frenetic/eval/incident_recorder.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,8 @@
 // One drive: the exchange loop with the latency rules of udacity-sim.md §2, one exchange at a
 // time (telemetry out, path in), so that an in-process planner and a network client run the
 // same loop and get the same outcome; RunEpisode / RunEpisodes drive a plan::Planner through it.
+// The record writer, the incident judge and the oracle look on as observers
+// (episode_observer.h); RunOptions / EpisodesOptions turn them on.
 #pragma once
 
 #include <cstdint>
@@ -15,10 +17,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/drive/drive_report.h"
+#include "frenetic/drive/episode_observer.h"
+#include "frenetic/eval/incident_judge.h"
+#include "frenetic/eval/oracle.h"
 #include "frenetic/plan/planner.h"
-#include "frenetic/sim/drive_report.h"
-#include "frenetic/sim/incident_judge.h"
-#include "frenetic/sim/oracle.h"
 #include "frenetic/sim/simulator.h"
 #include "frenetic/status.h"
 
@@ -35,28 +38,28 @@ struct EpisodeLimits {
   Status Validate() const;
 };
 
-class RecordWriter;      // sim/record.h
-class IncidentRecorder;  // sim/incident_recorder.h
+class RecordWriter;  // drive/record.h
 
 class Episode {
  public:
   Episode(std::unique_ptr<Simulator> sim, const EpisodeLimits& limits);
   ~Episode();
 
-  // From now on keeps the traffic's history and judges every incident (incident_judge.h) once
-  // its margin is driven, or when the drive ends. It never changes the drive. timing false:
-  // judging times are reported as 0.
-  void EnableJudging(const JudgeOptions& options, bool timing);
-  // One per incident judged so far (all of them once done()), in the log's order; nullptr when
-  // judging is off.
-  const std::vector<IncidentJudgement>* judgements() const;
+  // Attaches `observer` (not owned; it must outlive the episode) and calls its OnStart. Attach
+  // before the first Submit; observers are called in the order attached.
+  void Attach(EpisodeObserver* observer);
 
   // The telemetry to send now (valid until Submit).
   const plan::Telemetry& telemetry() const { return telemetry_; }
   // The reply to telemetry(): l_old ticks on the old path, the new path applied, l_new ticks,
   // new telemetry. A rejected path (non-finite, unequal lengths) is reported and skipped, as
-  // the simulator would ignore it, and the ticks still run.
-  Status Submit(std::span<const double> x, std::span<const double> y);
+  // the simulator would ignore it, and the ticks still run. `reply` tells the observers how the
+  // path was made (EpisodeObserver::OnExchange).
+  Status Submit(std::span<const double> x, std::span<const double> y,
+                const ExchangeReply& reply = {});
+  // The drive is over (or given up): every observer's OnEnd in turn adds to `report` (MakeReport's)
+  // and may fail; all are called, the first failure is returned.
+  Status Finish(DriveReport* report);
 
   bool done() const { return !stop_reason_.empty(); }
   const std::string& stop_reason() const { return stop_reason_; }  // "distance", "time", "stall"
@@ -79,15 +82,18 @@ class Episode {
   std::string stop_reason_;
   int exchanges_ = 0, last_l_old_ = 0, last_l_new_ = 0;
   double stall_ref_distance_ = 0, stall_ref_time_ = 0;
-  std::unique_ptr<IncidentRecorder> recorder_;
+  std::vector<EpisodeObserver*> observers_;
+  std::vector<EpisodeObserver*> tick_observers_;  // those that want every tick
 };
 
 // The report of an episode driven so far; `plan_ms` are the per-exchange planning (or round-trip)
-// times and `fallbacks` the exchanges whose plan status was not ok. With judging on, the
-// incidents' judgements so far.
+// times and `fallbacks` the exchanges whose plan status was not ok. What the observers add comes
+// from Episode::Finish.
 DriveReport MakeReport(const Episode& episode, std::string_view planner,
                        const std::vector<double>& plan_ms, int fallbacks);
 
+// What looks on at RunEpisode's drive, attached in this order (so the record's footer has the
+// judgements and the oracle): judge, oracle, record, progress.
 struct RunOptions {
   RecordWriter* record = nullptr;  // one line per exchange when set
   bool timing = true;   // false: planning times are recorded and reported as 0 (byte-stable)
@@ -95,10 +101,10 @@ struct RunOptions {
   nlohmann::json planner_config;  // written into the record's header (object or text)
   // Called after every exchange (e.g. a progress line); may be empty.
   std::function<void(const Episode&)> progress;
-  // Judge every incident (Episode::EnableJudging); unset: off.
+  // Judge every incident (JudgeObserver, evaluators.h); unset: off.
   std::optional<JudgeOptions> judge;
   // After the drive, search how far any planner could have driven against its traffic
-  // (oracle.h; DriveReport::oracle); unset: off. It never changes the drive.
+  // (OracleObserver, evaluators.h; DriveReport::oracle); unset: off. It never changes the drive.
   std::optional<OracleOptions> oracle;
 };
 
