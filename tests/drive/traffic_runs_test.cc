@@ -11,44 +11,15 @@
 #include <string>
 #include <vector>
 
+#include "common/real_recordings.h"
 #include "frenetic/eval/fidelity.h"
 #include "frenetic/sim/world.h"
 
 namespace frenetic::sim {
 namespace {
 
-const std::string kShared = FRENETIC_SHARED_DIR;
-const std::string kRecordings = kShared + "/realdata/telemetry";
-const std::string kMap = kShared + "/data/highway_map.csv";
-
 // The real recordings and the Udacity world, loaded once for all tests.
-class TrafficRuns : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    if (!std::filesystem::exists(kRecordings) || !std::filesystem::exists(kMap)) return;
-    auto recs = LoadRecordings(kRecordings);
-    auto world = LoadWorld(kMap);
-    if (!recs.ok() || !world.ok()) return;
-    recordings_ = new std::vector<Recording>(std::move(*recs));
-    world_ = new std::shared_ptr<const World>(*world);
-  }
-  static void TearDownTestSuite() {
-    delete recordings_;
-    delete world_;
-    recordings_ = nullptr;
-    world_ = nullptr;
-  }
-  void SetUp() override {
-    if (recordings_ == nullptr) {
-      GTEST_SKIP() << "real recordings or map not found under " << kShared
-                   << " (realdata/telemetry, data/highway_map.csv)";
-    }
-  }
-  static std::vector<Recording>* recordings_;
-  static std::shared_ptr<const World>* world_;
-};
-std::vector<Recording>* TrafficRuns::recordings_ = nullptr;
-std::shared_ptr<const World>* TrafficRuns::world_ = nullptr;
+using TrafficRuns = testing::RealRecordingsTest;
 
 TEST_F(TrafficRuns, SimulatedTrafficIsDeterministicAcrossThreads) {
   TrafficRunOptions options;

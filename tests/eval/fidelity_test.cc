@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/real_recordings.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/ego.h"
 #include "frenetic/sim/world.h"
@@ -21,9 +22,9 @@
 namespace frenetic::sim {
 namespace {
 
-const std::string kShared = FRENETIC_SHARED_DIR;
-const std::string kRecordings = kShared + "/realdata/telemetry";
-const std::string kMap = kShared + "/data/highway_map.csv";
+using testing::kMap;
+using testing::kRecordings;
+using testing::kShared;
 
 const CheckRow* Row(const CheckReport& report, const std::string& prefix) {
   for (const CheckRow& r : report.rows) {
@@ -33,28 +34,8 @@ const CheckRow* Row(const CheckReport& report, const std::string& prefix) {
 }
 
 // The real recordings and the Udacity world, loaded once for all tests.
-class RealData : public ::testing::Test {
+class RealData : public testing::RealRecordingsTest {
  protected:
-  static void SetUpTestSuite() {
-    if (!std::filesystem::exists(kRecordings) || !std::filesystem::exists(kMap)) return;
-    auto recs = LoadRecordings(kRecordings);
-    auto world = LoadWorld(kMap);
-    if (!recs.ok() || !world.ok()) return;
-    recordings_ = new std::vector<Recording>(std::move(*recs));
-    world_ = new std::shared_ptr<const World>(*world);
-  }
-  static void TearDownTestSuite() {
-    delete recordings_;
-    delete world_;
-    recordings_ = nullptr;
-    world_ = nullptr;
-  }
-  void SetUp() override {
-    if (recordings_ == nullptr) {
-      GTEST_SKIP() << "real recordings or map not found under " << kShared
-                   << " (realdata/telemetry, data/highway_map.csv)";
-    }
-  }
   // The first `n` messages (and replies) of every recording.
   static std::vector<Recording> Head(std::size_t n) {
     std::vector<Recording> out = *recordings_;
@@ -64,11 +45,7 @@ class RealData : public ::testing::Test {
     }
     return out;
   }
-  static std::vector<Recording>* recordings_;
-  static std::shared_ptr<const World>* world_;
 };
-std::vector<Recording>* RealData::recordings_ = nullptr;
-std::shared_ptr<const World>* RealData::world_ = nullptr;
 
 // --- Printing equality -----------------------------------------------------------------------
 
