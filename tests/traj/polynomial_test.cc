@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <utility>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -142,6 +143,25 @@ TEST(TrajectoryTest, APassGoesOutHoldsThereAndComesBack) {
   EXPECT_EQ(out.end_time(), 2.0);
   EXPECT_NEAR(out.At(9.0).p, -3.5, 1e-9);
   EXPECT_EQ(out.JerkSquared(), out.poly.JerkSquaredIntegral(2.0));
+}
+
+TEST(TrajectoryTest, LocateNamesEachPieceInTimeOrder) {
+  using P = Trajectory1d::Piece;
+  Trajectory1d pass = Pass();
+  pass.delay = 0.5;  // held 0.5 s, out until 2.5, held there until 3.5, back until 5.0
+  const std::pair<double, P> at[] = {{0.2, P::kHold},      {1.0, P::kPoly},  {3.0, P::kAfterPoly},
+                                     {4.0, P::kBack},      {6.0, P::kAfterBack}};
+  const double since[] = {0.0, 0.5, 0.5, 0.5, 1.0};  // s since the piece's start
+  for (int i = 0; i < 5; ++i) {
+    double u = -1;
+    EXPECT_EQ(pass.Locate(at[i].first, &u), at[i].second) << at[i].first;
+    EXPECT_NEAR(u, since[i], 1e-12) << at[i].first;
+  }
+  // Without a second move the continuation lasts for ever.
+  pass.back_duration = 0;
+  double u = -1;
+  EXPECT_EQ(pass.Locate(6.0, &u), P::kAfterPoly);
+  EXPECT_NEAR(u, 3.5, 1e-12);
 }
 
 TEST(TrajectoryTest, SampleGivesAtsValuesExactly) {

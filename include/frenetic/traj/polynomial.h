@@ -57,56 +57,88 @@ struct Trajectory1d {
     return back_duration > 0 ? j + back.JerkSquaredIntegral(back_duration) : j;
   }
   bool IsFinite() const { return poly.IsFinite() && (back_duration <= 0 || back.IsFinite()); }
-  State1d At(double t) const {
-    if (t < delay) return {poly.c[0], 0.0, 0.0, 0.0};
+
+  // The pieces of the motion, in time order: held at poly's start (the delay), on poly, the
+  // continuation after it, then with a second move on back and the continuation after it.
+  enum class Piece { kHold, kPoly, kAfterPoly, kBack, kAfterBack };
+  // The piece time t (s) falls on, and *u the time since that piece's start (s; 0 on kHold).
+  // At and Sample both evaluate from it.
+  Piece Locate(double t, double* u) const {
+    *u = 0;
+    if (t < delay) return Piece::kHold;
     t -= delay;
-    if (t <= duration) return poly.At(t);
+    if (t <= duration) {
+      *u = t;
+      return Piece::kPoly;
+    }
     if (back_duration > 0 && t > duration + hold) {
-      const double u = t - duration - hold;
-      if (u <= back_duration) return back.At(u);
-      const State1d b = back.At(back_duration);
-      return {b.p + b.v * (u - back_duration), b.v, 0.0, 0.0};
+      const double b = t - duration - hold;
+      if (b <= back_duration) {
+        *u = b;
+        return Piece::kBack;
+      }
+      *u = b - back_duration;
+      return Piece::kAfterBack;
+    }
+    *u = t - duration;
+    return Piece::kAfterPoly;
+  }
+
+  State1d At(double t) const {
+    double u = 0;
+    switch (Locate(t, &u)) {
+      case Piece::kHold:
+        return {poly.c[0], 0.0, 0.0, 0.0};
+      case Piece::kPoly:
+        return poly.At(u);
+      case Piece::kBack:
+        return back.At(u);
+      case Piece::kAfterBack: {
+        const State1d b = back.At(back_duration);
+        return {b.p + b.v * u, b.v, 0.0, 0.0};
+      }
+      case Piece::kAfterPoly:
+        break;
     }
     const State1d e = poly.At(duration);
-    return {e.p + e.v * (t - duration), e.v, 0.0, 0.0};
+    return {e.p + e.v * u, e.v, 0.0, 0.0};
   }
   // At(time(k)).p, .v and .a in p[k], v[k] and a[k] (a may be null) for k in [k0, k1): the
-  // same values (the same expressions), with the continuation's start, the polynomial's end
-  // state, evaluated once instead of at every sample past it, and no jerk.
+  // same values (the same expressions), with the continuations' starts, the moves' end states,
+  // evaluated once instead of at every sample past them, and no jerk.
   template <typename Time>
   void Sample(int k0, int k1, Time time, double* p, double* v, double* a) const {
     const double end_p = poly.P(duration), end_v = poly.V(duration);
     const double back_p = back_duration > 0 ? back.P(back_duration) : 0.0;
     const double back_v = back_duration > 0 ? back.V(back_duration) : 0.0;
     for (int k = k0; k < k1; ++k) {
-      double t = time(k);
-      if (t < delay) {
-        p[k] = poly.c[0];
-        v[k] = 0.0;
-        if (a != nullptr) a[k] = 0.0;
-        continue;
+      double u = 0, pk = 0, vk = 0, ak = 0;
+      switch (Locate(time(k), &u)) {
+        case Piece::kHold:
+          pk = poly.c[0];
+          break;
+        case Piece::kPoly:
+          pk = poly.P(u);
+          vk = poly.V(u);
+          ak = a != nullptr ? poly.A(u) : 0.0;
+          break;
+        case Piece::kBack:
+          pk = back.P(u);
+          vk = back.V(u);
+          ak = a != nullptr ? back.A(u) : 0.0;
+          break;
+        case Piece::kAfterBack:
+          pk = back_p + back_v * u;
+          vk = back_v;
+          break;
+        case Piece::kAfterPoly:
+          pk = end_p + end_v * u;
+          vk = end_v;
+          break;
       }
-      t -= delay;
-      if (t <= duration) {
-        p[k] = poly.P(t);
-        v[k] = poly.V(t);
-        if (a != nullptr) a[k] = poly.A(t);
-      } else if (back_duration > 0 && t > duration + hold) {
-        const double u = t - duration - hold;
-        if (u <= back_duration) {
-          p[k] = back.P(u);
-          v[k] = back.V(u);
-          if (a != nullptr) a[k] = back.A(u);
-        } else {
-          p[k] = back_p + back_v * (u - back_duration);
-          v[k] = back_v;
-          if (a != nullptr) a[k] = 0.0;
-        }
-      } else {
-        p[k] = end_p + end_v * (t - duration);
-        v[k] = end_v;
-        if (a != nullptr) a[k] = 0.0;
-      }
+      p[k] = pk;
+      v[k] = vk;
+      if (a != nullptr) a[k] = ak;
     }
   }
 };
