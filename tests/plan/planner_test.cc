@@ -1,6 +1,5 @@
-// Planners on the Udacity map in a small closed loop written here (the simulator's path-trimming
-// rule, 1-3 points consumed per cycle, traffic at constant velocity), plus fuzzing and the
-// no-allocation property of the search planner.
+// Planners on the Udacity map in a small closed loop (closed_loop_testing.h), plus the search
+// planner's deadlines, plan reuse and no-allocation property.
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -24,6 +23,7 @@
 #include "frenetic/units.h"
 #include "plan/search/planner.h"
 #include "plan/search/stages_testing.h"
+#include "plan/closed_loop_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../common/malloc_counter.h"
 
@@ -32,157 +32,13 @@
 namespace frenetic::plan {
 namespace {
 
-std::shared_ptr<const map::ReferenceLine> UdacityLine() { return search::testing::UdacityLine(); }
-
-#define REQUIRE_MAP(line)                                                                \
-  auto line = UdacityLine();                                                             \
-  if (line == nullptr) {                                                                 \
-    GTEST_SKIP() << "Udacity map not found at " FRENETIC_SHARED_DIR "/data/highway_map.csv"; \
-  }
-
-PlannerConfig Config() {
-  auto c = PlannerConfig::LoadDefault();
-  EXPECT_TRUE(c.ok()) << c.message();
-  return c.ok() ? *c : PlannerConfig::Defaults();
-}
-
-struct Car {
-  int id;
-  double s, d, v;
-};
-
-// A minimal closed loop: the simulator's control handling (§4.2) and one point per tick.
-class Loop {
- public:
-  Loop(std::shared_ptr<const map::ReferenceLine> line, Planner* planner, double s0, double d0,
-       double v0, std::uint32_t seed)
-      : line_(std::move(line)), planner_(planner), rng_(seed) {
-    const map::CartesianPose p = line_->ToCartesian(s0, d0);
-    x_ = p.x;
-    y_ = p.y;
-    yaw_ = p.heading;
-    speed_ = v0;
-    driven_x_.push_back(x_);
-    driven_y_.push_back(y_);
-  }
-
-  std::vector<Car> cars;
-  std::vector<double> driven_x_, driven_y_;
-  double min_same_lane_gap = 1e9;  // centre to centre along s, cars ahead in the ego's lane
-  bool collided = false;
-  int fallbacks = 0;
-  PlanStatus last_status = PlanStatus::kOk;
-
-  Telemetry Make() const {
-    Telemetry t;
-    t.x = x_;
-    t.y = y_;
-    t.yaw = yaw_;
-    t.speed = speed_;
-    const map::FrenetPoint f = line_->ToFrenet(x_, y_);
-    t.s = f.s;
-    t.d = f.d;
-    for (size_t i = 0; i < path_x_.size(); ++i) {
-      t.previous_path_x.push_back(static_cast<float>(path_x_[i]));
-      t.previous_path_y.push_back(static_cast<float>(path_y_[i]));
-    }
-    for (const Car& c : cars) {
-      const map::CartesianPose p = line_->ToCartesian(c.s, c.d);
-      t.sensor_fusion.push_back({c.id, p.x, p.y, c.v * std::cos(p.heading),
-                                 c.v * std::sin(p.heading), line_->WrapS(c.s), c.d});
-    }
-    return t;
-  }
-
-  // One exchange: plan, apply with the trimming rule, then advance 1-3 ticks.
-  void Cycle() {
-    const Telemetry t = Make();
-    const PlanResult& r = planner_->Plan(t);
-    last_status = r.status;
-    if (r.status == PlanStatus::kFallbackUsed) ++fallbacks;
-    ASSERT_GE(r.x.size(), static_cast<size_t>(kMinPathPoints));
-    int k = 0;
-    double best = 10000;
-    for (size_t i = 0; i < r.x.size(); ++i) {
-      const double dd = std::hypot(r.x[i] - x_, r.y[i] - y_);
-      if (dd < best) {
-        best = dd;
-        k = static_cast<int>(i);
-      }
-    }
-    const int drop = k > 0 ? k + 1 : (best == 0 ? 1 : 0);
-    path_x_.assign(r.x.begin() + drop, r.x.end());
-    path_y_.assign(r.y.begin() + drop, r.y.end());
-    const int ticks = 1 + static_cast<int>(rng_() % 3);
-    for (int i = 0; i < ticks; ++i) Tick();
-  }
-
-  void Tick() {
-    for (Car& c : cars) c.s += c.v * kTickSeconds;
-    if (path_x_.size() >= 2) {
-      const double nx = path_x_[0], ny = path_y_[0];
-      speed_ = std::hypot(nx - x_, ny - y_) / kTickSeconds;
-      x_ = nx;
-      y_ = ny;
-      yaw_ = std::atan2(path_y_[1] - ny, path_x_[1] - nx);
-    } else {
-      speed_ = 0;
-    }
-    if (!path_x_.empty()) {
-      path_x_.erase(path_x_.begin());
-      path_y_.erase(path_y_.begin());
-    }
-    driven_x_.push_back(x_);
-    driven_y_.push_back(y_);
-    const map::FrenetPoint e = line_->ToFrenet(x_, y_, ego_s_hint_);
-    ego_s_hint_ = e.s;
-    ego_d_.push_back(e.d);
-    for (const Car& c : cars) {
-      const double ds = line_->DiffS(line_->WrapS(c.s), e.s);
-      if (std::abs(c.d - e.d) < 2.0 && ds > 0) min_same_lane_gap = std::min(min_same_lane_gap, ds);
-      if (std::abs(ds) < 4.5 && std::abs(c.d - e.d) < 2.2) collided = true;
-    }
-  }
-
-  double speed() const { return speed_; }
-  double s() const { return ego_s_hint_; }
-  double d() const { return ego_d_.empty() ? 0 : ego_d_.back(); }
-  const std::vector<double>& ego_d() const { return ego_d_; }
-
- private:
-  std::shared_ptr<const map::ReferenceLine> line_;
-  Planner* planner_;
-  std::mt19937 rng_;
-  double x_, y_, yaw_, speed_;
-  double ego_s_hint_ = 0;
-  std::vector<double> path_x_, path_y_, ego_d_;
-};
-
-// Closed-loop tests count ticks, not wall time: the wall-clock deadlines are switched off, so
-// a loaded machine cannot cut a cycle and change the drive.
-std::unique_ptr<Planner> Make(const std::string& name,
-                              std::shared_ptr<const map::ReferenceLine> line) {
-  PlannerConfig config = Config();
-  config.PinDeadlines();
-  auto p = MakePlanner(name, config, std::move(line));
-  EXPECT_TRUE(p.ok()) << p.message();
-  return p.ok() ? std::move(p.value()) : nullptr;
-}
-
-// Runs the loop for `seconds` of simulated time (cycles are 1-3 ticks).
-void RunFor(Loop& loop, double seconds) {
-  const size_t target = loop.driven_x_.size() + static_cast<size_t>(seconds / kTickSeconds);
-  while (loop.driven_x_.size() < target) {
-    loop.Cycle();
-    if (testing::Test::HasFatalFailure()) return;
-  }
-}
-
-XyMeasure WorstSlidingMeasure(const Loop& loop, int from) {
-  XyChecker checker(static_cast<int>(loop.driven_x_.size()) + 8);
-  return checker.Measure(loop.driven_x_.data(), loop.driven_y_.data(),
-                         static_cast<int>(loop.driven_x_.size()), from);
-}
+using closed_loop::Car;
+using closed_loop::Config;
+using closed_loop::Loop;
+using closed_loop::Make;
+using closed_loop::RunFor;
+using closed_loop::UdacityLine;
+using closed_loop::WorstSlidingMeasure;
 
 TEST(PlannerFactoryTest, NamesAndErrors) {
   EXPECT_EQ(PlannerNames(), (std::vector<std::string>{"search", "baseline"}));
@@ -568,107 +424,6 @@ TEST(SearchPlannerTest, ReusesThePlanBetweenSearchesAndReplansOnANewCar) {
       EXPECT_GT(generated[min_ticks], 0) << "replan_min_ticks points driven: search again";
     }
   }
-}
-
-// Corrupts a plausible telemetry in one of many ways.
-Telemetry Corrupt(Telemetry t, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(0, 1);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const double inf = std::numeric_limits<double>::infinity();
-  const double wild[] = {nan, inf, -inf, 1e300, -1e300, 0, 1e7, -5};
-  auto pick = [&] { return wild[rng() % 8]; };
-  const int kind = static_cast<int>(rng() % 12);
-  switch (kind) {
-    case 0: t.x = pick(); break;
-    case 1: t.y = pick(); t.yaw = pick(); break;
-    case 2: t.speed = pick(); break;
-    case 3: t.previous_path_x.clear(); t.previous_path_y.clear(); break;
-    case 4: if (!t.previous_path_x.empty()) t.previous_path_x.pop_back(); break;
-    case 5:
-      for (auto& v : t.previous_path_x) v += 50 * (u(rng) - 0.5);
-      break;
-    case 6:
-      if (!t.previous_path_y.empty()) t.previous_path_y[rng() % t.previous_path_y.size()] = pick();
-      break;
-    case 7: t.sensor_fusion.clear(); break;
-    case 8:
-      for (auto& c : t.sensor_fusion) {
-        c.x = u(rng) < 0.3 ? pick() : c.x;
-        c.vx = u(rng) < 0.3 ? pick() : c.vx;
-        c.s = 0;
-        c.d = 0;
-      }
-      break;
-    case 9:
-      for (int i = 0; i < 40; ++i) {
-        t.sensor_fusion.push_back({static_cast<int>(rng() % 5), t.x + 100 * (u(rng) - 0.5),
-                                   t.y + 100 * (u(rng) - 0.5), 60 * u(rng), 60 * u(rng), 0, 0});
-      }
-      break;
-    case 10:
-      t.previous_path_x.assign(rng() % 300, u(rng) * 3000);
-      t.previous_path_y.assign(t.previous_path_x.size(), u(rng) * 3000);
-      break;
-    default:
-      t.x += 200 * (u(rng) - 0.5);
-      t.y += 200 * (u(rng) - 0.5);
-      break;
-  }
-  return t;
-}
-
-class FuzzTest : public testing::TestWithParam<std::string> {};
-
-TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
-  REQUIRE_MAP(line);
-  // Robustness does not need the full lattice: a small grid and a short refinement keep the
-  // 10,000 cycles within a few seconds (the defaults are exercised by the scenario tests).
-  PlannerConfig config = Config();
-  for (const auto& [key, value] : {std::pair<const char*, double>{"grid.speeds", 8},
-                                   {"grid.durations", 4},
-                                   {"grid.follow_gaps", 1},
-                                   {"grid.lat_durations", 1},
-                                   {"refine.max_iterations", 4}}) {
-    ASSERT_TRUE(config.Set(key, value).ok()) << key;
-  }
-  auto made = MakePlanner(GetParam(), config, line);
-  ASSERT_TRUE(made.ok()) << made.message();
-  std::unique_ptr<Planner> planner = std::move(made).value();
-  std::mt19937 rng(2024);
-  Loop loop(line, planner.get(), 3000, 6.0, 18.0, 8);
-  loop.cars.push_back({0, 3040, 6.0, 12.0});
-  loop.cars.push_back({1, 3020, 2.0, 22.0});
-  int invalid = 0;
-  for (int i = 0; i < 10000; ++i) {
-    if (i % 50 == 0) loop.Cycle();  // keep a live state now and then
-    ASSERT_FALSE(HasFatalFailure());
-    const Telemetry t = Corrupt(loop.Make(), rng);
-    const PlanResult* r = nullptr;
-    ASSERT_NO_THROW(r = &planner->Plan(t)) << "case " << i;
-    ASSERT_GE(r->x.size(), static_cast<size_t>(kMinPathPoints)) << "case " << i;
-    ASSERT_EQ(r->x.size(), r->y.size());
-    for (size_t k = 0; k < r->x.size(); ++k) {
-      ASSERT_TRUE(std::isfinite(r->x[k]) && std::isfinite(r->y[k])) << "case " << i;
-    }
-    invalid += r->status == PlanStatus::kInvalidInput;
-  }
-  EXPECT_GT(invalid, 0);
-}
-
-INSTANTIATE_TEST_SUITE_P(BothPlanners, FuzzTest, testing::Values("search", "baseline"));
-
-TEST(BaselinePlannerTest, DrivesAndOvertakesLikeTheWalkthrough) {
-  REQUIRE_MAP(line);
-  auto planner = Make("baseline", line);
-  Loop loop(line, planner.get(), 124.83, 6.0, 0.0, 9);
-  RunFor(loop, 25.0);
-  EXPECT_GT(loop.speed(), 45 * units::kMphToMps);
-  EXPECT_LT(WorstSlidingMeasure(loop, 0).max_speed, 50 * units::kMphToMps);
-  loop.cars.push_back({0, loop.s() + 40, 6.0, 12.0});
-  RunFor(loop, 15.0);
-  EXPECT_FALSE(loop.collided);
-  const double d = loop.d();
-  EXPECT_TRUE(d < 4.0 || d > 8.0) << "baseline did not overtake, d = " << d;
 }
 
 }  // namespace
