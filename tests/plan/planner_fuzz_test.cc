@@ -17,12 +17,10 @@
 namespace frenetic::plan {
 namespace {
 
-using closed_loop::Car;
 using closed_loop::Config;
 using closed_loop::Loop;
 using closed_loop::Make;
 using closed_loop::RunFor;
-using closed_loop::UdacityLine;
 using closed_loop::WorstSlidingMeasure;
 
 // Corrupts a plausible telemetry in one of many ways.
