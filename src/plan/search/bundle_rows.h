@@ -13,22 +13,20 @@
 namespace frenetic::plan::search {
 
 struct BundleRows {
-  // `slots` rows of `width` samples (index 0 unused: samples [1, width)), with the second
-  // derivative too when `with_a`.
-  void Resize(std::size_t slots, int width, bool with_a) {
+  // `slots` rows of `width` samples (index 0 unused: samples [1, width)).
+  void Resize(std::size_t slots, int width) {
     w = width;
     key.resize(slots);
     have.assign(slots, 0);
     p.assign(slots * w, 0.0);
     v.assign(slots * w, 0.0);
-    a.assign(with_a ? slots * w : 0, 0.0);
   }
-  // Row i holds `tr` at time_of(j) for j in [1, w) (value, first and, when kept, second
-  // derivative); true when sampled anew, false when it already held it.
+  // Row i holds `tr` at time_of(j) for j in [1, w) (value and first derivative); true when
+  // sampled anew, false when it already held it.
   template <typename TimeOf>
   bool Sample(const traj::Trajectory1d& tr, int i, TimeOf time_of) {
     if (have[i] && std::memcmp(&key[i], &tr, sizeof(tr)) == 0) return false;
-    tr.Sample(1, w, time_of, &p[i * w], &v[i * w], a.empty() ? nullptr : &a[i * w]);
+    tr.Sample(1, w, time_of, &p[i * w], &v[i * w], nullptr);
     std::memcpy(&key[i], &tr, sizeof(tr));
     have[i] = 1;
     return true;
@@ -37,7 +35,7 @@ struct BundleRows {
   int w = 0;                           // samples per row
   std::vector<traj::Trajectory1d> key;  // the trajectory each row holds
   std::vector<char> have;              // whether it holds one
-  std::vector<double> p, v, a;         // [slot * w + j]
+  std::vector<double> p, v;            // [slot * w + j]
 };
 
 }  // namespace frenetic::plan::search

@@ -86,8 +86,8 @@ void NarrowMasks(const double* x, const double* reach, const double* cars, const
 CollisionChecker::CollisionChecker(const Settings& cfg, Workspace& ws) : cfg_(cfg), ws_(ws) {
   const std::size_t n_lon = ws_.lon.capacity(), n_lat = ws_.lat.capacity();
   const std::size_t w = ws_.n_steps + 1;
-  lon_steps_.Resize(n_lon, static_cast<int>(w), false);
-  lat_steps_.Resize(n_lat, static_cast<int>(w), false);
+  lon_steps_.Resize(n_lon, static_cast<int>(w));
+  lat_steps_.Resize(n_lat, static_cast<int>(w));
   lon_near_.assign(n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
   reach_.assign(w, 0.0);

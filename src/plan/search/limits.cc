@@ -18,8 +18,8 @@ LimitChecker::LimitChecker(const Settings& cfg, const map::ReferenceLine& line, 
   chk_y_.assign(path_cap, 0.0);
   const std::size_t n_lon = ws_.lon.capacity(), n_lat = ws_.lat.capacity();
   verdicts_.resize(ws_.order.capacity());
-  lon_ticks_.Resize(n_lon, ws_.n_ticks + 1, true);
-  lat_ticks_.Resize(n_lat, ws_.n_ticks + 1, true);
+  lon_ticks_.Resize(n_lon, ws_.n_ticks + 1);
+  lat_ticks_.Resize(n_lat, ws_.n_ticks + 1);
   lon_centre_.resize(n_lon * (ws_.n_ticks + 1));
   lon_centre_have_.assign(n_lon, 0);
 }
