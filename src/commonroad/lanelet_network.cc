@@ -19,9 +19,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 void Network::InferNeighbours() {
-  constexpr double kSharedBound = 0.5;    // m
-  constexpr double kSampleSpacing = 2.0;  // m
-  constexpr double kSharedLength = 10.0;  // m of the bounds within kSharedBound of each other
+  constexpr double kSharedBound = 0.5;     // m
+  constexpr double kSampleSpacing = 2.0;   // m
+  constexpr double kSharedLength = 10.0;   // m of the bounds within kSharedBound of each other
   constexpr double kSameDirection = 0.35;  // rad
   const int n = size();
   inferred_left_.assign(n, -1);
@@ -148,7 +148,8 @@ std::vector<int> RouteTo(const Network& net, int start, const std::set<int>& goa
 double ChainLength(const Network& net, int i, double budget, std::set<int>& on_path) {
   if (budget <= 0 || !on_path.insert(i).second) return 0;
   double best = 0;
-  for (int j : net.Successors(i)) best = std::max(best, ChainLength(net, j, budget - net.length(i), on_path));
+  for (int j : net.Successors(i))
+    best = std::max(best, ChainLength(net, j, budget - net.length(i), on_path));
   on_path.erase(i);
   return net.length(i) + best;
 }

@@ -21,11 +21,13 @@
 
 namespace frenetic::plan::closed_loop {
 
-inline std::shared_ptr<const map::ReferenceLine> UdacityLine() { return search::testing::UdacityLine(); }
+inline std::shared_ptr<const map::ReferenceLine> UdacityLine() {
+  return search::testing::UdacityLine();
+}
 
-#define REQUIRE_MAP(line)                                                                     \
-  auto line = ::frenetic::plan::closed_loop::UdacityLine();                                   \
-  if (line == nullptr) {                                                                      \
+#define REQUIRE_MAP(line)                                                                    \
+  auto line = ::frenetic::plan::closed_loop::UdacityLine();                                  \
+  if (line == nullptr) {                                                                     \
     GTEST_SKIP() << "Udacity map not found at " FRENETIC_SHARED_DIR "/data/highway_map.csv"; \
   }
 
@@ -150,7 +152,7 @@ class Loop {
 // Closed-loop tests count ticks, not wall time: the wall-clock deadlines are switched off, so
 // a loaded machine cannot cut a cycle and change the drive.
 inline std::unique_ptr<Planner> Make(const std::string& name,
-                              std::shared_ptr<const map::ReferenceLine> line) {
+                                     std::shared_ptr<const map::ReferenceLine> line) {
   PlannerConfig config = Config();
   config.PinDeadlines();
   auto p = MakePlanner(name, config, std::move(line));

@@ -32,18 +32,32 @@ Telemetry Corrupt(Telemetry t, std::mt19937& rng) {
   auto pick = [&] { return wild[rng() % 8]; };
   const int kind = static_cast<int>(rng() % 12);
   switch (kind) {
-    case 0: t.x = pick(); break;
-    case 1: t.y = pick(); t.yaw = pick(); break;
-    case 2: t.speed = pick(); break;
-    case 3: t.previous_path_x.clear(); t.previous_path_y.clear(); break;
-    case 4: if (!t.previous_path_x.empty()) t.previous_path_x.pop_back(); break;
+    case 0:
+      t.x = pick();
+      break;
+    case 1:
+      t.y = pick();
+      t.yaw = pick();
+      break;
+    case 2:
+      t.speed = pick();
+      break;
+    case 3:
+      t.previous_path_x.clear();
+      t.previous_path_y.clear();
+      break;
+    case 4:
+      if (!t.previous_path_x.empty()) t.previous_path_x.pop_back();
+      break;
     case 5:
       for (auto& v : t.previous_path_x) v += 50 * (u(rng) - 0.5);
       break;
     case 6:
       if (!t.previous_path_y.empty()) t.previous_path_y[rng() % t.previous_path_y.size()] = pick();
       break;
-    case 7: t.sensor_fusion.clear(); break;
+    case 7:
+      t.sensor_fusion.clear();
+      break;
     case 8:
       for (auto& c : t.sensor_fusion) {
         c.x = u(rng) < 0.3 ? pick() : c.x;

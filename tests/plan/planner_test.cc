@@ -1,10 +1,14 @@
 // Planners on the Udacity map in a small closed loop (closed_loop_testing.h), plus the search
 // planner's deadlines, plan reuse and no-allocation property.
+#include "frenetic/plan/planner.h"
+
+#include <gtest/gtest.h>
+
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <new>
@@ -12,18 +16,15 @@
 #include <set>
 #include <utility>
 
-#include <gtest/gtest.h>
-
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/feasibility.h"
-#include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/plan/predictor.h"
 #include "frenetic/units.h"
+#include "plan/closed_loop_testing.h"
 #include "plan/search/planner.h"
 #include "plan/search/stages_testing.h"
-#include "plan/closed_loop_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../common/malloc_counter.h"
 

@@ -1,5 +1,7 @@
 // The predictor on the Udacity map: sensor-fusion glitches repaired, parked cars dropped, braking
 // and lane changes extrapolated, and the traffic's lane-change rule as ghost predictions.
+#include "frenetic/plan/predictor.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -7,7 +9,6 @@
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
-#include "frenetic/plan/predictor.h"
 #include "plan/search/stages_testing.h"
 
 namespace frenetic::plan {

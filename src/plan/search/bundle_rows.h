@@ -32,10 +32,10 @@ struct BundleRows {
     return true;
   }
 
-  int w = 0;                           // samples per row
+  int w = 0;                            // samples per row
   std::vector<traj::Trajectory1d> key;  // the trajectory each row holds
-  std::vector<char> have;              // whether it holds one
-  std::vector<double> p, v;            // [slot * w + j]
+  std::vector<char> have;               // whether it holds one
+  std::vector<double> p, v;             // [slot * w + j]
 };
 
 }  // namespace frenetic::plan::search

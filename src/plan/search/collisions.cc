@@ -12,8 +12,8 @@ namespace frenetic::plan::search {
 namespace {
 
 // m[j] for j in [1, n]: bit c set unless |cars[c * w + j] - x[j]| - extra[c] > reach[j] (NaN
-// passes), for cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2 registers until
-// every car is in; the rest car by car over the last steps. The scoring's
+// passes), for cars c < num_cars <= 64. Four steps at a time, car by car, the masks in SSE2
+// registers until every car is in; the rest car by car over the last steps. The scoring's
 // cost::FillNearMasks is built the same way but is not this test: a reach per step here
 // (FirstCollision's, from the step's speed), and a car at a NaN distance is kept (HitsAt then
 // decides), where a broad-phase mask leaves it out.
@@ -113,7 +113,8 @@ bool CollisionChecker::SampleSteps(const traj::Trajectory1d& tr, int i, BundleRo
 StepStates CollisionChecker::StepsOf(int c, double margin_scale, double behind_scale) {
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = ws_.n_steps + 1;
-  const int num_cars = std::min(ws_.num_check_cars, 64);  // ghosts too; FirstCollision may drop them
+  const int num_cars =
+      std::min(ws_.num_check_cars, 64);  // ghosts too; FirstCollision may drop them
   // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
   const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_steps_);
   LonNearKey& lk = lon_near_key_[i];
@@ -204,8 +205,8 @@ const std::uint64_t* CollisionChecker::TightLatNear(int i, int k) {
       lat_tight_[k * w + j] = lat_near_[k * w + j];
     }
     // HitsAt's d-axis separation for every margin up to tight_margin_ (NaN keeps the car).
-    NarrowMasks(&lat_steps_.p[k * w], tight_reach_.data(), ws_.step_d.data(), car_extent_d_.data(), w,
-                n_steps, num_cars, &lat_tight_[k * w]);
+    NarrowMasks(&lat_steps_.p[k * w], tight_reach_.data(), ws_.step_d.data(), car_extent_d_.data(),
+                w, n_steps, num_cars, &lat_tight_[k * w]);
     lat_tight_stamp_[k] = stamp;
   }
   return &lat_tight_[k * w];

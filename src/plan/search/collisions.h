@@ -182,11 +182,13 @@ class CollisionChecker {
 // ws.reach_s_base + widest fails its reach test anyway. Only with non-negative factors.
 inline double CollisionChecker::Widest(double s_d, double margin_scale, double behind_scale) const {
   const bool bounded = margin_scale >= 0 && behind_scale >= 0 && cfg_.check.margin_s >= 0 &&
-                       cfg_.check.headway_min >= 0 && cfg_.check.margin_behind >= 0 && cfg_.check.behind_time >= 0;
+                       cfg_.check.headway_min >= 0 && cfg_.check.margin_behind >= 0 &&
+                       cfg_.check.behind_time >= 0;
   if (!bounded) return std::numeric_limits<double>::infinity();
   return std::max(
       {margin_scale * std::max(cfg_.check.margin_s, cfg_.check.headway_min * std::max(s_d, 0.0)),
-       behind_scale * (cfg_.check.margin_behind + cfg_.check.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
+       behind_scale * (cfg_.check.margin_behind +
+                       cfg_.check.behind_time * std::max(0.0, ws_.step_v_max - s_d)),
        margin_scale * cfg_.check.margin_s});
 }
 
@@ -213,14 +215,16 @@ struct CollisionChecker::StepEgo {
   }
 };
 
-inline CollisionChecker::StepEgo CollisionChecker::EgoAt(const traj::FrenetState& st, double margin_scale,
-                                       double behind_scale) const {
-  return {traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.check.ego_length, 0.5 * cfg_.check.ego_width}, st.s_d,
-          std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
+inline CollisionChecker::StepEgo CollisionChecker::EgoAt(const traj::FrenetState& st,
+                                                         double margin_scale,
+                                                         double behind_scale) const {
+  return {
+      traj::OrientedBox{st.s, st.d, 0.0, 0.5 * cfg_.check.ego_length, 0.5 * cfg_.check.ego_width},
+      st.s_d, std::max(st.s_d, 0.5), st.d_d, ReachS(st.s_d, margin_scale, behind_scale)};
 }
 
 inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double margin_scale,
-                            double behind_scale) const {
+                                     double behind_scale) const {
   const traj::OrientedBox& ego = e.box;
   const int at = c * (ws_.n_steps + 1) + j;
   const double cs = ws_.step_s[at], cd = ws_.step_d[at];
@@ -267,8 +271,8 @@ inline bool CollisionChecker::HitsAt(const StepEgo& e, int j, int c, double marg
 }
 
 template <typename StateAt>
-int CollisionChecker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars, double margin_scale,
-                         double behind_scale) const {
+int CollisionChecker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t cars,
+                                  double margin_scale, double behind_scale) const {
   const std::uint64_t near = state_at.Near(j) & cars;
   if (near == 0) return -1;  // no car within reach at this step: nothing to test
   const StepEgo ego = EgoAt(state_at(j * ws_.collision_step), margin_scale, behind_scale);
@@ -281,7 +285,7 @@ int CollisionChecker::FirstCarHit(const StateAt& state_at, int j, std::uint64_t 
 
 template <typename StateAt>
 int CollisionChecker::FirstCollision(StateAt state_at, double margin_scale, double behind_scale,
-                            int* car_hit, bool ghosts, int from, int to) const {
+                                     int* car_hit, bool ghosts, int from, int to) const {
   const int num_cars = ghosts ? ws_.num_check_cars : ws_.ctx.num_cars;
   const std::uint64_t cars = CarMask(ghosts);
   const int n_steps = ws_.n_steps;

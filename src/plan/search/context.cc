@@ -28,7 +28,8 @@ void LaneCentres(const Settings& cfg, const map::ReferenceLine& line, Workspace&
     const map::ReferenceLine::OffsetRange r =
         line.ChordOffset(ws.start.s - 10.0, ws.start.s + ahead, ws.lane_nominal[l]);
     const double lo_read = l == 0 ? cfg.limits.d_min : l * cfg.road.lane_width + kLaneLineBand;
-    const double hi_read = l == last ? cfg.limits.d_max : (l + 1) * cfg.road.lane_width - kLaneLineBand;
+    const double hi_read =
+        l == last ? cfg.limits.d_max : (l + 1) * cfg.road.lane_width - kLaneLineBand;
     const double lo = lo_read - r.lo, hi = hi_read - r.hi;
     ws.lane_center[l] = lo <= hi ? std::clamp(ws.lane_nominal[l], lo, hi) : 0.5 * (lo + hi);
   }
@@ -129,7 +130,8 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     for (int b = 0; b < static_cast<int>(ws.abs_kappa.size()); ++b) {
       const double x = ws.kappa_s0 + b * Workspace::kEdgeBin;
       const double mid = std::abs(line.At(x + h).kappa), next = std::abs(line.At(x + 2 * h).kappa);
-      ws.abs_kappa[b] = Finite(mid) && Finite(next) && Finite(prev) ? std::max({prev, mid, next}) : 0.0;
+      ws.abs_kappa[b] =
+          Finite(mid) && Finite(next) && Finite(prev) ? std::max({prev, mid, next}) : 0.0;
       prev = next;
     }
     ws.max_abs_d = std::max(std::abs(ws.road_left), std::abs(ws.road_right));

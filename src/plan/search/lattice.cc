@@ -33,7 +33,7 @@ constexpr double kSwerveStep = 0.25;
 constexpr double kSwerveMinSpeed = 2.0;
 constexpr double kSwerveReachAccel = 5.0;
 constexpr int kSwerveSpeeds = 3;
-constexpr double kSwerveSpeedStep = 3.0;  // m/s
+constexpr double kSwerveSpeedStep = 3.0;                // m/s
 constexpr double kSwerveEndAccels[] = {0.0, 6.0, 9.0};  // m/s^2 across, toward the heading
 // A swerve that ended before the goal was met goes on kSwerveLate s at a time (a CommonRoad
 // step), for at most kSwerveOverrun s past its end.
@@ -46,8 +46,8 @@ constexpr double kPassHold[] = {0.0, 1.0, 2.0, 3.0};
 constexpr double kPassBack[] = {1.5, 2.5};
 constexpr double kPassMinGain = 2.0;
 constexpr double kPassResolve = 0.05;
-static_assert(std::size(kPassOut) * std::size(kPassHold) * std::size(kPassBack) + 1 <=
-              kMaxPasses, "the workspace's room for passes (and the one under way)");
+static_assert(std::size(kPassOut) * std::size(kPassHold) * std::size(kPassBack) + 1 <= kMaxPasses,
+              "the workspace's room for passes (and the one under way)");
 
 double Linspace(double lo, double hi, int count, int i) {
   return count <= 1 ? hi : lo + (hi - lo) * i / (count - 1);
@@ -80,7 +80,8 @@ bool Lattice::TooFastForTheCurve(int i) const {
   const int bins = static_cast<int>(ws_.abs_kappa.size());
   for (int k = 1; k < n && k * cfg_.score.dt <= cfg_.check.horizon + 1e-9; ++k) {
     const double v = ws_.lon_sd[i * n + k];
-    const int b = static_cast<int>(std::floor((ws_.lon_s[i * n + k] - ws_.kappa_s0) / Workspace::kEdgeBin));
+    const int b =
+        static_cast<int>(std::floor((ws_.lon_s[i * n + k] - ws_.kappa_s0) / Workspace::kEdgeBin));
     if (b < 0 || b >= bins) continue;
     const double kappa = ws_.abs_kappa[b];
     if (v * v * kappa * std::max(0.0, 1 - kappa * ws_.max_abs_d) > limit) return true;
@@ -382,18 +383,20 @@ void Lattice::AddGapTargets(int lane, double T) {
     const double hi = pa.s - ws_.car_sep_s[ahead] - cfg_.check.margin_s;
     if (!(hi > lo)) continue;
     // The following law's target, shifted (param) to the gap's middle.
-    const double longer = 0.5 * (predictor_.cars()[ws_.car_index[ahead]].length - cfg_.check.car_length) +
-                          0.5 * (cfg_.check.ego_length - cfg_.check.car_length);
+    const double longer =
+        0.5 * (predictor_.cars()[ws_.car_index[ahead]].length - cfg_.check.car_length) +
+        0.5 * (cfg_.check.ego_length - cfg_.check.car_length);
     const double law = pa.s - (cfg_.grid.follow_d0 + cfg_.grid.follow_tau * pa.v) - longer;
-    AddLon(MakeLon(cost::LonKind::kFollowing, lane, law - 0.5 * (lo + hi), T,
-                   ws_.car_index[ahead]));
+    AddLon(
+        MakeLon(cost::LonKind::kFollowing, lane, law - 0.5 * (lo + hi), T, ws_.car_index[ahead]));
   }
 }
 
 // On a free road, constant acceleration up to the fastest lane's limit (for every lane) and to
-// each slower reachable lane's own (with grid.lane_limit_speeds): a quartic starts and ends at zero acceleration, so it reaches the limit
-// from a standstill in about 1.5 v / a_peak; a step to a constant acceleration, which the
-// simulator's block means allow (udacity-sim.md §7.2, §7.3), takes v / a.
+// each slower reachable lane's own (with grid.lane_limit_speeds): a quartic starts and ends at zero
+// acceleration, so it reaches the limit from a standstill in about 1.5 v / a_peak; a step to a
+// constant acceleration, which the simulator's block means allow (udacity-sim.md §7.2, §7.3), takes
+// v / a.
 void Lattice::AddAccelerating(const bool reachable[], double vmax) {
   const double v0 = std::max(ws_.start.s_d, 0.0);
   // On a free road only: in traffic the run meets slow cars and their cut-ins at the limit's
@@ -457,19 +460,23 @@ void Lattice::Generate() {
   // Lanes within reach (grid.lane_reach lane widths): the current one and its neighbours.
   bool reachable[cost::kMaxLanes] = {};
   for (int l = 0; l < cfg_.road.num_lanes; ++l) {
-    reachable[l] = ws_.lane_exists[l] &&
-                   std::abs(ws_.lane_center[l] - start.d) <= cfg_.grid.lane_reach * cfg_.road.lane_width;
+    reachable[l] = ws_.lane_exists[l] && std::abs(ws_.lane_center[l] - start.d) <=
+                                             cfg_.grid.lane_reach * cfg_.road.lane_width;
   }
   double vmax = 0;
   for (int l = 0; l < cfg_.road.num_lanes; ++l) vmax = std::max(vmax, ws_.ctx.lane_speed_limit[l]);
   // The end speeds' grid reaches no higher than the ego can speed up to within the longest
   // duration (its steps stay as fine where it can go, however high the top speed).
-  const double vgrid = std::min(vmax, ReachableSpeed(cfg_.vehicle, cfg_.limits.max_accel, std::max(start.s_d, 0.0), cfg_.grid.max_duration));
+  const double vgrid =
+      std::min(vmax, ReachableSpeed(cfg_.vehicle, cfg_.limits.max_accel, std::max(start.s_d, 0.0),
+                                    cfg_.grid.max_duration));
   for (int di = 0; di < cfg_.grid.durations; ++di) {
-    const double T = Linspace(cfg_.grid.min_duration, cfg_.grid.max_duration, cfg_.grid.durations, di);
+    const double T =
+        Linspace(cfg_.grid.min_duration, cfg_.grid.max_duration, cfg_.grid.durations, di);
     for (int vi = 0; vi < cfg_.grid.speeds; ++vi) {
       // Velocity keeping to end speeds from 0 to the fastest lane's limit.
-      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vgrid, cfg_.grid.speeds, vi), T));
+      AddLon(MakeLon(cost::LonKind::kVelocityKeeping, -1, Linspace(0, vgrid, cfg_.grid.speeds, vi),
+                     T));
     }
     // ...and to each slower lane's own limit (the outer lanes of a bend, where the XY speed is
     // s' (1 + kappa d)): the grid's step would otherwise leave such a lane up to a whole step

@@ -15,14 +15,8 @@ double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr) {
 }
 
 LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
-                     CollisionChecker& collisions,
-                     const CycleClock& clock)
-    : cfg_(cfg),
-      ws_(ws),
-      scorer_(scorer),
-      limits_(limits),
-      collisions_(collisions),
-      clock_(clock) {
+                     CollisionChecker& collisions, const CycleClock& clock)
+    : cfg_(cfg), ws_(ws), scorer_(scorer), limits_(limits), collisions_(collisions), clock_(clock) {
   known_.reserve(ws_.order.capacity());
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
@@ -63,9 +57,9 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
 
 int LeastHarm::CheapestClearEnough(bool* over_budget) {
   // The cheapest candidate (exact cost, then index) that passes the three tests, found as
-  // Selection::CheapestPassing finds the cheapest feasible one: the candidates come off a heap by cost bound,
-  // the cheap tests first (bare boxes, clearance), and one that passes them waits in a second
-  // heap, by a bound raised one term at a time until it is its exact cost; the top of that
+  // Selection::CheapestPassing finds the cheapest feasible one: the candidates come off a heap by
+  // cost bound, the cheap tests first (bare boxes, clearance), and one that passes them waits in a
+  // second heap, by a bound raised one term at a time until it is its exact cost; the top of that
   // heap, once no bound left ranks before it, is tested for the limits (the dearest test) and
   // is the answer when it passes. The same candidate as walking the cost order, with no exact
   // cost for one that collides.
@@ -107,7 +101,8 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
       continue;
     }
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
-    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough)) continue;
+    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough))
+      continue;
     clear_.push_back({scorer_.KnownBound(c), c});
     std::push_heap(clear_.begin(), clear_.end(), later);
   }
@@ -181,8 +176,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       Contact(c);
       if (first_hit_[c] <= n_steps) return;
       const CollisionChecker::Rows rows = collisions_.StepRows(c);
-      clearance_[c] =
-          ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
+      clearance_[c] = ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
       if (limits_.CandidateBreaksLimits(c)) return;
       scorer_.ExactCost(c);
       best = c;

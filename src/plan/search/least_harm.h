@@ -26,7 +26,8 @@ namespace frenetic::plan::search {
 // horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - ws.car_sep_s,
 // |dd| - ws.car_sep_d), < 0 on overlap.
 double Clearance(const Workspace& ws, const traj::FrenetTrajectory& tr);
-// The same from the states at the collision-check steps (state_at(tick), CollisionChecker::StepsOf).
+// The same from the states at the collision-check steps (state_at(tick),
+// CollisionChecker::StepsOf).
 template <typename StateAt>
 double ClearanceAt(const Workspace& ws, StateAt state_at) {
   double worst = 1e9;
@@ -113,8 +114,7 @@ inline double MinOfMax(const double* a, const double* b, int n) {
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
 // `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
 // minimum, car by car: the order does not change a minimum that ignores NaN.
-inline double ClearanceAbove(const Workspace& ws, const double* s, const double* d,
-                             double floor) {
+inline double ClearanceAbove(const Workspace& ws, const double* s, const double* d, double floor) {
   constexpr int kMaxSteps = 256;
   const int n_steps = ws.n_steps;
   if (n_steps >= kMaxSteps) {
@@ -144,8 +144,7 @@ class LeastHarm {
   // `ws`, `scorer`, the checkers and `clock` must outlive this; sized for ws's largest candidate
   // set.
   LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
-            CollisionChecker& collisions,
-            const CycleClock& clock);
+            CollisionChecker& collisions, const CycleClock& clock);
 
   // Makes the least harmful candidate the winner: the candidates ranked by harm (latest
   // contact, then most clearance, then cost), the first feasible one, else the first feasible
@@ -164,8 +163,8 @@ class LeastHarm {
  private:
   // The first candidate in cost order that collides with no car on bare boxes (the room behind
   // kept, the predictor's ghosts left out, as BestClear tests), keeps at least
-  // cfg.check.clear_enough from every car (Clearance) and breaks no limit; -1 when none does (or the
-  // deadline cut it short: then *over_budget is set). Where the predictions are the traffic's
+  // cfg.check.clear_enough from every car (Clearance) and breaks no limit; -1 when none does (or
+  // the deadline cut it short: then *over_budget is set). Where the predictions are the traffic's
   // own future (recorded traffic), more room than enough buys nothing, and the clearest
   // candidate is mostly the one braking hardest, away from the goal.
   int CheapestClearEnough(bool* over_budget);

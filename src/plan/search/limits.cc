@@ -25,7 +25,7 @@ LimitChecker::LimitChecker(const Settings& cfg, const map::ReferenceLine& line, 
 }
 
 void LimitChecker::SetXyPrefix(const double* hist_x, const double* hist_y, int hist_n,
-                          const double* kept_x, const double* kept_y, int kept) {
+                               const double* kept_x, const double* kept_y, int kept) {
   int n = 0;
   for (int i = 0; i < hist_n; ++i, ++n) {
     chk_x_[n] = hist_x[i];
@@ -40,7 +40,8 @@ void LimitChecker::SetXyPrefix(const double* hist_x, const double* hist_y, int h
   ++prefix_stamp_;
 }
 
-LimitChecker::ReadRange LimitChecker::ReadBetween(const double* s, const double* d, int prev, int i) const {
+LimitChecker::ReadRange LimitChecker::ReadBetween(const double* s, const double* d, int prev,
+                                                  int i) const {
   const double d_lo = std::min(d[prev], d[i]), d_hi = std::max(d[prev], d[i]);
   const map::ReferenceLine::OffsetRange r =
       line_.ChordOffset(std::min(s[prev], s[i]), std::max(s[prev], s[i]), 0.5 * (d_lo + d_hi));

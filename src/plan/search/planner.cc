@@ -19,12 +19,12 @@
 #include "frenetic/traj/frenet.h"
 #include "plan/predictor_options.h"
 #include "plan/search/collisions.h"
-#include "plan/search/limits.h"
 #include "plan/search/context.h"
 #include "plan/search/continuity.h"
 #include "plan/search/fallback.h"
 #include "plan/search/lattice.h"
 #include "plan/search/least_harm.h"
+#include "plan/search/limits.h"
 #include "plan/search/refiner.h"
 #include "plan/search/scoring.h"
 #include "plan/search/selection.h"
@@ -38,7 +38,6 @@ namespace {
 using search::Finite;
 using traj::FrenetState;
 using traj::FrenetTrajectory;
-
 
 double SteadyMs() {
   return std::chrono::duration<double, std::milli>(
@@ -207,8 +206,8 @@ class SearchPlanner : public Planner {
       // A swerve into a goal region is taken as it is: its checks end at the region
       // (Workspace::CheckTicks), the refinement's run over the whole horizon; and a pass, which
       // the refinement's single move cannot express.
-      if (found && cfg_.refine.enabled && refiner_.available() && !ws_.lat[ws_.winner_lat].swerve() &&
-          !ws_.lat[ws_.winner_lat].pass()) {
+      if (found && cfg_.refine.enabled && refiner_.available() &&
+          !ws_.lat[ws_.winner_lat].swerve() && !ws_.lat[ws_.winner_lat].pass()) {
         // A pinned (infinite) cycle budget always leaves room; a pinned refinement budget
         // asks for none beyond the cycle's.
         const double refine_ms = std::isfinite(cfg_.refine.budget_ms) ? cfg_.refine.budget_ms : 0;
@@ -322,9 +321,9 @@ class SearchPlanner : public Planner {
   search::Continuity continuity_;
   search::LaneEnds lane_ends_;
 
-  std::vector<double> per_term_;  // unweighted term values (EvaluateWinnerCosts)
-  bool none_passed_last_ = false;              // the last search's checks found no candidate passing
-  double sim_time_ = NAN;  // s, simulated time of the current message (NaN: unknown)
+  std::vector<double> per_term_;   // unweighted term values (EvaluateWinnerCosts)
+  bool none_passed_last_ = false;  // the last search's checks found no candidate passing
+  double sim_time_ = NAN;          // s, simulated time of the current message (NaN: unknown)
   PlanResult result_;
 };
 

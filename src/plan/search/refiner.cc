@@ -169,13 +169,11 @@ void Refiner::Refine(PlanSummary& sum) {
   const traj::FrenetTrajectory refined = FromParams(x);
   ws_.FillTicks(refined);
   const Eval* seen = Find(x);  // the result is a point NLopt evaluated
-  const double violation =
-      seen != nullptr && seen->has_g ? seen->g : limits_.Violation(nullptr);
+  const double violation = seen != nullptr && seen->has_g ? seen->g : limits_.Violation(nullptr);
   if (violation > 0 || collisions_.Collides()) return;
   ws_.winner = refined;
-  sum.refine_cost_after = seen != nullptr && seen->has_f && constraints_ok_
-                              ? seen->f
-                              : scorer_.CostOf(refined, lb, db);
+  sum.refine_cost_after =
+      seen != nullptr && seen->has_f && constraints_ok_ ? seen->f : scorer_.CostOf(refined, lb, db);
 }
 
 }  // namespace frenetic::plan::search

@@ -22,8 +22,8 @@ inline void NearLat(const Workspace& ws, const double* d, std::uint64_t* near) {
                       ws.n_samples, near);
 }
 inline void NearLon(const Workspace& ws, const double* s, std::uint64_t* near) {
-  cost::FillNearMasks(s, ws.n_samples, ws.ctx.num_cars, cost::kNearLongitudinal,
-                      ws.car_s.data(), ws.n_samples, near);
+  cost::FillNearMasks(s, ws.n_samples, ws.ctx.num_cars, cost::kNearLongitudinal, ws.car_s.data(),
+                      ws.n_samples, near);
 }
 // Points a cost input at a trajectory's masks (each 2 * n_samples words, as Near* fill them).
 inline void SetNear(const Workspace& ws, cost::CostInput& in, const std::uint64_t* lat,

@@ -7,8 +7,7 @@
 namespace frenetic::plan::search {
 
 Selection::Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
-                     CollisionChecker& collisions,
-                     Tracer& tracer, const CycleClock& clock)
+                     CollisionChecker& collisions, Tracer& tracer, const CycleClock& clock)
     : cfg_(cfg),
       ws_(ws),
       scorer_(scorer),
@@ -51,7 +50,7 @@ bool Selection::Select(bool none_passed_before, PlanSummary* summary, bool* over
     int hit_car = -1, hit = ws_.n_steps + 1;
     if (r < traced) {
       hit = collisions_.FirstCollision(collisions_.StepsOf(c), 1.0, 1.0, &hit_car, true, 1,
-                                    ws_.CheckSteps(c));
+                                       ws_.CheckSteps(c));
     } else {
       hit = collisions_.CandidateCollides(c) ? 1 : hit;
     }

@@ -27,8 +27,7 @@ class Selection {
   // `ws`, `scorer`, the checkers, `tracer` and `clock` must outlive this; sized for ws's largest
   // candidate set.
   Selection(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitChecker& limits,
-            CollisionChecker& collisions,
-            Tracer& tracer, const CycleClock& clock);
+            CollisionChecker& collisions, Tracer& tracer, const CycleClock& clock);
 
   // The hard checks of a cycle: the cheapest candidate that passes every check is taken as
   // ws's winner (Workspace::TakeWinner) and true returned. False when none passes, or when the

@@ -45,11 +45,11 @@ struct Settings {
     bool uniform = true;     // the Udacity layout: d_min / d_max, the lane-line timer
   };
   struct Continuity {
-    int keep_points = 0;            // points of the last path kept before a new plan
-    int output_points = 0;          // points sent
-    double resync_tolerance = 0;    // m: previous_path is ours when its ends are this near
-    int replan_min_ticks = 0;       // fewer driven points than this: the last plan re-sent
-    double replan_deviation = 0;    // m: ...unless a car moved this far from its prediction
+    int keep_points = 0;          // points of the last path kept before a new plan
+    int output_points = 0;        // points sent
+    double resync_tolerance = 0;  // m: previous_path is ours when its ends are this near
+    int replan_min_ticks = 0;     // fewer driven points than this: the last plan re-sent
+    double replan_deviation = 0;  // m: ...unless a car moved this far from its prediction
   };
   // The longitudinal lattice (grid.*).
   struct Grid {
@@ -57,16 +57,16 @@ struct Settings {
     bool lane_limit_speeds = false;  // and each lane's own limit
     int durations = 0;               // durations between min_duration and max_duration (s)
     double min_duration = 0, max_duration = 0;
-    int follow_gaps = 0;             // following: extra gaps behind the leader
-    int gap_targets = 0;             // gaps between a lane's cars aimed into, per lane (0: none)
-    double follow_d0 = 0;            // m: following's standstill gap
-    double follow_tau = 0;           // s: its time gap, follow_tau_step apart per extra gap
+    int follow_gaps = 0;    // following: extra gaps behind the leader
+    int gap_targets = 0;    // gaps between a lane's cars aimed into, per lane (0: none)
+    double follow_d0 = 0;   // m: following's standstill gap
+    double follow_tau = 0;  // s: its time gap, follow_tau_step apart per extra gap
     double follow_tau_step = 0;
-    bool stop = false;               // stopping trajectories
-    int accels = 0;                  // constant accelerations between accel_min and accel_max
+    bool stop = false;                    // stopping trajectories
+    int accels = 0;                       // constant accelerations between accel_min and accel_max
     double accel_min = 0, accel_max = 0;  // m/s^2 (grid.min_accel, grid.max_accel)
-    double lane_reach = 0;           // lane widths: lanes whose centre is this near are targets
-    bool passes = false;             // passes on a two-way road's oncoming lane (AddPasses)
+    double lane_reach = 0;  // lane widths: lanes whose centre is this near are targets
+    bool passes = false;    // passes on a two-way road's oncoming lane (AddPasses)
   };
   // Constant-deceleration braking (grid.brake_*).
   struct Brake {
@@ -78,9 +78,9 @@ struct Settings {
   struct Lateral {
     int durations = 0;  // between min_duration and max_duration (s)
     double min_duration = 0, max_duration = 0;
-    int offsets = 0;         // offsets from a lane's centre, offset_step (m) apart
+    int offsets = 0;  // offsets from a lane's centre, offset_step (m) apart
     double offset_step = 0;
-    int delays = 0;          // delayed starts, delay_step (s) apart
+    int delays = 0;  // delayed starts, delay_step (s) apart
     double delay_step = 0;
   };
   struct Score {
@@ -93,18 +93,18 @@ struct Settings {
     double horizon = 0;                    // s checked on the XY path
     double collision_dt = 0;               // s between collision-check steps
     double margin_s = 0, margin_d = 0;     // m added to every car's box
-    double margin_behind = 0;  // m of room for a car behind in another lane...
-    double behind_time = 0;    // ...plus this many s of its closing speed
-    double headway_min = 0;    // s of headway to a car ahead
-    double clear_enough = 0;   // m: least harm takes the cheapest this clear (0: off)
+    double margin_behind = 0;              // m of room for a car behind in another lane...
+    double behind_time = 0;                // ...plus this many s of its closing speed
+    double headway_min = 0;                // s of headway to a car ahead
+    double clear_enough = 0;               // m: least harm takes the cheapest this clear (0: off)
     // Longitudinal trajectories whose v^2 kappa along the line clearly exceeds
     // limits.max_accel are not candidates (Lattice::AddLon).
     bool curve_prefilter = false;
   };
   struct Refine {
-    bool enabled = false;   // NLopt on the winner (refine.enabled)
-    int iterations = 0;     // refine.max_iterations
-    double budget_ms = 0;   // ms (infinite when pinned)
+    bool enabled = false;  // NLopt on the winner (refine.enabled)
+    int iterations = 0;    // refine.max_iterations
+    double budget_ms = 0;  // ms (infinite when pinned)
   };
   // Keep-lane braking when nothing else is left.
   struct Fallback {

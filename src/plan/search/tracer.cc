@@ -6,9 +6,8 @@
 
 namespace frenetic::plan::search {
 
-Tracer::Tracer(const Settings& cfg, const Workspace& ws, Scorer& scorer,
-               const cost::CostSet& costs, const map::ReferenceLine& line,
-               const Predictor& predictor)
+Tracer::Tracer(const Settings& cfg, const Workspace& ws, Scorer& scorer, const cost::CostSet& costs,
+               const map::ReferenceLine& line, const Predictor& predictor)
     : cfg_(cfg), ws_(ws), scorer_(scorer), costs_(costs), line_(line), predictor_(predictor) {
   per_term_.assign(costs_.size(), 0.0);
 }

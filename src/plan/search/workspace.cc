@@ -23,14 +23,15 @@ Workspace::Workspace(const Settings& cfg) {
   n_ticks = static_cast<int>(std::ceil(cfg.check.horizon / kTickSeconds));
   n_ticks = std::max(n_ticks, cfg.continuity.output_points);
   // The lattice's largest bundles (Lattice::Generate), with a little slack.
-  const int max_lon = (cfg.grid.speeds + cfg.road.num_lanes) * cfg.grid.durations + cfg.grid.durations +
-                      2 * cfg.road.num_lanes * cfg.grid.follow_gaps * cfg.grid.durations +
-                      cfg.road.num_lanes * cfg.grid.gap_targets * cfg.grid.durations +
-                      cfg.brake.decels * cfg.brake.targets + cost::kMaxGoalRegions * cfg.grid.durations +
-                      cfg.grid.accels * (cfg.road.num_lanes + 1) + 9;
+  const int max_lon =
+      (cfg.grid.speeds + cfg.road.num_lanes) * cfg.grid.durations + cfg.grid.durations +
+      2 * cfg.road.num_lanes * cfg.grid.follow_gaps * cfg.grid.durations +
+      cfg.road.num_lanes * cfg.grid.gap_targets * cfg.grid.durations +
+      cfg.brake.decels * cfg.brake.targets + cost::kMaxGoalRegions * cfg.grid.durations +
+      cfg.grid.accels * (cfg.road.num_lanes + 1) + 9;
   const int max_lat =
-      cfg.road.num_lanes * (cfg.lat.durations + 1 + cfg.lat.delays) * cfg.lat.offsets + kMaxSwerves +
-      kMaxPasses + 9;
+      cfg.road.num_lanes * (cfg.lat.durations + 1 + cfg.lat.delays) * cfg.lat.offsets +
+      kMaxSwerves + kMaxPasses + 9;
   lon.reserve(max_lon);
   lat.reserve(max_lat);
   for (auto* v : {&lon_s, &lon_sd, &lon_sdd}) v->assign(max_lon * n_samples, 0.0);
@@ -44,15 +45,18 @@ Workspace::Workspace(const Settings& cfg) {
   for (auto* v : {&car_hl, &car_hw, &car_sep_s, &car_sep_d, &car_reach_s, &car_reach_d}) {
     v->assign(kMaxCars, 0.0);
   }
-  const int edge_bins =
-      static_cast<int>(std::ceil((cfg.limits.max_speed * std::max(cfg.check.horizon, cfg.score.horizon) +
-                                  kEdgeBehind + kEdgeAhead) / kEdgeBin)) + 2;
+  const int edge_bins = static_cast<int>(std::ceil(
+                            (cfg.limits.max_speed * std::max(cfg.check.horizon, cfg.score.horizon) +
+                             kEdgeBehind + kEdgeAhead) /
+                            kEdgeBin)) +
+                        2;
   edge_lo.assign(edge_bins, 0.0);
   edge_hi.assign(edge_bins, 0.0);
   abs_kappa.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
-  collision_step = std::max(1, static_cast<int>(std::lround(cfg.check.collision_dt / kTickSeconds)));
+  collision_step =
+      std::max(1, static_cast<int>(std::lround(cfg.check.collision_dt / kTickSeconds)));
   n_steps = n_ticks / collision_step;
   for (auto* v : {&step_s, &step_d, &step_v, &step_vd, &step_dir_s, &step_dir_d})
     v->assign(kMaxCars * (n_steps + 1), 0.0);

@@ -68,7 +68,8 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
     return c;
   };
   Stages off(with(0)), on(with(1));
-  off.cfg.limits.max_accel = on.cfg.limits.max_accel = 0.5;  // below the config's range: a test-only limit
+  off.cfg.limits.max_accel = on.cfg.limits.max_accel =
+      0.5;  // below the config's range: a test-only limit
   PrepareCentred(off, 20);
   PrepareCentred(on, 20);
   off.lattice.Generate();
@@ -249,7 +250,8 @@ TEST(SearchLatticeTest, GapTargetsEndBetweenTwoCarsOfTheNeighbourLane) {
     // nearer gap (between the first two cars) and the next one.
     const double behind = kS - 15 + 18 * T, ahead = kS + 15 + 18 * T, far = kS + 120 + 18 * T;
     const double sep = ws.car_sep_s[0] + margin;
-    if (std::abs(s - 0.5 * (behind + ahead)) < 0.05 && s > behind + sep && s < ahead - sep) ++in_gaps;
+    if (std::abs(s - 0.5 * (behind + ahead)) < 0.05 && s > behind + sep && s < ahead - sep)
+      ++in_gaps;
     if (std::abs(s - 0.5 * (ahead + far)) < 0.05) ++in_gaps;
     EXPECT_NEAR(l.traj.At(T).v, 18, 1e-3);
   }

@@ -253,8 +253,8 @@ TEST(SearchLeastHarmTest, ClearEnoughIsTheCheapestThatPassesAfterTheLazyCheck) {
     int expected = -1;
     for (const int c : st.ws.order) {
       if (expected >= 0 && !Cheaper(st.ws, c, expected)) continue;
-      if (st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
-          st.ws.n_steps) {
+      if (st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr,
+                                       false) <= st.ws.n_steps) {
         continue;
       }
       const CollisionChecker::Rows rows = st.collisions.StepRows(c);
@@ -304,12 +304,12 @@ TEST(SearchLeastHarmTest, LatestFeasibleContactWhenTheLatestOnesBreakLimits) {
     // Whether a later contact than the choice's exists (among the colliding candidates).
     int latest = 0;
     for (const int c : st.ws.order) {
-      const int hit =
-          st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+      const int hit = st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0,
+                                                   nullptr, false);
       if (hit <= st.ws.n_steps) latest = std::max(latest, hit);
     }
-    const int chosen =
-        st.collisions.FirstCollision(st.collisions.StepsOf(expected, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+    const int chosen = st.collisions.FirstCollision(st.collisions.StepsOf(expected, 0.0, 1.0), 0.0,
+                                                    1.0, nullptr, false);
     earlier_group += chosen <= st.ws.n_steps && chosen < latest;
   }
   EXPECT_GE(earlier_group, 5) << "the scenes do not reach an earlier contact group";
