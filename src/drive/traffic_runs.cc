@@ -15,6 +15,7 @@
 
 #include "eval/fidelity_traffic_internal.h"
 #include "frenetic/drive/episode.h"
+#include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 
 namespace frenetic::sim {
@@ -24,7 +25,7 @@ using fidelity::Interpolate;
 using fidelity::LaneOf;
 using fidelity::OnRoad;
 
-constexpr double kTickSeconds = 0.02;
+using plan::kTickSeconds;  // the simulator's physics step
 
 // A scripted ego that drives like a recorded one (EgoProfile): the recorded speed as a cap, the
 // recorded lane. Cheap and independent of any planner's tuning, so the traffic comparison does

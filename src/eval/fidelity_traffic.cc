@@ -6,6 +6,7 @@
 
 #include "eval/fidelity_traffic_internal.h"
 #include "frenetic/eval/fidelity.h"
+#include "frenetic/plan/planner.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/protocol.h"
 
@@ -16,7 +17,7 @@ using fidelity::Interpolate;
 using fidelity::LaneOf;
 using fidelity::OnRoad;
 
-constexpr double kTickSeconds = 0.02;
+using plan::kTickSeconds;  // the simulator's physics step
 constexpr double kRespawnJump = 15;  // m off the constant-velocity prediction (STATS.md)
 constexpr double kHardBrake = -7;    // m/s^2
 
