@@ -300,8 +300,14 @@ int LeastHarm::CheapestFeasible(std::vector<BoundIndex>::iterator first,
       // The cost first once there is one to beat (the limits cost more); before, the limits.
       const double cost = ws_.cand_cost[best];
       if (bound > cost || (bound == cost && c > best)) break;  // none cheaper is left
-      scorer_.ExactCost(c);
-      if (!Cheaper(ws_, c, best)) continue;
+      // Its cost a term at a time, until its bound ranks it after the best one (the group's
+      // candidates mostly lose so, on their first terms) or the cost is exact.
+      bool behind = false;
+      while (!behind && !scorer_.Resolved(c)) {
+        const double b = scorer_.Advance(c);
+        behind = b > cost || (b == cost && c > best);
+      }
+      if (behind || !Cheaper(ws_, c, best)) continue;
     }
     if (limits_.CandidateBreaksLimits(c)) continue;
     scorer_.ExactCost(c);
