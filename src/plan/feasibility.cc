@@ -135,9 +135,10 @@ void XyChecker::SetPrefix(const double* x, const double* y, int n) {
   prefix_ = std::max(0, Compute(x, y, n, 1));
 }
 
-XyMeasure XyChecker::MeasureWithPrefix(const double* x, const double* y, int n, int first) {
+XyMeasure XyChecker::MeasureWithPrefix(const double* x, const double* y, int n, int first,
+                                        const XyLimits* stop_over) {
   n = Compute(x, y, n, std::max(1, prefix_));
-  return n < 2 ? XyMeasure{} : Worst(n, first);
+  return n < 2 ? XyMeasure{} : Worst(n, first, stop_over);
 }
 
 int XyChecker::Compute(const double* x, const double* y, int n, int from) {
@@ -186,13 +187,17 @@ int XyChecker::Compute(const double* x, const double* y, int n, int from) {
   return n;
 }
 
-XyMeasure XyChecker::Worst(int n, int first) const {
+XyMeasure XyChecker::Worst(int n, int first, const XyLimits* stop_over) const {
   XyMeasure m;
   first = std::clamp(first, 1, n - 1);
   for (int i = first; i < n; ++i) m.max_speed = std::max(m.max_speed, v_[i]);
   if (std::isnan(v_[n - 1])) m.max_speed = NAN;
   const int a0 = 2 * kBlock;
   for (int j = std::max(a0, first); j < n; ++j) m.max_accel = std::max(m.max_accel, acc_[j]);
+  if (stop_over != nullptr && (m.max_speed / stop_over->max_speed - 1.0 > 0 ||
+                               m.max_accel / stop_over->max_accel - 1.0 > 0)) {
+    return m;
+  }
   // Jerk from 1 s means of the acceleration samples, block-aligned with j.
   const int span = kBlock * kJerkBlocks;
   for (int j = std::max(a0 + (kJerkBlocks - 1) * kBlock + span, first); j < n; ++j) {

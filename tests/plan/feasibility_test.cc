@@ -74,6 +74,33 @@ TEST(FeasibilityTest, MeasureWithAPrefixEqualsTheWholeMeasure) {
   EXPECT_GT(c.max_accel, a.max_accel);
 }
 
+TEST(FeasibilityTest, StopOverSkipsTheJerkOnlyWhenSpeedOrAccelerationIsOver) {
+  // Speeding up from 10 m/s at 4 m/s^2 for 2 s, then on: acceleration ~4, jerk > 0.
+  std::vector<double> x{0}, y(501, 0.0);
+  double v = 10;
+  for (int i = 1; i <= 500; ++i) {
+    if (i <= 100) v += 4 * 0.02;
+    x.push_back(x.back() + v * 0.02);
+  }
+  XyChecker full(1024), stopping(1024);
+  const XyMeasure all = full.MeasureWithPrefix(x.data(), y.data(), 501, 1);
+  ASSERT_GT(all.max_jerk, 0.5);
+  ASSERT_GT(all.max_accel, 3.0);
+  // Within every limit: measured in full, the same values.
+  const XyLimits roomy{30, 9, 9};
+  const XyMeasure within = stopping.MeasureWithPrefix(x.data(), y.data(), 501, 1, &roomy);
+  EXPECT_EQ(within.max_jerk, all.max_jerk);
+  EXPECT_EQ(within.max_accel, all.max_accel);
+  // Acceleration over its limit, or speed over its own: the answer is known, the jerk is not
+  // measured; the speed and acceleration are.
+  for (const XyLimits over : {XyLimits{30, 3, 9}, XyLimits{15, 9, 9}}) {
+    const XyMeasure cut = stopping.MeasureWithPrefix(x.data(), y.data(), 501, 1, &over);
+    EXPECT_EQ(cut.max_jerk, 0.0);
+    EXPECT_EQ(cut.max_speed, all.max_speed);
+    EXPECT_EQ(cut.max_accel, all.max_accel);
+  }
+}
+
 TEST(FeasibilityTest, SlidingCheckBoundsTheSimulatorsMeasureAndSeesKinks) {
   // From rest at 2 m/s^2 to 22 m/s, then straight on, with a 4 degree kink at tick 800.
   std::vector<double> x{0}, y{0};

@@ -56,13 +56,17 @@ class XyChecker {
   // points, common to every candidate of a cycle): SetPrefix computes their part once, and
   // MeasureWithPrefix, given a path whose first prefix points are those, only the rest.
   void SetPrefix(const double* x, const double* y, int n);
-  XyMeasure MeasureWithPrefix(const double* x, const double* y, int n, int first);
+  // stop_over (optional): when the speed or the acceleration is already over its limit there
+  // (value / limit - 1 > 0), the jerk and the vehicle's measures are left at 0, unmeasured (a
+  // caller asking only whether any limit is broken has its answer).
+  XyMeasure MeasureWithPrefix(const double* x, const double* y, int n, int first,
+                              const XyLimits* stop_over = nullptr);
 
  private:
   // Fills the per-tick arrays from index `from` on (1: the whole path), assuming the earlier
   // entries are those of the same path; returns the path length used.
   int Compute(const double* x, const double* y, int n, int from);
-  XyMeasure Worst(int n, int first) const;
+  XyMeasure Worst(int n, int first, const XyLimits* stop_over = nullptr) const;
   void WorstVehicle(int n, int first, XyMeasure* m) const;
   int prefix_ = 0;
   VehicleLimits vehicle_;

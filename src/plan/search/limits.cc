@@ -176,7 +176,11 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
     xy_ticks.centre = &lon_centre_[i * w];
   }
   const int n = BuildXyPath(xy_ticks);
-  const XyMeasure m = xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_);
+  // Asked only whether a limit is broken: no jerk or vehicle measure once the speed or the
+  // acceleration is over (the same test as below).
+  const XyLimits over{cfg_.limits.max_speed, cfg_.limits.max_accel, cfg_.limits.max_jerk};
+  const XyMeasure m =
+      xy_.MeasureWithPrefix(chk_x_.data(), chk_y_.data(), n, first_new_, any ? &over : nullptr);
   take(m.max_speed / cfg_.limits.max_speed - 1.0, Reject::kSpeed);
   take(m.max_accel / cfg_.limits.max_accel - 1.0, Reject::kAcceleration);
   take(m.max_jerk / cfg_.limits.max_jerk - 1.0, Reject::kJerk);
