@@ -2,16 +2,15 @@
 // Drive / Follow / Overtake; speed ramped by a fixed step per cycle; the path is a spline through
 // the last two path points and anchors 30/60/90 m ahead in the target lane, in car coordinates
 // (Eigen's spline module), filled up to a fixed number of points.
-#include <unsupported/Eigen/Splines>
-
 #include <algorithm>
 #include <cmath>
+#include <unsupported/Eigen/Splines>
 
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/plan/predictor.h"
+#include "frenetic/plan/search_planner.h"
 #include "frenetic/units.h"
+#include "plan/predictor.h"
 #include "plan/predictor_options.h"
-#include "plan/search/planner.h"
 
 namespace frenetic::plan {
 namespace {

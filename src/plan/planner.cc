@@ -1,7 +1,7 @@
 #include "frenetic/plan/planner.h"
 
 #include "frenetic/plan/planner_config.h"
-#include "plan/search/planner.h"
+#include "frenetic/plan/search_planner.h"
 
 namespace frenetic::plan {
 

@@ -1,4 +1,4 @@
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 
 #include <algorithm>
 #include <bit>

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 
 namespace frenetic::plan {
 

@@ -20,10 +20,10 @@
 #include "frenetic/map/track.h"
 #include "frenetic/plan/feasibility.h"
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/plan/predictor.h"
+#include "frenetic/plan/search_planner.h"
 #include "frenetic/units.h"
 #include "plan/closed_loop_testing.h"
-#include "plan/search/planner.h"
+#include "plan/predictor.h"
 #include "plan/search/stages_testing.h"
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../common/malloc_counter.h"

@@ -1,6 +1,6 @@
 // The predictor on the Udacity map: sensor-fusion glitches repaired, parked cars dropped, braking
 // and lane changes extrapolated, and the traffic's lane-change rule as ghost predictions.
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 
 #include <gtest/gtest.h>
 

@@ -2,18 +2,18 @@
 // end, trucks longer than the configured car, recorded futures. A small closed loop written
 // here drives the ego exactly along its own path, 5 ticks (0.1 s) per exchange, as the
 // CommonRoad runner does.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/road.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 
 namespace frenetic::plan {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "frenetic/map/road.h"
 #include "frenetic/plan/planner.h"
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 #include "plan/search/settings.h"
 #include "plan/search/workspace.h"
 

@@ -6,8 +6,8 @@
 #pragma once
 
 #include "frenetic/cost/cost_term.h"
-#include "frenetic/plan/predictor.h"
 #include "frenetic/traj/frenet.h"
+#include "plan/predictor.h"
 #include "plan/search/settings.h"
 
 namespace frenetic::plan::search {

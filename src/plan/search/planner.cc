@@ -4,8 +4,6 @@
 // the cycle's orchestration; the stages live in search/*.h (context, lattice, scoring,
 // limits, collisions, selection, least_harm, refiner, fallback, continuity) and share one
 // Workspace.
-#include "plan/search/planner.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,8 +13,9 @@
 #include <utility>
 #include <vector>
 
-#include "frenetic/plan/predictor.h"
+#include "frenetic/plan/search_planner.h"
 #include "frenetic/traj/frenet.h"
+#include "plan/predictor.h"
 #include "plan/predictor_options.h"
 #include "plan/search/collisions.h"
 #include "plan/search/context.h"

@@ -8,7 +8,7 @@
 #include "frenetic/cost/cost_set.h"
 #include "frenetic/map/reference_line.h"
 #include "frenetic/plan/planner.h"
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 #include "plan/search/scoring.h"
 #include "plan/search/settings.h"
 #include "plan/search/workspace.h"

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "frenetic/cost/cost_term.h"
+#include "frenetic/plan/search_planner.h"
 #include "frenetic/traj/frenet.h"
 #include "plan/search/lattice.h"
-#include "plan/search/planner.h"
 #include "plan/search/settings.h"
 
 namespace frenetic::plan::search {

@@ -14,7 +14,7 @@
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
-#include "frenetic/plan/predictor.h"
+#include "plan/predictor.h"
 #include "plan/search/collisions.h"
 #include "plan/search/context.h"
 #include "plan/search/continuity.h"

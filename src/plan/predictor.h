@@ -24,13 +24,13 @@ namespace frenetic::plan {
 struct TrackedCar {
   int id = 0;
   double s = 0, d = 0, v_s = 0;
-  double a_s = 0;       // m/s^2 along the lane, from the previous reading (0 when unknown)
-  double v_d = 0;       // m/s across the lane, right positive
-  double d_target = 0;  // m: where a lateral move is predicted to end (= d when none)
-  bool ghost = false;   // a lane change the car may start (PredictorOptions::lane_change_ghosts)
+  double a_s = 0;        // m/s^2 along the lane, from the previous reading (0 when unknown)
+  double v_d = 0;        // m/s across the lane, right positive
+  double d_target = 0;   // m: where a lateral move is predicted to end (= d when none)
+  bool ghost = false;    // a lane change the car may start (PredictorOptions::lane_change_ghosts)
   double lat_delay = 0;  // s before a predicted lateral move starts
   double length = 0, width = 0;  // footprint, m (the row's, else PredictorOptions' defaults)
-  bool recorded = false;  // predicted from its CarFuture
+  bool recorded = false;         // predicted from its CarFuture
   // s after the observation a car to come appears (CarFuture::start); 0 for a car there now.
   // Before it, Predict places the car kAbsentS behind the ego (out of every check's reach).
   double appears = 0;
@@ -40,24 +40,24 @@ struct TrackedCar {
 inline constexpr double kAbsentS = -1e6;
 
 struct PredictorOptions {
-  double range = 200;        // m: cars farther along s are ignored
+  double range = 200;             // m: cars farther along s are ignored
   double d_min = -1, d_max = 13;  // m: the carriageway
-  double max_speed = 30;     // m/s: faster readings are the spawn glitch
-  double spike_ratio = 1.8;  // a reading this much above the id's last one is the spawn glitch
-  int max_cars = 64;         // rows beyond this are ignored (keeps Observe allocation-free)
+  double max_speed = 30;          // m/s: faster readings are the spawn glitch
+  double spike_ratio = 1.8;       // a reading this much above the id's last one is the spawn glitch
+  int max_cars = 64;              // rows beyond this are ignored (keeps Observe allocation-free)
   // Manoeuvre-aware predictor only.
-  double brake_threshold = 2.0;  // m/s^2: a car decelerating harder is predicted to keep braking
-  double brake_horizon = 2.0;    // s: for at most this long (then constant speed, never < 0)
+  double brake_threshold = 2.0;    // m/s^2: a car decelerating harder is predicted to keep braking
+  double brake_horizon = 2.0;      // s: for at most this long (then constant speed, never < 0)
   double lateral_threshold = 0.5;  // m/s: a car moving across faster is changing lanes
   // A lane change ends at the next lane centre: of lanes [0, w), [w, 2w), ... on a uniform road
   // (the line-only factories build one from these two), else the road's lanes at the car's s.
-  double lane_width = 4.0;       // m
+  double lane_width = 4.0;  // m
   int num_lanes = 3;
   // The carriageway on a road that is not uniform: rows farther than this outside the road's
   // edges at their s are dropped (on a uniform road d_min and d_max above rule).
-  double edge_slack = 1.0;  // m
+  double edge_slack = 1.0;                   // m
   double car_length = 4.8, car_width = 2.4;  // m: a row's footprint when it gives none
-  double future_horizon = 8.0;  // s of a recorded future kept (past it: straight on)
+  double future_horizon = 8.0;               // s of a recorded future kept (past it: straight on)
   // The simulator's traffic changes lane only while braking behind a leader (udacity-sim.md
   // §8.5): left from the middle lane, to the middle from the outer ones, when no car (nor the
   // ego) within 20 m of it in s is in that lane. With this on, every such car faster than
@@ -80,8 +80,8 @@ class Predictor {
   // in `futures` (same id) is predicted from it (its first kMaxFutureSamples samples) instead;
   // a future with start > 0 whose id has no row is a car to come, tracked from then on (its
   // first sample within `range`). Never fails: invalid rows and future samples are skipped (a
-  // future with any non-finite sample is not used). `ego_d` is the ego's lateral offset (m; NaN: unknown), which the
-  // traffic's lane-change rule looks at (PredictorOptions::lane_change_ghosts).
+  // future with any non-finite sample is not used). `ego_d` is the ego's lateral offset (m; NaN:
+  // unknown), which the traffic's lane-change rule looks at (PredictorOptions::lane_change_ghosts).
   virtual void Observe(std::span<const SensorCar> rows, double ego_s, double now,
                        std::span<const CarFuture> futures = {}, double ego_d = NAN) = 0;
   static constexpr int kMaxFutureSamples = 96;
