@@ -64,6 +64,7 @@ struct Args {
   int jobs = 0;
   bool progress = false;
   bool no_timing = false;
+  bool way_through = false;
 };
 
 // --record DIR: created when missing; an error names it when it is no writable directory.
@@ -106,7 +107,8 @@ ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem
 
 FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
                    const cr::RunOptions& options, const ReferenceSet& references,
-                   const std::string& solution_dir, const std::string& record_dir) {
+                   const std::string& solution_dir, const std::string& record_dir,
+                   bool way_through) {
   FileReport r;
   r.path = item.path;
   if (!item.error.empty()) {
@@ -140,6 +142,7 @@ FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
   solution.date = cr::CurrentDate();
   solution.processor_name = cr::ProcessorName();
   double computation = 0;
+  std::optional<cr::VerdictChecker> checker;  // --way-through's, built for the first search
   for (const cr::ProblemRun& p : run.problems) {
     const cr::PlanningProblem* problem = scenario->FindProblem(p.problem_id);
     ProblemReport& report = r.problems.emplace_back(ReportProblem(p, problem));
@@ -157,6 +160,11 @@ FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
             commonroad_cli::EvaluateReference(*scenario, *problem, reference->second.path, t);
         break;
       }
+    }
+    if (way_through && problem != nullptr && p.road.ok() && !p.verdict.solved &&
+        !p.verdict.infeasible_at_start) {
+      if (!checker) checker.emplace(*scenario, vehicle);
+      report.way_through = cr::SearchWayThrough(*scenario, *problem, *checker, vehicle);
     }
     computation += p.computation_s;
     if (!p.trajectory.empty()) {
@@ -251,7 +259,7 @@ std::vector<FileReport> RunShare(const Args& a, const Setup& setup, const tune::
     for (int k = next++; k < share; k = next++) {
       const int i = mine[k];
       results[i] = RunFile(files[i], setup.config, setup.options, setup.inputs.references,
-                           a.solution_dir, a.record_dir);
+                           a.solution_dir, a.record_dir, a.way_through);
       for (const ProblemReport& p : results[i].problems) {
         ++problems;
         solved += p.verdict.solved;
@@ -400,6 +408,16 @@ void RegisterCommonRoad(CLI::App& app) {
                 "Show the progress line on stderr even when it is not a terminal");
   sub->add_flag("--no-timing", args->no_timing,
                 "Report planning times as 0 (byte-stable output for the same files)");
+  sub->add_flag("--way-through", args->way_through,
+                "For each problem left unsolved (not infeasible at start), search whether any way "
+                "through its traffic exists, to tell a planner's miss from a problem with no "
+                "solution: the states a point mass with the vehicle's accelerations (forward up to "
+                "the KS limit at its speed, lateral within the friction circle; the steering rate "
+                "unbounded) reaches step by step, kept while the verdict's collision and road "
+                "checks pass, on a grid (0.25 m, 0.25 m/s, 0.01 rad), at most 10000 per step, to "
+                "the traffic's last step. A hint, not a proof: per problem 'found', or the last "
+                "step any state reached (and whether a step was capped); the summary counts "
+                "both. Takes seconds per problem. Default: off");
   sub->callback([args] { ExitWith(Run(*args)); });
 }
 

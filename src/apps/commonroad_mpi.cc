@@ -120,6 +120,24 @@ ReferenceReport ReferenceFrom(const json& j) {
   return r;
 }
 
+json WayThroughWire(const cr::WayThrough& w) {
+  return {{"found", w.found},
+          {"last_step", w.last_step},
+          {"survived_to", w.survived_to},
+          {"exhaustive", w.exhaustive},
+          {"checked", w.checked}};
+}
+
+cr::WayThrough WayThroughFrom(const json& j) {
+  cr::WayThrough w;
+  w.found = j.at("found").get<bool>();
+  w.last_step = j.at("last_step").get<int>();
+  w.survived_to = j.at("survived_to").get<int>();
+  w.exhaustive = j.at("exhaustive").get<bool>();
+  w.checked = j.at("checked").get<std::int64_t>();
+  return w;
+}
+
 json ProblemWire(const ProblemReport& p) {
   return {{"problem_id", p.problem_id},
           {"road_error", p.road_error},
@@ -135,7 +153,8 @@ json ProblemWire(const ProblemReport& p) {
           {"tracking_error_max_m", Num(p.tracking_error_max_m)},
           {"computation_s", Num(p.computation_s)},
           {"costs", Costs(p.costs)},
-          {"reference", p.reference ? ReferenceWire(*p.reference) : json(nullptr)}};
+          {"reference", p.reference ? ReferenceWire(*p.reference) : json(nullptr)},
+          {"way_through", p.way_through ? WayThroughWire(*p.way_through) : json(nullptr)}};
 }
 
 ProblemReport ProblemFrom(const json& j) {
@@ -155,6 +174,7 @@ ProblemReport ProblemFrom(const json& j) {
   p.computation_s = NumFrom(j.at("computation_s"));
   p.costs = CostsFrom(j.at("costs"));
   if (!j.at("reference").is_null()) p.reference = ReferenceFrom(j.at("reference"));
+  if (!j.at("way_through").is_null()) p.way_through = WayThroughFrom(j.at("way_through"));
   return p;
 }
 

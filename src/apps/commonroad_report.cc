@@ -148,6 +148,15 @@ std::string ProblemText(const FileReport& f, const ProblemReport& p) {
   }
   text += "\n    " + VerdictLine(p) + "\n";
   if (p.reference) text += ReferenceLine(p, f.dt);
+  if (p.way_through) {
+    const cr::WayThrough& w = *p.way_through;
+    std::snprintf(buf, sizeof(buf),
+                  w.found ? "    way through: found (to step %d, the traffic's last)\n"
+                          : "    way through: none found, no state past step %d of %d%s\n",
+                  w.found ? w.last_step : w.survived_to, w.last_step,
+                  w.found || w.exhaustive ? "" : " (capped)");
+    text += buf;
+  }
   return text;
 }
 
@@ -183,6 +192,14 @@ json ProblemJson(const ProblemReport& p, double dt) {
   j["computation_s"] = p.computation_s;
   j["costs"] = p.costs;
   if (p.reference) j["reference"] = ReferenceJson(p, dt);
+  if (p.way_through) {
+    const cr::WayThrough& w = *p.way_through;
+    j["way_through"] = {{"found", w.found},
+                        {"last_step", w.last_step},
+                        {"survived_to", w.survived_to},
+                        {"exhaustive", w.exhaustive},
+                        {"states_checked", w.checked}};
+  }
   return j;
 }
 

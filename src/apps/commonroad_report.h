@@ -13,6 +13,7 @@
 
 #include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/verdict.h"
+#include "frenetic/commonroad/way_through.h"
 #include "frenetic/status.h"
 
 namespace frenetic::apps::commonroad_cli {
@@ -53,6 +54,9 @@ struct ProblemReport {
   double computation_s = 0;
   std::map<std::string, double> costs;  // "WX1", "JB1" of the trajectory, when it has states
   std::optional<ReferenceReport> reference;
+  // --way-through: for a problem left unsolved (not infeasible at start), whether the search of
+  // way_through.h found a way through its traffic.
+  std::optional<cr::WayThrough> way_through;
 };
 
 struct FileReport {

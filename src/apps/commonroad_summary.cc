@@ -90,6 +90,11 @@ Summary Summarise(const std::vector<FileReport>& files,
       Count(p, &family);
       Count(p, &s.comparison);
       s.candidates += p.candidates;
+      if (p.way_through) {
+        ++s.way_searched;
+        s.way_found += p.way_through->found;
+        s.way_none_exhaustive += !p.way_through->found && p.way_through->exhaustive;
+      }
       if (p.verdict.solved || p.verdict.infeasible_at_start) continue;
       if (!p.road_error.empty()) ++s.failures["road"];
       std::set<std::string> kinds;
@@ -198,6 +203,12 @@ json SummaryJson(const Summary& s, const SummarySettings& settings) {
             {"candidates_mean", cycles ? s.candidates / cycles : 0.0},
             {"families", families}};
   if (s.comparison.solution_files > 0) j["comparison"] = ComparisonJson(s.comparison);
+  if (s.way_searched > 0) {
+    j["way_through"] = {{"searched", s.way_searched},
+                        {"found", s.way_found},
+                        {"none_found", s.way_searched - s.way_found},
+                        {"none_found_exhaustive", s.way_none_exhaustive}};
+  }
   return j;
 }
 
@@ -222,6 +233,12 @@ std::string SummaryText(const Summary& s, const SummarySettings& settings) {
   text += Format("candidates per cycle: mean %.0f\n", cycles ? s.candidates / cycles : 0.0);
   text += FamilyTable(s);
   if (s.comparison.solution_files > 0) text += ComparisonText(s.comparison);
+  if (s.way_searched > 0) {
+    text += Format(
+        "way through the traffic (--way-through) of the %d unsolved problems: found for %d, none "
+        "found for %d (%d with no step capped)\n",
+        s.way_searched, s.way_found, s.way_searched - s.way_found, s.way_none_exhaustive);
+  }
   return text;
 }
 

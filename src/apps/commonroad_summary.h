@@ -63,6 +63,9 @@ struct Summary {
   std::map<std::string, int> failures;
   double candidates = 0;  // summed over every cycle
   Comparison comparison;
+  // --way-through: the unsolved problems searched, and of those the ones with a way found; the
+  // ones with none found where no step was capped (WayThrough::exhaustive).
+  int way_searched = 0, way_found = 0, way_none_exhaustive = 0;
 };
 
 // `solution_files`: scenario id -> path of each loaded solution file (gives the unpaired ones).

@@ -344,9 +344,43 @@ TEST_F(CommonRoadCliTest, HelpListsEveryOptionWithItsDefault) {
         r.out.substr(at, next == std::string::npos ? std::string::npos : next - at);
     EXPECT_THAT(entry, HasSubstr("Default")) << entry;
   }
-  for (const char* flag : {"--json", "--progress", "--no-timing", "paths"}) {
+  for (const char* flag : {"--json", "--progress", "--no-timing", "--way-through", "paths"}) {
     EXPECT_THAT(r.out, HasSubstr(flag));
   }
+}
+
+// --way-through searches the unsolved problems only (not the solved, not the infeasible at
+// start): the far goal's road has no traffic, so a way through it is found, to the search's
+// default 10 steps; the summary counts it. Without the flag there is no such field.
+TEST_F(CommonRoadCliTest, WayThroughIsSearchedForTheUnsolvedOnly) {
+  const std::string paths = Set() + " " + (dir_ / "blocked" / "b_blocked.xml").string();
+  CommandResult r = RunFrenetic("commonroad " + paths + " --json --no-timing --way-through");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = json::parse(r.out);
+  int searched = 0;
+  for (const json& s : j.at("scenarios")) {
+    for (const json& p : s.at("problems")) {
+      const bool unsolved = !p.at("solved").get<bool>() && !p.contains("infeasible_at_start");
+      ASSERT_EQ(p.contains("way_through"), unsolved) << s.at("benchmark_id") << ": " << p.dump();
+      if (!unsolved) continue;
+      ++searched;
+      const json& w = p.at("way_through");
+      EXPECT_TRUE(w.at("found").get<bool>()) << w.dump();
+      EXPECT_EQ(w.at("last_step"), 10);
+      EXPECT_EQ(w.at("survived_to"), 10);
+      EXPECT_GT(w.at("states_checked").get<int>(), 10);
+    }
+  }
+  EXPECT_EQ(searched, 1);
+  const json& sum = j.at("summary").at("way_through");
+  EXPECT_EQ(sum.at("searched"), 1);
+  EXPECT_EQ(sum.at("found"), 1);
+  EXPECT_EQ(sum.at("none_found"), 0);
+  CommandResult text = RunFrenetic("commonroad " + paths + " --no-timing --way-through");
+  EXPECT_THAT(text.out, HasSubstr("    way through: found (to step 10, the traffic's last)\n"));
+  EXPECT_THAT(text.out, HasSubstr("of the 1 unsolved problems: found for 1, none found for 0"));
+  CommandResult plain = RunFrenetic("commonroad " + paths + " --json --no-timing");
+  EXPECT_THAT(plain.out, Not(HasSubstr("way_through")));
 }
 
 TEST_F(CommonRoadCliTest, JobsDoNotChangeTheResults) {

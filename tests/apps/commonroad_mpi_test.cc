@@ -80,6 +80,7 @@ FileReport Awkward() {
   r.distance_ratio = 1.9535585655180756;
   r.verdict = "failed: start, dynamics";
   p.reference = r;
+  p.way_through = commonroad::WayThrough{false, 75, 7, true, 12506};
   f.problems.push_back(p);
   ProblemReport plain;  // defaults: no goal, no reference
   plain.problem_id = 2;
@@ -123,6 +124,11 @@ TEST(CommonRoadMpiTest, ReportsReadBackExactly) {
   EXPECT_EQ(q.reference->costs, p.reference->costs);
   EXPECT_EQ(q.reference->goal_step, 75);
   EXPECT_FALSE(b.problems[1].reference.has_value());
+  ASSERT_TRUE(q.way_through.has_value());
+  EXPECT_EQ(q.way_through->survived_to, 7);
+  EXPECT_EQ(q.way_through->checked, 12506);
+  EXPECT_TRUE(q.way_through->exhaustive);
+  EXPECT_FALSE(b.problems[1].way_through.has_value());
   EXPECT_FALSE(b.problems[1].verdict.goal_step.has_value());
   // What the output is made of reads the same.
   EXPECT_EQ(FileJson(b).dump(), FileJson(a).dump());

@@ -1,0 +1,132 @@
+#include "frenetic/commonroad/way_through.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "frenetic/commonroad/ks_model.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+struct Point {
+  double x, y, v, heading;
+};
+
+// The grid cell of a state, packed in 64 bits (16 bits per coordinate, wrapping: two states that
+// far apart never meet in one step's set).
+std::uint64_t CellOf(const Point& p, const WayThroughOptions& o) {
+  const auto bits = [](double value, double cell) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(value / cell))) &
+           0xffffu;
+  };
+  return bits(p.x, o.cell_xy) << 48 | bits(p.y, o.cell_xy) << 32 | bits(p.v, o.cell_v) << 16 |
+         bits(p.heading, o.cell_heading);
+}
+
+// splitmix64's finaliser: a cell's place in the checking order.
+std::uint64_t Mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& problem,
+                            const VerdictChecker& checker, const VehicleParams& vehicle,
+                            const WayThroughOptions& options) {
+  WayThrough r;
+  const int first = problem.initial.time_step;
+  int traffic_end = INT_MIN;
+  for (const Obstacle& o : scenario.obstacles) {
+    if (o.LastStep() != INT_MAX) traffic_end = std::max(traffic_end, o.LastStep());
+  }
+  const int horizon = traffic_end == INT_MIN
+                          ? std::min(options.max_steps, 10)
+                          : std::clamp(traffic_end - first, 0, options.max_steps);
+  r.last_step = first + horizon;
+  r.survived_to = first;
+  const double dt = scenario.dt;
+  const auto valid = [&](const Point& p, int step) {
+    ++r.checked;
+    KsState s;
+    s.time_step = step;
+    s.x = p.x;
+    s.y = p.y;
+    s.velocity = p.v;
+    s.orientation = p.heading;
+    return !checker.CollisionAt(s) && !checker.OffRoadAt(s);
+  };
+  std::vector<Point> now{{problem.initial.position.x, problem.initial.position.y,
+                          std::clamp(problem.initial.velocity.value_or(0.0), 0.0, vehicle.v_max),
+                          problem.initial.orientation.value_or(0.0)}};
+  if (!valid(now[0], first)) return r;
+  // The largest curvature the steering angle allows.
+  const double max_curvature =
+      std::tan(std::max(std::abs(vehicle.steering_min), std::abs(vehicle.steering_max))) /
+      vehicle.Wheelbase();
+  const double lateral[5] = {-options.lateral_accel, -0.5 * options.lateral_accel, 0.0,
+                             0.5 * options.lateral_accel, options.lateral_accel};
+  std::vector<std::pair<std::uint64_t, Point>> next;
+  std::unordered_set<std::uint64_t> seen;
+  std::unordered_map<std::uint64_t, std::size_t> strata;
+  std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
+  for (int k = 1; k <= horizon; ++k) {
+    const int step = first + k;
+    next.clear();
+    seen.clear();
+    for (const Point& p : now) {
+      const double up = vehicle.MaxAcceleration(p.v);
+      const double forward[5] = {-vehicle.a_max, -0.5 * vehicle.a_max, 0.0, 0.5 * up, up};
+      for (const double a : forward) {
+        const double v1 = std::clamp(p.v + a * dt, 0.0, vehicle.v_max);
+        const double v_mid = 0.5 * (p.v + v1);
+        for (const double a_lat : lateral) {
+          if (a * a + a_lat * a_lat > vehicle.a_max * vehicle.a_max) continue;
+          const double curvature =
+              std::clamp(a_lat / std::max(v_mid * v_mid, 1.0), -max_curvature, max_curvature);
+          const double h1 = p.heading + curvature * v_mid * dt;
+          const double h_mid = 0.5 * (p.heading + h1);
+          const Point q{p.x + v_mid * dt * std::cos(h_mid), p.y + v_mid * dt * std::sin(h_mid), v1,
+                        h1};
+          const std::uint64_t cell = CellOf(q, options);
+          if (seen.insert(cell).second) next.push_back({cell, q});
+        }
+      }
+    }
+    // Checked round-robin over coarse strata (2 m of position, 1 m/s of speed), each in the
+    // order of a hash of the cells (deterministic, and unrelated to where they are), until
+    // max_states are valid: a capped step keeps a spread over positions and speeds, the rare
+    // slow states (the ones that stop before a wall) with the many fast ones.
+    for (auto& [cell, q] : next) cell = Mix(cell);
+    std::sort(next.begin(), next.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    strata.clear();
+    rank.resize(next.size());
+    for (std::size_t i = 0; i < next.size(); ++i) {
+      const Point& q = next[i].second;
+      const std::uint64_t stratum =
+          CellOf({q.x, q.y, q.v, 0.0}, {.cell_xy = 2.0, .cell_v = 1.0, .cell_heading = 1.0});
+      rank[i] = {strata[stratum]++, i};
+    }
+    std::sort(rank.begin(), rank.end());
+    const std::size_t n = next.size(), cap = std::max(options.max_states, 1);
+    now.clear();
+    std::size_t visited = 0;
+    for (; visited < n && now.size() < cap; ++visited) {
+      const Point& q = next[rank[visited].second].second;
+      if (valid(q, step)) now.push_back(q);
+    }
+    if (now.empty()) return r;
+    if (visited < n) r.exhaustive = false;
+    r.survived_to = step;
+  }
+  r.found = true;
+  return r;
+}
+
+}  // namespace frenetic::commonroad
