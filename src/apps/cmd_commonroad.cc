@@ -411,13 +411,14 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_flag("--way-through", args->way_through,
                 "For each problem left unsolved (not infeasible at start), search whether any way "
                 "through its traffic exists, to tell a planner's miss from a problem with no "
-                "solution: the states a point mass with the vehicle's accelerations (forward up to "
-                "the KS limit at its speed, lateral within the friction circle; the steering rate "
-                "unbounded) reaches step by step, kept while the verdict's collision and road "
-                "checks pass, on a grid (0.25 m, 0.25 m/s, 0.01 rad), at most 10000 per step, to "
-                "the traffic's last step. A hint, not a proof: per problem 'found', or the last "
-                "step any state reached (and whether a step was capped); the summary counts "
-                "both. Takes seconds per problem. Default: off");
+                "solution: the states the vehicle reaches step by step with the KS model's limits "
+                "(five forward accelerations up to the limit at its speed, five changes of its "
+                "path's curvature up to what the steering rate allows, within the friction "
+                "circle), kept while the verdict's collision and road checks pass, on a grid "
+                "(0.25 m, 0.25 m/s, 0.01 rad, 0.002 1/m), at most 10000 per step, to the "
+                "traffic's last step. Evidence, not proof: per problem 'found', or the last step "
+                "any state reached (and whether a step was capped); the summary counts both. "
+                "Takes seconds per problem. Default: off");
   sub->callback([args] { ExitWith(Run(*args)); });
 }
 

@@ -14,17 +14,22 @@ namespace {
 
 struct Point {
   double x, y, v, heading;
+  double curvature;  // 1/m, of the path (tan(steering angle) / wheelbase)
 };
 
-// The grid cell of a state, packed in 64 bits (16 bits per coordinate, wrapping: two states that
-// far apart never meet in one step's set).
-std::uint64_t CellOf(const Point& p, const WayThroughOptions& o) {
-  const auto bits = [](double value, double cell) {
+struct Cells {
+  double xy, v, heading, curvature;
+};
+
+// The grid cell of a state, packed in 64 bits (x, y 14 bits each, the others 12, wrapping: two
+// states that far apart never meet in one step's set).
+std::uint64_t CellOf(const Point& p, const Cells& c) {
+  const auto bits = [](double value, double cell, int width) {
     return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(value / cell))) &
-           0xffffu;
+           ((std::uint64_t{1} << width) - 1);
   };
-  return bits(p.x, o.cell_xy) << 48 | bits(p.y, o.cell_xy) << 32 | bits(p.v, o.cell_v) << 16 |
-         bits(p.heading, o.cell_heading);
+  return bits(p.x, c.xy, 14) << 50 | bits(p.y, c.xy, 14) << 36 | bits(p.v, c.v, 12) << 24 |
+         bits(p.heading, c.heading, 12) << 12 | bits(p.curvature, c.curvature, 12);
 }
 
 // splitmix64's finaliser: a cell's place in the checking order.
@@ -61,16 +66,23 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
     s.orientation = p.heading;
     return !checker.CollisionAt(s) && !checker.OffRoadAt(s);
   };
+  const double wheelbase = vehicle.Wheelbase();
   std::vector<Point> now{{problem.initial.position.x, problem.initial.position.y,
                           std::clamp(problem.initial.velocity.value_or(0.0), 0.0, vehicle.v_max),
-                          problem.initial.orientation.value_or(0.0)}};
+                          problem.initial.orientation.value_or(0.0),
+                          std::tan(problem.initial.steering_angle.value_or(0.0)) / wheelbase}};
   if (!valid(now[0], first)) return r;
-  // The largest curvature the steering angle allows.
+  // The path's curvature within the steering angle's limit, and its change in a step within
+  // what the steering rate allows (d tan(delta) / dt = delta' / cos^2 delta >= delta').
   const double max_curvature =
-      std::tan(std::max(std::abs(vehicle.steering_min), std::abs(vehicle.steering_max))) /
-      vehicle.Wheelbase();
-  const double lateral[5] = {-options.lateral_accel, -0.5 * options.lateral_accel, 0.0,
-                             0.5 * options.lateral_accel, options.lateral_accel};
+      std::tan(std::min(std::abs(vehicle.steering_min), std::abs(vehicle.steering_max))) /
+      wheelbase;
+  const double turn =
+      std::min(std::abs(vehicle.steering_rate_min), std::abs(vehicle.steering_rate_max)) * dt /
+      wheelbase;
+  const double turns[5] = {-turn, -0.5 * turn, 0.0, 0.5 * turn, turn};
+  const Cells cells{options.cell_xy, options.cell_v, options.cell_heading, options.cell_curvature};
+  const Cells strata_cells{2.0, 1.0, 1e3, 1e3};  // position and speed only
   std::vector<std::pair<std::uint64_t, Point>> next;
   std::unordered_set<std::uint64_t> seen;
   std::unordered_map<std::uint64_t, std::size_t> strata;
@@ -85,15 +97,16 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
       for (const double a : forward) {
         const double v1 = std::clamp(p.v + a * dt, 0.0, vehicle.v_max);
         const double v_mid = 0.5 * (p.v + v1);
-        for (const double a_lat : lateral) {
-          if (a * a + a_lat * a_lat > vehicle.a_max * vehicle.a_max) continue;
-          const double curvature =
-              std::clamp(a_lat / std::max(v_mid * v_mid, 1.0), -max_curvature, max_curvature);
-          const double h1 = p.heading + curvature * v_mid * dt;
+        for (const double dk : turns) {
+          const double k1 = std::clamp(p.curvature + dk, -max_curvature, max_curvature);
+          // The friction circle: forward and lateral (v^2 curvature) acceleration together.
+          const double lateral = v1 * v1 * k1;
+          if (a * a + lateral * lateral > vehicle.a_max * vehicle.a_max) continue;
+          const double h1 = p.heading + 0.5 * (p.curvature + k1) * v_mid * dt;
           const double h_mid = 0.5 * (p.heading + h1);
           const Point q{p.x + v_mid * dt * std::cos(h_mid), p.y + v_mid * dt * std::sin(h_mid), v1,
-                        h1};
-          const std::uint64_t cell = CellOf(q, options);
+                        h1, k1};
+          const std::uint64_t cell = CellOf(q, cells);
           if (seen.insert(cell).second) next.push_back({cell, q});
         }
       }
@@ -109,8 +122,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
     rank.resize(next.size());
     for (std::size_t i = 0; i < next.size(); ++i) {
       const Point& q = next[i].second;
-      const std::uint64_t stratum =
-          CellOf({q.x, q.y, q.v, 0.0}, {.cell_xy = 2.0, .cell_v = 1.0, .cell_heading = 1.0});
+      const std::uint64_t stratum = CellOf(q, strata_cells);
       rank[i] = {strata[stratum]++, i};
     }
     std::sort(rank.begin(), rank.end());

@@ -3,17 +3,18 @@
 //
 // A breadth-first search of the states the vehicle can reach, step by step from the problem's
 // initial state, each state kept only while the verdict's own collision and road checks
-// (VerdictChecker::CollisionAt, OffRoadAt) pass. The vehicle is a point moving along its
-// heading: at each step one of five forward accelerations (from -a_max to the KS limit at its
-// speed, VehicleParams::MaxAcceleration) and one of five lateral accelerations (the path's
-// curvature, within the steering angle's limit and the friction circle a_max); the steering
-// rate is not bounded. States are merged on a grid (position, speed, heading cells), and when
-// more than max_states are left at a step a random-like spread of them is kept (the first
-// valid ones in the order of a hash of their cells: deterministic).
+// (VerdictChecker::CollisionAt, OffRoadAt) pass. The vehicle moves along its heading with the
+// KS model's limits: at each step one of five forward accelerations (from -a_max to the limit
+// at its speed, VehicleParams::MaxAcceleration) and one of five changes of its path's curvature
+// (up to what the steering rate allows in a step, tan(delta) / wheelbase within the steering
+// angle's limit), the forward and lateral (v^2 curvature) accelerations within the friction
+// circle a_max. States are merged on a grid (position, speed, heading and curvature cells), and
+// when more than max_states are valid at a step a spread of them over coarse strata of position
+// and speed is kept (deterministic).
 //
-// So the model is looser than KS in one way (the steering rate) and coarser in another (the
-// grid and the cap): a way found is a strong hint that the problem has a solution, none found
-// with `exhaustive` (no step capped) a strong hint that it has none. Neither is a proof.
+// So the model is coarser than KS (five choices of each input a step, the grid, the cap): a way
+// found is strong evidence that the problem has a solution; none found, with `exhaustive` (no
+// step capped), that it has none. Neither is a proof.
 #pragma once
 
 #include <cstdint>
@@ -26,12 +27,12 @@
 namespace frenetic::commonroad {
 
 struct WayThroughOptions {
-  int max_states = 10000;      // states kept per step (an even spread when more)
-  int max_steps = 200;         // steps searched at most after the initial one
-  double lateral_accel = 4;    // m/s^2, the largest lateral acceleration tried (also half of it)
-  double cell_xy = 0.25;       // m, grid cell of the position
-  double cell_v = 0.25;        // m/s, of the speed
-  double cell_heading = 0.01;  // rad, of the heading
+  int max_states = 10000;         // valid states kept per step (a spread when more)
+  int max_steps = 200;            // steps searched at most after the initial one
+  double cell_xy = 0.25;          // m, grid cell of the position
+  double cell_v = 0.25;           // m/s, of the speed
+  double cell_heading = 0.01;     // rad, of the heading
+  double cell_curvature = 0.002;  // 1/m, of the path's curvature
 };
 
 struct WayThrough {
