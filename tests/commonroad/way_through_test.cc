@@ -19,7 +19,7 @@ using testing::GoalTimeOnlyXml;
 using testing::ScenarioXml;
 using testing::StateXml;
 
-// A car `length` m long driving along +x at `v` m/s from x0 in the lane at y, steps 0..steps.
+// A car driving along +x at `v` m/s from x0, at y, its states at steps 0..steps.
 std::vector<StateXml> Car(double x0, double y, double v, int steps) {
   std::vector<StateXml> out;
   for (int k = 0; k <= steps; ++k) out.push_back({k, {x0 + v * 0.1 * k, y}, 0.0, v});
