@@ -60,6 +60,9 @@ constexpr Default kDefaults[] = {
     {"grid.lat_max_duration", 4.0, 1, 8, false},
     {"grid.lat_offsets", 1, 1, 7, false},
     {"grid.lat_offset_step", 0.3, 0.05, 1, false},
+    {"grid.escape_lat_offsets", 0, 0, 7, false},
+    {"grid.escape_lat_offset_step", 1.0, 0.05, 2, false},
+    {"grid.limit_ramps", 0, 0, 1, false},
     {"grid.lane_reach", 2.5, 1, 4, false},
     {"grid.lat_delays", 2, 0, 4, false},
     {"grid.lat_delay_step", 1.5, 0.5, 3, false},
@@ -222,6 +225,9 @@ Status PlannerConfig::Validate() const {
     return err("continuity.keep_points must leave room in continuity.output_points");
   }
   if (int_value("grid.lat_offsets") % 2 == 0) return err("grid.lat_offsets must be odd");
+  if (int_value("grid.escape_lat_offsets") > 0 && int_value("grid.escape_lat_offsets") % 2 == 0) {
+    return err("grid.escape_lat_offsets must be odd (or 0: grid.lat_offsets)");
+  }
   auto set = cost::CostSet::Build(cost_terms());
   if (!set.ok()) return err(set.message());
   return Status::Ok();

@@ -19,6 +19,7 @@ constexpr double kStandingGoal = 0.5;
 constexpr double kLaneLimitStep = 0.05;
 // m/s: a lane's limit this far above the start's speed is worth a constant-acceleration run.
 constexpr double kAccelMinGain = 1.0;
+constexpr double kLimitRampShare = 0.97;  // of the vehicle's limit (AddLimitRamps)
 // m along s: the road is free for a constant-acceleration run when no car is from this far
 // behind to this far ahead of the ego (a run from a standstill to the limit takes ~60 m).
 constexpr double kAccelFreeBehind = 20.0, kAccelFreeAhead = 100.0;
@@ -423,6 +424,26 @@ void Lattice::AddAccelerating(const bool reachable[], double vmax) {
   }
 }
 
+// With a vehicle's limits, in any traffic: to each end speed of the grid above the ego's, the
+// constant acceleration the vehicle can hold up to it (a_max, or a_max v_switch / v above the
+// switch speed, at the end speed; 3% inside), within limits.max_accel. In recorded traffic that
+// closes in from behind at twice the ego's speed (highD), the polynomials, which start from the
+// present acceleration, gain too little in the first second.
+void Lattice::AddLimitRamps(double vgrid) {
+  const VehicleLimits& veh = cfg_.vehicle;
+  if (!(veh.max_accel > 0)) return;
+  const double v0 = std::max(ws_.start.s_d, 0.0);
+  for (int vi = 0; vi < cfg_.grid.speeds; ++vi) {
+    const double target = Linspace(0, vgrid, cfg_.grid.speeds, vi);
+    if (target - v0 < kAccelMinGain) continue;
+    const double limit = veh.switch_speed > 0 && target > veh.switch_speed
+                             ? veh.max_accel * veh.switch_speed / target
+                             : veh.max_accel;
+    const double a = kLimitRampShare * std::min(limit, cfg_.limits.max_accel);
+    AddLon(MakeLon(cost::LonKind::kAccelerating, -1, a, (target - v0) / a));
+  }
+}
+
 double ReachableSpeed(const VehicleLimits& veh, double max_accel, double v0, double T) {
   if (!(veh.max_accel > 0)) return v0 + max_accel * T;
   // dv/dt = a up to the switch speed, a v_switch / v above it (v^2 grows linearly).
@@ -502,6 +523,7 @@ void Lattice::Generate() {
     if (di == 0) {
       AddBraking();
       AddAccelerating(reachable, vmax);
+      if (cfg_.grid.limit_ramps) AddLimitRamps(vgrid);
     }
     for (int l = 0; l < cfg_.road.num_lanes; ++l) {
       if (!reachable[l]) continue;
@@ -531,10 +553,10 @@ void Lattice::Generate() {
     for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
       const double T =
           Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti);
-      for (int oi = 0; oi < cfg_.lat.offsets; ++oi) {
-        const double off = (oi - cfg_.lat.offsets / 2) * cfg_.lat.offset_step;
-        AddLat(MakeLat(l, off, T));
-      }
+      const bool wide = ws_.escape && cfg_.lat.escape_offsets > 0;
+      const int offsets = wide ? cfg_.lat.escape_offsets : cfg_.lat.offsets;
+      const double step = wide ? cfg_.lat.escape_offset_step : cfg_.lat.offset_step;
+      for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * step, T));
     }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives

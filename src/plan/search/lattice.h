@@ -76,6 +76,7 @@ class Lattice {
   void AddBraking();
   void AddGapTargets(int lane, double T);
   void AddAccelerating(const bool reachable[], double vmax);
+  void AddLimitRamps(double vgrid);
   void AddSwerves();
   void AddSwerveUnderWay();
   void AddPasses();

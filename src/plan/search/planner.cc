@@ -181,6 +181,7 @@ class SearchPlanner : public Planner {
     bool least_harm = false;  // none did: the least harmful feasible one was taken instead
     bool over_budget = false;
     if (!invalid || synced) {
+      ws_.escape = none_passed_last_;
       lattice_.Generate();
       sum.candidates_generated = static_cast<int>(ws_.cand_lon.size());
       sum.ms_generate = Elapsed() - sum.ms_prepare;

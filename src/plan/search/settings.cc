@@ -54,11 +54,14 @@ Settings::Settings(const PlannerConfig& c) {
   grid.accels = c.int_value("grid.accels");
   grid.accel_min = c.value("grid.min_accel");
   grid.accel_max = c.value("grid.max_accel");
+  grid.limit_ramps = c.int_value("grid.limit_ramps") != 0;
   lat.durations = c.int_value("grid.lat_durations");
   lat.min_duration = c.value("grid.lat_min_duration");
   lat.max_duration = c.value("grid.lat_max_duration");
   lat.offsets = c.int_value("grid.lat_offsets");
   lat.offset_step = c.value("grid.lat_offset_step");
+  lat.escape_offsets = c.int_value("grid.escape_lat_offsets");
+  lat.escape_offset_step = c.value("grid.escape_lat_offset_step");
   grid.lane_reach = c.value("grid.lane_reach");
   lat.delays = c.int_value("grid.lat_delays");
   grid.passes = c.int_value("grid.passes") != 0;

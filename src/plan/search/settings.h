@@ -65,6 +65,9 @@ struct Settings {
     bool stop = false;                    // stopping trajectories
     int accels = 0;                       // constant accelerations between accel_min and accel_max
     double accel_min = 0, accel_max = 0;  // m/s^2 (grid.min_accel, grid.max_accel)
+    // With a vehicle's limits (vehicle.max_accel): constant accelerations at its limit at each end
+    // speed of the grid, to that speed, in any traffic (grid.limit_ramps).
+    bool limit_ramps = false;
     double lane_reach = 0;  // lane widths: lanes whose centre is this near are targets
     bool passes = false;    // passes on a two-way road's oncoming lane (AddPasses)
   };
@@ -80,6 +83,10 @@ struct Settings {
     double min_duration = 0, max_duration = 0;
     int offsets = 0;  // offsets from a lane's centre, offset_step (m) apart
     double offset_step = 0;
+    // When the last search found no candidate passing (Workspace::escape): these offsets
+    // instead (grid.escape_lat_offsets, 0: the same as above; grid.escape_lat_offset_step).
+    int escape_offsets = 0;
+    double escape_offset_step = 0;
     int delays = 0;  // delayed starts, delay_step (s) apart
     double delay_step = 0;
   };

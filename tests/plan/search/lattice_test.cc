@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <utility>
+#include <vector>
 
 #include "plan/search/stages_testing.h"
 
@@ -323,6 +326,86 @@ TEST(SearchLatticeTest, RunsUpToTheLimitAtConstantAccelerationBelowIt) {
   PrepareCentred(far, 0.0, 0, {{kS + 110, 10.0, 20.0}});
   far.lattice.Generate();
   EXPECT_EQ(Count(far.ws, cost::LonKind::kAccelerating), c.grid.accels);
+}
+
+// With a vehicle's limits and grid.limit_ramps: to each end speed of the grid at least 1 m/s
+// above the ego's, a constant acceleration at 97% of what the vehicle holds at that speed
+// (a_max v_switch / v above the switch speed), even with a car 15 m behind, where the free-road
+// runs are not offered. Neither without the setting nor without a vehicle.
+TEST(SearchLatticeTest, LimitRampsRunAtTheVehiclesLimitInAnyTraffic) {
+  REQUIRE_UDACITY_MAP();
+  const auto config = [](bool ramps, double vehicle_accel) {
+    PlannerConfig c = GridOnly();
+    EXPECT_TRUE(c.Set("grid.accels", 0).ok());
+    EXPECT_TRUE(c.Set("grid.limit_ramps", ramps ? 1 : 0).ok());
+    EXPECT_TRUE(c.Set("vehicle.max_accel", vehicle_accel).ok());
+    EXPECT_TRUE(c.Set("vehicle.switch_speed", 7.319).ok());
+    return c;
+  };
+  const std::vector<SceneCar> behind = {{kS - 15, 2.0, 20.0}};
+  Stages st(config(true, 9.775));
+  PrepareCentred(st, 10.0, 0, behind);
+  st.lattice.Generate();
+  std::set<double> grid;  // the end speeds of velocity keeping
+  for (const LonTraj& l : st.ws.lon) {
+    if (l.kind == cost::LonKind::kVelocityKeeping) {
+      grid.insert(std::round(l.traj.At(l.traj.duration).v * 1e6) / 1e6);
+    }
+  }
+  int expected = 0;
+  for (const double v : grid) expected += v - 10.0 >= 1.0;
+  ASSERT_GT(expected, 3);
+  EXPECT_EQ(Count(st.ws, cost::LonKind::kAccelerating), expected);
+  for (const LonTraj& l : st.ws.lon) {
+    if (l.kind != cost::LonKind::kAccelerating) continue;
+    const double end = l.traj.At(l.traj.duration).v;
+    EXPECT_EQ(l.lane, -1);
+    EXPECT_TRUE(std::any_of(grid.begin(), grid.end(), [end](double v) {
+      return std::abs(v - end) < 1e-6;
+    })) << end;
+    const double limit =
+        std::min(end > 7.319 ? 9.775 * 7.319 / end : 9.775, st.cfg.limits.max_accel);
+    EXPECT_NEAR(l.param, 0.97 * limit, 1e-12) << end;
+    // At once, not from the present acceleration.
+    EXPECT_NEAR(l.traj.At(0.5 * l.traj.duration).a, l.param, 1e-9);
+  }
+  for (const auto& [ramps, accel] : {std::pair{false, 9.775}, std::pair{true, 0.0}}) {
+    Stages off(config(ramps, accel));
+    PrepareCentred(off, 10.0, 0, behind);
+    off.lattice.Generate();
+    EXPECT_EQ(Count(off.ws, cost::LonKind::kAccelerating), 0) << ramps << " " << accel;
+  }
+}
+
+// After a search where nothing passed (Workspace::escape), the lateral moves end at
+// grid.escape_lat_offsets offsets, escape_lat_offset_step apart, around each lane's centre
+// instead of grid.lat_offsets: out to a lane's edge, where two lanes of cars may pass by.
+TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig c = GridOnly();
+  ASSERT_TRUE(c.Set("grid.escape_lat_offsets", 5).ok());
+  ASSERT_TRUE(c.Set("grid.escape_lat_offset_step", 1.0).ok());
+  Stages st(c);
+  for (const bool escape : {false, true}) {
+    PrepareCentred(st, 20);
+    st.ws.escape = escape;
+    st.lattice.Generate();
+    std::set<double> offsets;
+    int neighbour = 0;
+    for (const LatTraj& l : st.ws.lat) {
+      offsets.insert(l.offset);
+      neighbour += l.lane == 0 && l.traj.delay == 0;
+    }
+    if (escape) {
+      EXPECT_EQ(offsets, (std::set<double>{-2.0, -1.0, 0.0, 1.0, 2.0}));
+      EXPECT_EQ(neighbour, st.cfg.lat.durations * 5);
+    } else {
+      EXPECT_EQ(offsets, (std::set<double>{0.0}));  // the shipped grid.lat_offsets: 1
+      EXPECT_EQ(neighbour, st.cfg.lat.durations);
+    }
+  }
+  // Odd counts only (0: the same as grid.lat_offsets).
+  EXPECT_FALSE(c.Set("grid.escape_lat_offsets", 4).ok());
 }
 
 // On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets
