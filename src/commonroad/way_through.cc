@@ -82,7 +82,8 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
       wheelbase;
   const double turns[5] = {-turn, -0.5 * turn, 0.0, 0.5 * turn, turn};
   const Cells cells{options.cell_xy, options.cell_v, options.cell_heading, options.cell_curvature};
-  const Cells strata_cells{2.0, 1.0, 1e3, 1e3};  // position and speed only
+  // Strata of position and speed; the 1e3 cells leave of heading and curvature only their sign.
+  const Cells strata_cells{2.0, 1.0, 1e3, 1e3};
   std::vector<std::pair<std::uint64_t, Point>> next;
   std::unordered_set<std::uint64_t> seen;
   std::unordered_map<std::uint64_t, std::size_t> strata;

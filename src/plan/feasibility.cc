@@ -120,10 +120,7 @@ void XyChecker::WorstVehicle(int n, int first, XyMeasure* m) const {
     }
     if (lim.max_accel > 0) {
       const double v0 = vmean(j - b), a = (vmean(j) - v0) / bt;
-      const double limit =
-          lim.switch_speed > 0 && v0 > lim.switch_speed ? lim.max_accel * lim.switch_speed / v0
-                                                         : lim.max_accel;
-      m->forward_accel_ratio = std::max(m->forward_accel_ratio, a / limit);
+      m->forward_accel_ratio = std::max(m->forward_accel_ratio, a / lim.MaxForwardAccel(v0));
     }
   }
   if (lim.max_steer > 0) m->steer_ratio = std::atan(max_tan) / lim.max_steer;

@@ -29,6 +29,11 @@ struct VehicleLimits {
   double max_accel = 0;       // m/s^2, forward
   double switch_speed = 0;    // m/s
   bool any() const { return max_steer > 0 || max_steer_rate > 0 || max_accel > 0; }
+  // The forward acceleration allowed at speed v (m/s^2): max_accel up to switch_speed,
+  // max_accel switch_speed / v above it.
+  double MaxForwardAccel(double v) const {
+    return switch_speed > 0 && v > switch_speed ? max_accel * switch_speed / v : max_accel;
+  }
 };
 
 // The Menger curvature of three points as the simulator computes it, 2 sin(theta) / |p3 - p1|

@@ -436,10 +436,7 @@ void Lattice::AddLimitRamps(double vgrid) {
   for (int vi = 0; vi < cfg_.grid.speeds; ++vi) {
     const double target = Linspace(0, vgrid, cfg_.grid.speeds, vi);
     if (target - v0 < kAccelMinGain) continue;
-    const double limit = veh.switch_speed > 0 && target > veh.switch_speed
-                             ? veh.max_accel * veh.switch_speed / target
-                             : veh.max_accel;
-    const double a = kLimitRampShare * std::min(limit, cfg_.limits.max_accel);
+    const double a = kLimitRampShare * std::min(veh.MaxForwardAccel(target), cfg_.limits.max_accel);
     AddLon(MakeLon(cost::LonKind::kAccelerating, -1, a, (target - v0) / a));
   }
 }
@@ -545,6 +542,10 @@ void Lattice::Generate() {
   // Laterally at rest (keeping a lane): one duration stands for all for the own lane (they
   // coincide), and lane changes may also wait before they start.
   const bool at_rest = std::abs(start.d_d) < 0.2 && std::abs(start.d_dd) < 0.5;
+  // The end offsets around a lane's centre: wider after a search where nothing passed.
+  const bool wide = ws_.none_passed_last && cfg_.lat.escape_offsets > 0;
+  const int offsets = wide ? cfg_.lat.escape_offsets : cfg_.lat.offsets;
+  const double offset_step = wide ? cfg_.lat.escape_offset_step : cfg_.lat.offset_step;
   for (int l = 0; l < cfg_.road.num_lanes; ++l) {
     if (!reachable[l]) continue;
     const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.road.lane_width;
@@ -553,10 +554,7 @@ void Lattice::Generate() {
     for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
       const double T =
           Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti);
-      const bool wide = ws_.escape && cfg_.lat.escape_offsets > 0;
-      const int offsets = wide ? cfg_.lat.escape_offsets : cfg_.lat.offsets;
-      const double step = wide ? cfg_.lat.escape_offset_step : cfg_.lat.offset_step;
-      for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * step, T));
+      for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, T));
     }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives

@@ -109,7 +109,7 @@ class SearchPlanner : public Planner {
     ws_.lane_before_change = -1;
     ws_.time_since_change = 1e9;
     sim_time_ = NAN;
-    none_passed_last_ = false;
+    ws_.none_passed_last = false;
     predictor_->Reset();
   }
 
@@ -181,7 +181,6 @@ class SearchPlanner : public Planner {
     bool least_harm = false;  // none did: the least harmful feasible one was taken instead
     bool over_budget = false;
     if (!invalid || synced) {
-      ws_.escape = none_passed_last_;
       lattice_.Generate();
       sum.candidates_generated = static_cast<int>(ws_.cand_lon.size());
       sum.ms_generate = Elapsed() - sum.ms_prepare;
@@ -194,9 +193,9 @@ class SearchPlanner : public Planner {
       sum.ms_score = Elapsed() - t_score;
       const double t_check = Elapsed();
       bool check_cut = false;
-      const bool none_passed_before = none_passed_last_;
+      const bool none_passed_before = ws_.none_passed_last;
       found = selection_.Select(none_passed_before, &sum, &check_cut);
-      none_passed_last_ = !found && !check_cut;
+      ws_.none_passed_last = !found && !check_cut;
       if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut, none_passed_before);
       if (check_cut) {
         over_budget = true;
@@ -322,7 +321,6 @@ class SearchPlanner : public Planner {
   search::LaneEnds lane_ends_;
 
   std::vector<double> per_term_;   // unweighted term values (EvaluateWinnerCosts)
-  bool none_passed_last_ = false;  // the last search's checks found no candidate passing
   double sim_time_ = NAN;          // s, simulated time of the current message (NaN: unknown)
   PlanResult result_;
 };

@@ -83,7 +83,7 @@ struct Settings {
     double min_duration = 0, max_duration = 0;
     int offsets = 0;  // offsets from a lane's centre, offset_step (m) apart
     double offset_step = 0;
-    // When the last search found no candidate passing (Workspace::escape): these offsets
+    // When the last search found no candidate passing (Workspace::none_passed_last): these offsets
     // instead (grid.escape_lat_offsets, 0: the same as above; grid.escape_lat_offset_step).
     int escape_offsets = 0;
     double escape_offset_step = 0;

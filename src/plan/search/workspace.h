@@ -168,9 +168,10 @@ struct Workspace {
   // The last decision, kept across cycles: the previous winner (consistency cost, the lateral
   // move under way, the fallback ContinuePrevious) and the lane-change timer.
   bool have_prev_traj = false;
-  // The last search found no candidate passing (a box-in): the lattice widens its lateral
-  // offsets (Settings::Lateral::escape_offsets).
-  bool escape = false;
+  // The last search's checks found no candidate passing (a box-in): the lattice widens its
+  // lateral offsets (Settings::Lateral::escape_offsets), and the selection and least harm take
+  // it as a hint for their order of work.
+  bool none_passed_last = false;
   traj::FrenetTrajectory prev_traj;
   double prev_elapsed = 0;  // s: the current start's time on prev_traj
   double prev_base = 0;     // s: the stored plan start's time on prev_traj (see ContinuePrevious)

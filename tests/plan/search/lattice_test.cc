@@ -377,7 +377,7 @@ TEST(SearchLatticeTest, LimitRampsRunAtTheVehiclesLimitInAnyTraffic) {
   }
 }
 
-// After a search where nothing passed (Workspace::escape), the lateral moves end at
+// After a search where nothing passed (Workspace::none_passed_last), the lateral moves end at
 // grid.escape_lat_offsets offsets, escape_lat_offset_step apart, around each lane's centre
 // instead of grid.lat_offsets: out to a lane's edge, where two lanes of cars may pass by.
 TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
@@ -388,7 +388,7 @@ TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
   Stages st(c);
   for (const bool escape : {false, true}) {
     PrepareCentred(st, 20);
-    st.ws.escape = escape;
+    st.ws.none_passed_last = escape;
     st.lattice.Generate();
     std::set<double> offsets;
     int neighbour = 0;
