@@ -64,6 +64,7 @@ struct Args {
   int jobs = 0;
   bool progress = false;
   bool no_timing = false;
+  bool no_rescue = false;
   bool way_through = false;
 };
 
@@ -208,6 +209,7 @@ StatusOr<Setup> Prepare(const Args& a) {
   setup.options.prediction = *prediction;
   setup.options.vehicle_type = a.vehicle;
   setup.options.timing = !a.no_timing;
+  setup.options.rescue = !a.no_rescue;
   if (Status st = setup.options.Validate(); !st.ok()) {
     return Status::Error("--vehicle: " + st.message());
   }
@@ -408,6 +410,15 @@ void RegisterCommonRoad(CLI::App& app) {
                 "Show the progress line on stderr even when it is not a terminal");
   sub->add_flag("--no-timing", args->no_timing,
                 "Report planning times as 0 (byte-stable output for the same files)");
+  sub->add_flag("--no-rescue", args->no_rescue,
+                "Drive the planner's path even when it would hit a predicted car. By default the "
+                "path is checked against the predictions (the cars' boxes every step, 4 s ahead) "
+                "and, when it hits one, a search of the vehicle's own KS inputs (five "
+                "accelerations and five steering rates a step, within 97% of its limits and the "
+                "friction circle, the ego's box 0.05 m wider, on the road between its edges, at "
+                "most 150 states a step) looks for a way that meets a goal region or lasts the 4 "
+                "s; the ego drives its first step, and the rest of it while it stays clear. Its "
+                "time counts as planning time. Default: off (the rescue runs)");
   sub->add_flag("--way-through", args->way_through,
                 "For each problem left unsolved (not infeasible at start), search whether any way "
                 "through its traffic exists, to tell a planner's miss from a problem with no "

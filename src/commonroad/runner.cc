@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/observation.h"
@@ -380,6 +381,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     run.trajectory.push_back(ego);
     plan::Telemetry t;
     std::vector<double> path_x, path_y;
+    std::optional<Rescue> rescue;
+    if (options.rescue) rescue.emplace(road, vp, dt);
     run.stop_reason = "time";
     for (int k = start; k < end; ++k) {
       bool met = false;
@@ -421,7 +424,6 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
       const plan::PlanResult& res = (*planner)->Plan(t);
-      const auto t_planned = std::chrono::steady_clock::now();
       if (options.on_plan) options.on_plan(input, res);
       if (tracing) {
         // The best candidate of each lane: its cost by term and what became of it.
@@ -440,7 +442,23 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         }
         (*planner)->set_trace(nullptr, 0);
       }
-      const double ms = std::chrono::duration<double, std::milli>(t_planned - t0).count();
+      // The planner's path against the predictions: when it hits a car, the rescue's way if
+      // one lasts longer.
+      std::optional<KsInput> rescue_input;
+      if (rescue) {
+        rescue->Predict(t);
+        const int hit = rescue->PathHit(res.x, res.y);
+        if (hit > 0) {
+          rescue_input = rescue->Next(ego, t.goals);
+          spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue {}",
+                        sc.benchmark_id, problem.id, k, hit,
+                        rescue_input ? "drives its way" : "found no way");
+        } else {
+          rescue->Drop();
+        }
+      }
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       RunCycle cyc;
       cyc.step = k;
       cyc.plan_ms = options.timing ? ms : 0.0;
@@ -449,12 +467,23 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       cyc.status = res.status;
       // The ego drives dt along the plan.
       const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
-      ego = FollowPath(ego, res.x, res.y, dt, vp);
-      ego.time_step = k + 1;
-      const size_t j = std::min<size_t>(ticks - 1, res.x.empty() ? 0 : res.x.size() - 1);
-      if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);
-      path_x.assign(res.x.begin() + std::min<size_t>(ticks, res.x.size()), res.x.end());
-      path_y.assign(res.y.begin() + std::min<size_t>(ticks, res.y.size()), res.y.end());
+      if (rescue_input) {
+        // The way's input, exactly (the search simulated it); the planner gets the rest of the
+        // way as its previous path.
+        cyc.rescued = true;
+        rescue->Points(ego, &path_x, &path_y);
+        path_x.erase(path_x.begin(), path_x.begin() + std::min<size_t>(ticks, path_x.size()));
+        path_y.erase(path_y.begin(), path_y.begin() + std::min<size_t>(ticks, path_y.size()));
+        ego = SimulateKs(ego, *rescue_input, dt, vp);
+        ego.time_step = k + 1;
+      } else {
+        ego = FollowPath(ego, res.x, res.y, dt, vp);
+        ego.time_step = k + 1;
+        const size_t j = std::min<size_t>(ticks - 1, res.x.empty() ? 0 : res.x.size() - 1);
+        if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);
+        path_x.assign(res.x.begin() + std::min<size_t>(ticks, res.x.size()), res.x.end());
+        path_y.assign(res.y.begin() + std::min<size_t>(ticks, res.y.size()), res.y.end());
+      }
       run.trajectory.push_back(ego);
       // A collision or a box off the road fails the problem whatever follows: the run ends.
       if (checker.CollisionAt(ego)) {

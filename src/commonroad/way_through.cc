@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "frenetic/commonroad/ks_model.h"
+#include "commonroad/reach_grid.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -21,22 +22,9 @@ struct Cells {
   double xy, v, heading, curvature;
 };
 
-// The grid cell of a state, packed in 64 bits (x, y 14 bits each, the others 12, wrapping: two
-// states that far apart never meet in one step's set).
 std::uint64_t CellOf(const Point& p, const Cells& c) {
-  const auto bits = [](double value, double cell, int width) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(value / cell))) &
-           ((std::uint64_t{1} << width) - 1);
-  };
-  return bits(p.x, c.xy, 14) << 50 | bits(p.y, c.xy, 14) << 36 | bits(p.v, c.v, 12) << 24 |
-         bits(p.heading, c.heading, 12) << 12 | bits(p.curvature, c.curvature, 12);
-}
-
-// splitmix64's finaliser: a cell's place in the checking order.
-std::uint64_t Mix(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-  return z ^ (z >> 31);
+  const double cell[5] = {c.xy, c.xy, c.v, c.heading, c.curvature};
+  return reach::CellOf(p.x, p.y, p.v, p.heading, p.curvature, cell);
 }
 
 }  // namespace
@@ -116,7 +104,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
     // order of a hash of the cells (deterministic, and unrelated to where they are), until
     // max_states are valid: a capped step keeps a spread over positions and speeds, the rare
     // slow states (the ones that stop before a wall) with the many fast ones.
-    for (auto& [cell, q] : next) cell = Mix(cell);
+    for (auto& [cell, q] : next) cell = reach::Mix(cell);
     std::sort(next.begin(), next.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
     strata.clear();

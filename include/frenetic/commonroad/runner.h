@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "frenetic/commonroad/ks_model.h"
+#include "frenetic/commonroad/rescue.h"
 #include "frenetic/commonroad/scenario.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/commonroad/verdict.h"
@@ -60,6 +61,9 @@ struct RunOptions {
   PredictionMode prediction = PredictionMode::kRecorded;
   int vehicle_type = 2;  // CommonRoad vehicle 1, 2 or 3 (KS1..KS3)
   bool timing = true;    // false: planning times are recorded as 0 (byte-stable output)
+  // When the planner's path would hit a predicted car or leave the road, drive a way the
+  // rescue finds instead (rescue.h); its time counts as planning time.
+  bool rescue = true;
   // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
   std::function<void(const CycleInput&)> on_cycle;
   // Called after each Plan() with its input and result (the ego has not moved yet; the time it
@@ -78,6 +82,7 @@ struct RunCycle {
   int candidates = 0, checked = 0;
   plan::PlanStatus status = plan::PlanStatus::kOk;
   double tracking_error = 0;  // m: the ego's centre after the step from the planned one
+  bool rescued = false;       // the ego drove the rescue's way, not the planner's path
 };
 
 struct ProblemRun {

@@ -1,0 +1,122 @@
+// The closed loop's rescue: when the path the planner sends would hit a predicted car, or
+// leave the road, within a few seconds, a search of the vehicle's own KS inputs looks for a way
+// that does not, and the ego drives that way's first input instead.
+//
+// The lattice planner's candidates are a few thousand smooth Frenet manoeuvres; in recorded
+// highway traffic the only way through a box-in is sometimes none of them: full acceleration
+// from the first step, a lateral move of a metre and a half in a second, then a hold at the
+// lane's edge while the cars of two lanes pass 0.2 m away. The rescue searches that space
+// directly: breadth first over the KS model's states, step by step (the scenario's dt), at each
+// step five accelerations (from -a_max to the limit at the speed) and five steering rates, all
+// within `limit_share` of the vehicle's limits and within its friction circle; a state is kept
+// while the ego's box (grown by `ego_margin`) is clear of every predicted car's box at that step
+// and lies between the road's edges (the planner's road, its ends closed). It uses what the
+// planner was told and nothing else: the telemetry's futures of the cars (recorded
+// predictions), else each car carried on at its velocity. States share grid cells; above
+// `max_states` valid states a step keeps a spread over coarse strata of position and speed.
+//
+// The way kept is the one that lasts longest, and of those the one farthest along the road.
+// Each later cycle the rest of it is checked again from the ego's state against the new
+// predictions and kept while it stays clear for at least half the horizon; otherwise a new
+// search runs. The way only stands in for the planner's path while that path still hits, and
+// only when it lasts longer than that path.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "frenetic/commonroad/ks_model.h"
+#include "frenetic/cost/goal_region.h"
+#include "frenetic/commonroad/vehicle_params.h"
+#include "frenetic/map/road.h"
+#include "frenetic/plan/telemetry.h"
+#include "frenetic/traj/box.h"
+
+namespace frenetic::commonroad {
+
+struct RescueOptions {
+  int steps = 40;             // steps searched ahead (4 s at the benchmark's 0.1 s)
+  int max_states = 150;       // valid states kept per step (a spread when more)
+  double limit_share = 0.97;  // of the vehicle's acceleration, steering and steering-rate limits
+  double ego_margin = 0.05;   // m added to each side of the ego's box
+  double car_length = 5.0;    // m, the footprint of a car whose row gives none
+  double car_width = 2.0;
+};
+
+class Rescue {
+ public:
+  // `road` must outlive the rescue; dt: the scenario's step, s.
+  Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
+         const RescueOptions& options = {});
+
+  // The predicted boxes of the telemetry's cars at steps 1..steps from its instant: a car's
+  // future where it has one (a car to come appears at its start), else its row carried on at
+  // its velocity (a car with no speed is a square of its longer side: its heading is unknown).
+  void Predict(const plan::Telemetry& t);
+
+  // The first step (1..steps) at which a path of points every plan::kTickSeconds (the first one
+  // tick from now) hits a predicted car; 0 when it does not within the steps it covers. (The
+  // road's ends are the planner's own limits; past the goal its path may run off the map.)
+  int PathHit(const std::vector<double>& x, const std::vector<double>& y) const;
+
+  // The way's input for the next step from `ego`, when a way that lasts the whole horizon (or
+  // meets a goal region of `goals`, the telemetry's) is found: the rest of the last way while
+  // it is still clear to its end and at least half the horizon long, else a new search's.
+  // nullopt when none does (the planner's path is driven then: its least harm knows the goals).
+  std::optional<KsInput> Next(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
+
+  // The way's centre points every plan::kTickSeconds from `ego` (the first one tick on): the
+  // path sent in its place.
+  void Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const;
+
+  // Forget the way (the planner's path is clear again).
+  void Drop() { way_.clear(); }
+
+  int searches() const { return searches_; }
+  std::int64_t checked() const { return checked_; }
+
+ private:
+  struct Car {
+    traj::OrientedBox box;
+    double cos_h, sin_h, radius;
+  };
+  struct Node {
+    KsState state;
+    double s, d;  // in the road's frame (s: the Frenet hint of its children)
+    int parent;  // index in the step before
+    KsInput input;
+  };
+  // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
+  // s along the road (from the hint s_hint).
+  bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
+  // The same for the cars alone.
+  bool ClearOfCars(const KsState& s, int k) const;
+  // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
+  // horizon, the nearest a goal region at its end (then the farthest along the road); its
+  // length in steps, 0 when none (way_ empty).
+  int Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
+  // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
+  // horizon's end (any region when none is; 0 without regions).
+  double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;
+  // How many steps of way_ stay clear from `ego`.
+  int Lasts(const KsState& ego);
+
+  const map::Road& road_;
+  VehicleParams vehicle_;
+  double dt_;
+  RescueOptions options_;
+  std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
+  std::vector<KsInput> way_;
+  std::vector<std::vector<Node>> layers_;
+  std::vector<std::pair<std::uint64_t, Node>> next_;
+  std::unordered_set<std::uint64_t> seen_;
+  std::unordered_map<std::uint64_t, std::size_t> strata_;
+  std::vector<std::pair<std::size_t, std::size_t>> rank_;
+  int searches_ = 0;
+  mutable std::int64_t checked_ = 0;
+};
+
+}  // namespace frenetic::commonroad

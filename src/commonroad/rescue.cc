@@ -1,0 +1,320 @@
+#include "frenetic/commonroad/rescue.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "commonroad/reach_grid.h"
+#include "frenetic/plan/planner.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+constexpr double kTick = plan::kTickSeconds;
+// Grid cells: position, speed, heading, steering angle; the strata of the spread (position,
+// speed; the 1e3 cells leave of heading and steering only their sign).
+constexpr double kCells[5] = {0.25, 0.25, 0.25, 0.01, 0.005};
+constexpr double kStrata[5] = {2.0, 2.0, 1.0, 1e3, 1e3};
+
+// A future's centre and heading at t s from its telemetry's instant; false when the car is not
+// there yet. Past its last sample it keeps its last speed and heading.
+bool FutureAt(const plan::CarFuture& f, double t, double* x, double* y, double* heading) {
+  const int n = static_cast<int>(std::min({f.x.size(), f.y.size(), f.v.size(), f.heading.size()}));
+  if (n == 0 || t < f.start - 1e-9) return false;
+  const double at = (t - f.start) / f.dt;
+  const int i = std::min(static_cast<int>(std::lround(at)), n - 1);
+  const double beyond = std::max(0.0, at - (n - 1)) * f.dt;
+  *heading = f.heading[i];
+  *x = f.x[i] + beyond * f.v[i] * std::cos(f.heading[i]);
+  *y = f.y[i] + beyond * f.v[i] * std::sin(f.heading[i]);
+  return std::isfinite(*x) && std::isfinite(*y) && std::isfinite(*heading);
+}
+
+}  // namespace
+
+double Rescue::GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const {
+  // Regions whose window is still open at the way's end (all: none is).
+  const double t_end = static_cast<double>(options_.steps) * dt_;
+  double best = std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < 2 && !std::isfinite(best); ++pass) {
+    for (const cost::GoalRegion& g : goals) {
+      if (pass == 0 && g.t_hi < t_end) continue;
+      const double d_off = g.d_slope * (n.s - g.s_ref);
+      const double ds = std::max({g.s_lo - n.s, n.s - g.s_hi, 0.0});
+      const double dd = std::max({g.d_lo + d_off - n.d, n.d - g.d_hi - d_off, 0.0});
+      best = std::min(best, std::hypot(ds, dd));
+    }
+  }
+  return std::isfinite(best) ? best : 0.0;
+}
+
+Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
+               const RescueOptions& options)
+    : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
+  options_.steps = std::max(options_.steps, 1);
+  options_.max_states = std::max(options_.max_states, 1);
+  cars_.resize(options_.steps);
+  layers_.resize(options_.steps + 1);
+}
+
+void Rescue::Predict(const plan::Telemetry& t) {
+  for (std::vector<Car>& step : cars_) step.clear();
+  const auto add = [this](int k, double x, double y, double heading, double length, double width) {
+    Car c;
+    c.box = {x, y, heading, 0.5 * length, 0.5 * width};
+    c.cos_h = std::cos(heading);
+    c.sin_h = std::sin(heading);
+    c.radius = 0.5 * std::hypot(length, width);
+    cars_[k - 1].push_back(c);
+  };
+  for (const plan::SensorCar& car : t.sensor_fusion) {
+    const double length = car.length > 0 ? car.length : options_.car_length;
+    const double width = car.width > 0 ? car.width : options_.car_width;
+    const plan::CarFuture* future = nullptr;
+    for (const plan::CarFuture& f : t.futures) {
+      if (f.id == car.id && f.start <= 0) future = &f;
+    }
+    const double speed = std::hypot(car.vx, car.vy);
+    // Without a future: on along the road at its speed along the road, at its offset from the
+    // line (the planner's own prediction keeps a car in its lane too; a straight line would
+    // run a car on a curving ramp into the next lane).
+    const map::ReferenceLine& line = road_.line();
+    const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
+    const double road_heading = line.At(fe.s).heading;
+    const double along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
+    const double rel = std::atan2(car.vy, car.vx) - road_heading;
+    for (int k = 1; k <= options_.steps; ++k) {
+      double x, y, heading;
+      if (future != nullptr) {
+        if (!FutureAt(*future, k * dt_, &x, &y, &heading)) continue;
+        add(k, x, y, heading, length, width);
+      } else if (speed > 0.1) {
+        const map::CartesianPose at = line.ToCartesian(fe.s + along * k * dt_, fe.d);
+        add(k, at.x, at.y, at.heading + rel, length, width);
+      } else {
+        const double side = std::max(length, width);
+        add(k, car.x, car.y, 0.0, side, side);
+      }
+    }
+  }
+  for (const plan::CarFuture& f : t.futures) {
+    if (f.start <= 0) continue;  // a present car's, above
+    const double length = f.length > 0 ? f.length : options_.car_length;
+    const double width = f.width > 0 ? f.width : options_.car_width;
+    for (int k = 1; k <= options_.steps; ++k) {
+      double x, y, heading;
+      if (FutureAt(f, k * dt_, &x, &y, &heading)) add(k, x, y, heading, length, width);
+    }
+  }
+}
+
+bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const {
+  ++checked_;
+  if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.orientation)) return false;
+  // The road: the box's extent along the line and across it between the edges at both ends.
+  const double hl = 0.5 * vehicle_.length + options_.ego_margin;
+  const double hw = 0.5 * vehicle_.width + options_.ego_margin;
+  const map::ReferenceLine& line = road_.line();
+  const map::FrenetPoint fe = line.ToFrenet(s.x, s.y, s_hint);
+  *at = fe;
+  const double rel = s.orientation - line.At(fe.s).heading;
+  const double c = std::abs(std::cos(rel)), sn = std::abs(std::sin(rel));
+  const double along = hl * c + hw * sn, across = hl * sn + hw * c;
+  for (const double at : {fe.s - along, fe.s + along}) {
+    const map::Road::Span e = road_.EdgesAt(at);
+    if (!e.exists || fe.d - across < e.left || fe.d + across > e.right) return false;
+  }
+  return ClearOfCars(s, k);
+}
+
+bool Rescue::ClearOfCars(const KsState& s, int k) const {
+  const double hl = 0.5 * vehicle_.length + options_.ego_margin;
+  const double hw = 0.5 * vehicle_.width + options_.ego_margin;
+  const traj::OrientedBox ego{s.x, s.y, s.orientation, hl, hw};
+  const double cos_e = std::cos(s.orientation), sin_e = std::sin(s.orientation);
+  const double radius = std::hypot(hl, hw);
+  for (const Car& car : cars_[k - 1]) {
+    const double reach = radius + car.radius;
+    const double dx = car.box.cx - s.x, dy = car.box.cy - s.y;
+    if (dx * dx + dy * dy > reach * reach) continue;
+    if (traj::Overlap(ego, cos_e, sin_e, car.box, car.cos_h, car.sin_h)) return false;
+  }
+  return true;
+}
+
+int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y) const {
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  const int n = static_cast<int>(std::min(x.size(), y.size()));
+  for (int k = 1; k <= options_.steps; ++k) {
+    const int j = k * ticks - 1;
+    if (j + 1 >= n) break;
+    const int a = std::max(0, j - 1);
+    KsState st;
+    st.x = x[j];
+    st.y = y[j];
+    st.orientation = std::atan2(y[j + 1] - y[a], x[j + 1] - x[a]);
+    if (!std::isfinite(st.x) || !std::isfinite(st.y) || !std::isfinite(st.orientation) ||
+        !ClearOfCars(st, k)) {
+      return k;
+    }
+  }
+  return 0;
+}
+
+int Rescue::Lasts(const KsState& ego) {
+  KsState s = ego;
+  double s_hint = std::numeric_limits<double>::quiet_NaN();
+  const int n = std::min(static_cast<int>(way_.size()), options_.steps);
+  for (int k = 1; k <= n; ++k) {
+    s = SimulateKs(s, way_[k - 1], dt_, vehicle_, 1);
+    map::FrenetPoint at;
+    if (!Clear(s, k, s_hint, &at)) return k - 1;
+    s_hint = at.s;
+  }
+  return n;
+}
+
+std::optional<KsInput> Rescue::Next(const KsState& ego,
+                                    const std::vector<cost::GoalRegion>& goals) {
+  if (!way_.empty()) way_.erase(way_.begin());  // the step driven since
+  const int rest = static_cast<int>(way_.size());
+  const bool keep = rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
+  if (!keep) Search(ego, goals);
+  if (way_.empty()) return std::nullopt;
+  return way_.front();
+}
+
+int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
+  ++searches_;
+  way_.clear();
+  const VehicleParams& p = vehicle_;
+  const double share = options_.limit_share;
+  const double wheelbase = p.Wheelbase();
+  const double a_max = share * p.a_max;
+  const double steer_max = share * std::min(std::abs(p.steering_min), std::abs(p.steering_max));
+  const double rate = share * std::min(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
+  const double rates[5] = {-rate, -0.5 * rate, 0.0, 0.5 * rate, rate};
+  // Whether an input keeps the friction circle at speed v and steering angle delta.
+  const auto in_circle = [&](double a, double v, double delta) {
+    const double lateral = v * v * std::tan(delta) / wheelbase;
+    return a * a + lateral * lateral <= a_max * a_max;
+  };
+  for (std::vector<Node>& layer : layers_) layer.clear();
+  KsState start = ego;
+  start.time_step = 0;
+  const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
+  layers_[0].push_back({start, fe0.s, fe0.d, -1, {}});
+  // The distance (s, d) of a state from the nearest goal region it is in the time window of
+  // (0 inside it, with its speed and heading), +inf when no window holds step k.
+  const map::ReferenceLine& line = road_.line();
+  const auto goal_distance = [&](const Node& n, int k) {
+    double best = std::numeric_limits<double>::infinity();
+    const double t = k * dt_;
+    for (const cost::GoalRegion& g : goals) {
+      if (t < g.t_lo || t > g.t_hi) continue;
+      const double d_off = g.d_slope * (n.s - g.s_ref);
+      const double ds = std::max({g.s_lo - n.s, n.s - g.s_hi, 0.0});
+      const double dd = std::max({g.d_lo + d_off - n.d, n.d - g.d_hi - d_off, 0.0});
+      double dist = std::hypot(ds, dd);
+      if (dist == 0) {
+        const double tangent = std::tan(n.state.orientation - line.At(n.s).heading);
+        const bool fits = n.state.velocity >= g.v_lo && n.state.velocity <= g.v_hi &&
+                          -tangent >= g.h_lo && -tangent <= g.h_hi;
+        if (!fits) dist = 1e-3;  // there, not yet as the region asks
+      }
+      best = std::min(best, dist);
+    }
+    return best;
+  };
+  int depth = 0, met = -1;
+  for (int k = 1; k <= options_.steps; ++k) {
+    next_.clear();
+    seen_.clear();
+    const std::vector<Node>& now = layers_[k - 1];
+    for (int i = 0; i < static_cast<int>(now.size()); ++i) {
+      const KsState& s = now[i].state;
+      const double up = share * p.MaxAcceleration(s.velocity);
+      const double floor = -s.velocity / dt_;  // never backwards
+      const double accels[5] = {-a_max, -0.5 * a_max, 0.0, 0.5 * up, up};
+      for (const double a0 : accels) {
+        const double a = std::max(a0, floor);
+        for (const double r : rates) {
+          const double delta1 = s.steering_angle + r * dt_;
+          if (std::abs(delta1) > steer_max) continue;
+          const double v1 = std::max(0.0, s.velocity + a * dt_);
+          if (!in_circle(a, s.velocity, s.steering_angle) || !in_circle(a, v1, delta1)) continue;
+          KsState q = SimulateKs(s, {r, a}, dt_, p, 1);
+          q.velocity = std::max(q.velocity, 0.0);
+          const std::uint64_t cell =
+              reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kCells);
+          if (seen_.insert(cell).second) next_.push_back({cell, Node{q, now[i].s, now[i].d, i, {r, a}}});
+        }
+      }
+    }
+    // Checked round-robin over the strata, each in the order of a hash of the cells, until
+    // max_states are valid.
+    for (auto& [cell, node] : next_) cell = reach::Mix(cell);
+    std::sort(next_.begin(), next_.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    strata_.clear();
+    rank_.resize(next_.size());
+    for (std::size_t i = 0; i < next_.size(); ++i) {
+      const KsState& q = next_[i].second.state;
+      const std::uint64_t stratum = reach::CellOf(q.x, q.y, q.velocity, q.orientation,
+                                                  q.steering_angle, kStrata);
+      rank_[i] = {strata_[stratum]++, i};
+    }
+    std::sort(rank_.begin(), rank_.end());
+    std::vector<Node>& layer = layers_[k];
+    const std::size_t cap = static_cast<std::size_t>(options_.max_states);
+    for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
+      Node node = next_[rank_[v].second].second;
+      map::FrenetPoint at;
+      if (Clear(node.state, k, node.s, &at)) {
+        node.s = at.s;
+        node.d = at.d;
+        layer.push_back(node);
+        if (met < 0 && goal_distance(node, k) == 0) met = static_cast<int>(layer.size()) - 1;
+      }
+    }
+    if (layer.empty()) break;
+    depth = k;
+    if (met >= 0) break;
+  }
+  if (met < 0 && depth < options_.steps) return 0;
+  // The state that meets a goal, else the last layer's nearest a goal region at its end (then
+  // the farthest along the road, then the first), and its inputs back.
+  const std::vector<Node>& last = layers_[depth];
+  int best = std::max(met, 0);
+  if (met < 0) {
+    std::vector<double> dist(last.size());
+    for (std::size_t i = 0; i < last.size(); ++i) dist[i] = GoalGap(last[i], goals);
+    for (int i = 1; i < static_cast<int>(last.size()); ++i) {
+      if (dist[i] < dist[best] || (dist[i] == dist[best] && last[i].s > last[best].s)) best = i;
+    }
+  }
+  way_.resize(depth);
+  for (int k = depth, i = best; k >= 1; --k) {
+    const Node& node = layers_[k][i];
+    way_[k - 1] = node.input;
+    i = node.parent;
+  }
+  return depth;
+}
+
+void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {
+  x->clear();
+  y->clear();
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  const double h = dt_ / ticks;
+  KsState s = ego;
+  for (const KsInput& u : way_) {
+    for (int i = 0; i < ticks; ++i) {
+      s = SimulateKs(s, u, h, vehicle_, 1);
+      x->push_back(s.x);
+      y->push_back(s.y);
+    }
+  }
+}
+
+}  // namespace frenetic::commonroad

@@ -1,0 +1,162 @@
+// The closed loop's rescue (rescue.h) on a hand-made straight road of two 3.5 m lanes: the step
+// a path runs into a predicted car, a way found past a car closing from behind that stays clear
+// of it and on the road, the way into a goal region's lane, and no way when the cars of both
+// lanes close in side by side.
+#include "frenetic/commonroad/rescue.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "frenetic/map/reference_line.h"
+#include "frenetic/plan/planner.h"
+
+namespace frenetic::commonroad {
+namespace {
+
+constexpr double kDt = 0.1;
+constexpr double kRight = -1.75, kLeft = -5.25;  // y of the lanes' centres (d 1.75 and 5.25)
+
+std::shared_ptr<const map::Road> TwoLanes() {
+  const std::vector<map::ReferenceLine::Point> pts = {{0, 0}, {600, 0}};
+  auto line = map::ReferenceLine::FitOpen(pts, map::ReferenceLine::Options(), "straight");
+  EXPECT_TRUE(line.ok()) << line.message();
+  return map::Road::Uniform(*line, 2, 3.5);
+}
+
+plan::SensorCar Row(int id, double x, double y, double v) {
+  plan::SensorCar c;
+  c.id = id;
+  c.x = x;
+  c.y = y;
+  c.vx = v;
+  c.length = 4.5;
+  c.width = 2.0;
+  return c;
+}
+
+KsState Ego(double x, double y, double v) {
+  KsState s;
+  s.x = x;
+  s.y = y;
+  s.velocity = v;
+  return s;
+}
+
+// Points every tick along +x at y from x0 at v, the first one tick on.
+void Straight(double x0, double y, double v, int n, std::vector<double>* x, std::vector<double>* y_out) {
+  x->clear();
+  y_out->clear();
+  for (int i = 1; i <= n; ++i) {
+    x->push_back(x0 + v * i * plan::kTickSeconds);
+    y_out->push_back(y);
+  }
+}
+
+TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 10;
+  t.sensor_fusion = {Row(1, 60, kRight, 0.0)};
+  rescue.Predict(t);
+  std::vector<double> x, y;
+  Straight(10, kRight, 20, 250, &x, &y);
+  // The ego's front (2.25 m + 0.05 m) meets the stopped car's square (2.25 m half side) when its
+  // centre is past 60 - 4.55 m: 10 + 2 k >= 55.45, step 23.
+  EXPECT_EQ(rescue.PathHit(x, y), 23);
+  Straight(10, kLeft, 20, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);
+  // A path that ends before the car: nothing within the steps it covers.
+  Straight(10, kRight, 20, 50, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);
+}
+
+// The way's states (Points every tick from ego): each step's centre, and whether any is NaN.
+std::vector<KsState> StepsOf(const Rescue& rescue, const KsState& ego) {
+  std::vector<double> x, y;
+  rescue.Points(ego, &x, &y);
+  std::vector<KsState> out;
+  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  for (std::size_t j = ticks - 1; j + 1 < x.size(); j += ticks) {
+    KsState s;
+    s.x = x[j];
+    s.y = y[j];
+    s.orientation = std::atan2(y[j + 1] - y[j - 1], x[j + 1] - x[j - 1]);
+    out.push_back(s);
+  }
+  return out;
+}
+
+TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 50;
+  t.sensor_fusion = {Row(1, 20, kRight, 40.0)};  // 30 m behind, 20 m/s faster
+  rescue.Predict(t);
+  std::vector<double> x, y;
+  Straight(50, kRight, 20, 250, &x, &y);
+  ASSERT_GT(rescue.PathHit(x, y), 0);  // keeping the lane is hit
+  const KsState ego = Ego(50, kRight, 20);
+  const std::optional<KsInput> u = rescue.Next(ego, {});
+  ASSERT_TRUE(u.has_value());
+  const VehicleParams vp;
+  EXPECT_LE(std::abs(u->acceleration), vp.a_max);
+  EXPECT_LE(std::abs(u->steering_rate), vp.steering_rate_max);
+  const std::vector<KsState> steps = StepsOf(rescue, ego);
+  ASSERT_GE(steps.size(), 39u);  // the whole 4 s
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const double car_x = 20 + 40.0 * kDt * (k + 1);
+    const KsState& s = steps[k];
+    // Apart along x by two half lengths, or across by two half widths (boxes near the axis).
+    const bool apart = std::abs(s.x - car_x) > 4.5 || std::abs(s.y - kRight) > 1.8 + 0.05;
+    EXPECT_TRUE(apart) << "step " << k + 1 << " ego (" << s.x << ", " << s.y << ") car x " << car_x;
+    EXPECT_LT(s.y, -0.8) << "step " << k + 1;   // the road's left edge (y 0) and the box
+    EXPECT_GT(s.y, -6.2) << "step " << k + 1;   // the right edge (y -7)
+  }
+  // Driven again next cycle from where the first input leads: the rest of the same way is kept
+  // (no new search).
+  const int searches = rescue.searches();
+  const KsState next = SimulateKs(ego, *u, kDt, vp);
+  t.sensor_fusion = {Row(1, 24, kRight, 40.0)};
+  rescue.Predict(t);
+  ASSERT_TRUE(rescue.Next(next, {}).has_value());
+  EXPECT_EQ(rescue.searches(), searches);
+}
+
+TEST(RescueTest, TheWayEndsInTheGoalRegionsLane) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 50;
+  rescue.Predict(t);  // no cars: every way lasts, the goal decides
+  // A goal in the right lane (d in [0, 3.5]) far ahead, open all along.
+  cost::GoalRegion goal;
+  goal.s_lo = 400;
+  goal.s_hi = 450;
+  goal.d_lo = 0.5;
+  goal.d_hi = 3.0;
+  const KsState ego = Ego(50, kLeft, 20);
+  ASSERT_TRUE(rescue.Next(ego, {goal}).has_value());
+  const std::vector<KsState> steps = StepsOf(rescue, ego);
+  ASSERT_FALSE(steps.empty());
+  EXPECT_GT(steps.back().y, -3.5 + 0.5);  // in the right lane at the end (y in [-3.5, 0])
+}
+
+TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 50;
+  // 2 m wide cars in both lanes: 1.5 m between them, 0.75 m to each edge; the ego is 1.61 m.
+  t.sensor_fusion = {Row(1, 20, kRight, 40.0), Row(2, 20, kLeft, 40.0)};
+  rescue.Predict(t);
+  EXPECT_FALSE(rescue.Next(Ego(50, kRight, 20), {}).has_value());
+  EXPECT_EQ(rescue.searches(), 1);
+  EXPECT_GT(rescue.checked(), 0);
+}
+
+}  // namespace
+}  // namespace frenetic::commonroad
