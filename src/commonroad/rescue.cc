@@ -179,12 +179,19 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   if (!way_.empty()) way_.erase(way_.begin());  // the step driven since
   const int rest = static_cast<int>(way_.size());
   const bool keep = rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
-  if (!keep) Search(ego, goals);
+  if (!keep) {
+    Search(ego, goals, options_.max_states);
+    // None at the usual size: once more with more states a step (a narrow way through).
+    if (way_.empty() && options_.retry_states > options_.max_states) {
+      Search(ego, goals, options_.retry_states);
+    }
+  }
   if (way_.empty()) return std::nullopt;
   return way_.front();
 }
 
-int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
+int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
+                   int max_states) {
   ++searches_;
   way_.clear();
   const VehicleParams& p = vehicle_;
@@ -266,7 +273,7 @@ int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goal
     }
     std::sort(rank_.begin(), rank_.end());
     std::vector<Node>& layer = layers_[k];
-    const std::size_t cap = static_cast<std::size_t>(options_.max_states);
+    const std::size_t cap = static_cast<std::size_t>(std::max(max_states, 1));
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
       Node node = next_[rank_[v].second].second;
       map::FrenetPoint at;

@@ -382,7 +382,11 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     plan::Telemetry t;
     std::vector<double> path_x, path_y;
     std::optional<Rescue> rescue;
-    if (options.rescue) rescue.emplace(road, vp, dt);
+    if (options.rescue) {
+      RescueOptions rescue_options;
+      rescue_options.retry_states = options.rescue_retry_states;
+      rescue.emplace(road, vp, dt, rescue_options);
+    }
     run.stop_reason = "time";
     for (int k = start; k < end; ++k) {
       bool met = false;
@@ -449,9 +453,14 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         rescue->Predict(t);
         const int hit = rescue->PathHit(res.x, res.y);
         if (hit > 0) {
+          const auto r0 = std::chrono::steady_clock::now();
           rescue_input = rescue->Next(ego, t.goals);
-          spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue {}",
-                        sc.benchmark_id, problem.id, k, hit,
+          const double r_ms =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
+                  .count();
+          spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue "
+                        "({:.3f} ms) {}",
+                        sc.benchmark_id, problem.id, k, hit, r_ms,
                         rescue_input ? "drives its way" : "found no way");
         } else {
           rescue->Drop();

@@ -156,6 +156,14 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   EXPECT_FALSE(rescue.Next(Ego(50, kRight, 20), {}).has_value());
   EXPECT_EQ(rescue.searches(), 1);
   EXPECT_GT(rescue.checked(), 0);
+  // With a retry: a second, larger search, which finds none either.
+  RescueOptions wider;
+  wider.retry_states = 600;
+  Rescue retried(*road, VehicleParams(), kDt, wider);
+  retried.Predict(t);
+  EXPECT_FALSE(retried.Next(Ego(50, kRight, 20), {}).has_value());
+  EXPECT_EQ(retried.searches(), 2);
+  EXPECT_GT(retried.checked(), rescue.checked());
 }
 
 }  // namespace

@@ -40,6 +40,7 @@ namespace frenetic::commonroad {
 struct RescueOptions {
   int steps = 40;             // steps searched ahead (4 s at the benchmark's 0.1 s)
   int max_states = 150;       // valid states kept per step (a spread when more)
+  int retry_states = 0;       // when none is found, once more with this many (0: no retry)
   double limit_share = 0.97;  // of the vehicle's acceleration, steering and steering-rate limits
   double ego_margin = 0.05;   // m added to each side of the ego's box
   double car_length = 5.0;    // m, the footprint of a car whose row gives none
@@ -97,7 +98,7 @@ class Rescue {
   // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
   // horizon, the nearest a goal region at its end (then the farthest along the road); its
   // length in steps, 0 when none (way_ empty).
-  int Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
+  int Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states);
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;

@@ -64,6 +64,9 @@ struct RunOptions {
   // When the planner's path would hit a predicted car or leave the road, drive a way the
   // rescue finds instead (rescue.h); its time counts as planning time.
   bool rescue = true;
+  // States a step of a second rescue search when the first (RescueOptions::max_states) finds no
+  // way; 0: none. A narrow way needs thousands, and such a search takes up to a second.
+  int rescue_retry_states = 0;
   // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
   std::function<void(const CycleInput&)> on_cycle;
   // Called after each Plan() with its input and result (the ego has not moved yet; the time it
