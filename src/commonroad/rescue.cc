@@ -55,6 +55,8 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
   options_.max_states = std::max(options_.max_states, 1);
   cars_.resize(options_.steps);
   layers_.resize(options_.steps + 1);
+  ego_radius_ = std::hypot(0.5 * vehicle_.length + options_.ego_margin,
+                           0.5 * vehicle_.width + options_.ego_margin);
 }
 
 void Rescue::Predict(const plan::Telemetry& t) {
@@ -132,9 +134,8 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
   const double hw = 0.5 * vehicle_.width + options_.ego_margin;
   const traj::OrientedBox ego{s.x, s.y, s.orientation, hl, hw};
   const double cos_e = std::cos(s.orientation), sin_e = std::sin(s.orientation);
-  const double radius = std::hypot(hl, hw);
   for (const Car& car : cars_[k - 1]) {
-    const double reach = radius + car.radius;
+    const double reach = ego_radius_ + car.radius;
     const double dx = car.box.cx - s.x, dy = car.box.cy - s.y;
     if (dx * dx + dy * dy > reach * reach) continue;
     if (traj::Overlap(ego, cos_e, sin_e, car.box, car.cos_h, car.sin_h)) return false;

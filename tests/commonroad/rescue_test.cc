@@ -16,7 +16,7 @@ namespace frenetic::commonroad {
 namespace {
 
 constexpr double kDt = 0.1;
-constexpr double kRight = -1.75, kLeft = -5.25;  // y of the lanes' centres (d 1.75 and 5.25)
+constexpr double kLane0 = -1.75, kLane1 = -5.25;  // y of the lanes' centres (d 1.75, 5.25)
 
 std::shared_ptr<const map::Road> TwoLanes() {
   const std::vector<map::ReferenceLine::Point> pts = {{0, 0}, {600, 0}};
@@ -59,17 +59,17 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   Rescue rescue(*road, VehicleParams(), kDt);
   plan::Telemetry t;
   t.x = 10;
-  t.sensor_fusion = {Row(1, 60, kRight, 0.0)};
+  t.sensor_fusion = {Row(1, 60, kLane0, 0.0)};
   rescue.Predict(t);
   std::vector<double> x, y;
-  Straight(10, kRight, 20, 250, &x, &y);
+  Straight(10, kLane0, 20, 250, &x, &y);
   // The ego's front (2.25 m + 0.05 m) meets the stopped car's square (2.25 m half side) when its
   // centre is past 60 - 4.55 m: 10 + 2 k >= 55.45, step 23.
   EXPECT_EQ(rescue.PathHit(x, y), 23);
-  Straight(10, kLeft, 20, 250, &x, &y);
+  Straight(10, kLane1, 20, 250, &x, &y);
   EXPECT_EQ(rescue.PathHit(x, y), 0);
   // A path that ends before the car: nothing within the steps it covers.
-  Straight(10, kRight, 20, 50, &x, &y);
+  Straight(10, kLane0, 20, 50, &x, &y);
   EXPECT_EQ(rescue.PathHit(x, y), 0);
 }
 
@@ -94,12 +94,12 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   Rescue rescue(*road, VehicleParams(), kDt);
   plan::Telemetry t;
   t.x = 50;
-  t.sensor_fusion = {Row(1, 20, kRight, 40.0)};  // 30 m behind, 20 m/s faster
+  t.sensor_fusion = {Row(1, 20, kLane0, 40.0)};  // 30 m behind, 20 m/s faster
   rescue.Predict(t);
   std::vector<double> x, y;
-  Straight(50, kRight, 20, 250, &x, &y);
+  Straight(50, kLane0, 20, 250, &x, &y);
   ASSERT_GT(rescue.PathHit(x, y), 0);  // keeping the lane is hit
-  const KsState ego = Ego(50, kRight, 20);
+  const KsState ego = Ego(50, kLane0, 20);
   const std::optional<KsInput> u = rescue.Next(ego, {});
   ASSERT_TRUE(u.has_value());
   const VehicleParams vp;
@@ -111,7 +111,7 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
     const double car_x = 20 + 40.0 * kDt * (k + 1);
     const KsState& s = steps[k];
     // Apart along x by two half lengths, or across by two half widths (boxes near the axis).
-    const bool apart = std::abs(s.x - car_x) > 4.5 || std::abs(s.y - kRight) > 1.8 + 0.05;
+    const bool apart = std::abs(s.x - car_x) > 4.5 || std::abs(s.y - kLane0) > 1.8 + 0.05;
     EXPECT_TRUE(apart) << "step " << k + 1 << " ego (" << s.x << ", " << s.y << ") car x " << car_x;
     EXPECT_LT(s.y, -0.8) << "step " << k + 1;   // the road's left edge (y 0) and the box
     EXPECT_GT(s.y, -6.2) << "step " << k + 1;   // the right edge (y -7)
@@ -120,7 +120,7 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   // (no new search).
   const int searches = rescue.searches();
   const KsState next = SimulateKs(ego, *u, kDt, vp);
-  t.sensor_fusion = {Row(1, 24, kRight, 40.0)};
+  t.sensor_fusion = {Row(1, 24, kLane0, 40.0)};
   rescue.Predict(t);
   ASSERT_TRUE(rescue.Next(next, {}).has_value());
   EXPECT_EQ(rescue.searches(), searches);
@@ -132,17 +132,22 @@ TEST(RescueTest, TheWayEndsInTheGoalRegionsLane) {
   plan::Telemetry t;
   t.x = 50;
   rescue.Predict(t);  // no cars: every way lasts, the goal decides
-  // A goal in the right lane (d in [0, 3.5]) far ahead, open all along.
+  // A goal in lane 0 (d in [0, 3.5]) along the stretch every way ends on (50 m on from
+  // 20 m/s, 4 s: 80-160 m), open all along: the lane decides.
   cost::GoalRegion goal;
-  goal.s_lo = 400;
-  goal.s_hi = 450;
+  goal.s_lo = 60;
+  goal.s_hi = 400;
   goal.d_lo = 0.5;
   goal.d_hi = 3.0;
-  const KsState ego = Ego(50, kLeft, 20);
+  const KsState ego = Ego(50, kLane1, 20);
   ASSERT_TRUE(rescue.Next(ego, {goal}).has_value());
-  const std::vector<KsState> steps = StepsOf(rescue, ego);
-  ASSERT_FALSE(steps.empty());
-  EXPECT_GT(steps.back().y, -3.5 + 0.5);  // in the right lane at the end (y in [-3.5, 0])
+  std::vector<double> x, y;
+  rescue.Points(ego, &x, &y);
+  ASSERT_FALSE(y.empty());
+  // It meets the goal (the way ends there: inside d [0.5, 3], y [-3, -0.5]) or ends nearest it.
+  EXPECT_GE(y.back(), -3.0 - 1e-6);
+  EXPECT_LE(y.back(), -0.5);
+  EXPECT_GE(x.back(), 60.0);
 }
 
 TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
@@ -151,9 +156,9 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   plan::Telemetry t;
   t.x = 50;
   // 2 m wide cars in both lanes: 1.5 m between them, 0.75 m to each edge; the ego is 1.61 m.
-  t.sensor_fusion = {Row(1, 20, kRight, 40.0), Row(2, 20, kLeft, 40.0)};
+  t.sensor_fusion = {Row(1, 20, kLane0, 40.0), Row(2, 20, kLane1, 40.0)};
   rescue.Predict(t);
-  EXPECT_FALSE(rescue.Next(Ego(50, kRight, 20), {}).has_value());
+  EXPECT_FALSE(rescue.Next(Ego(50, kLane0, 20), {}).has_value());
   EXPECT_EQ(rescue.searches(), 1);
   EXPECT_GT(rescue.checked(), 0);
   // With a retry: a second, larger search, which finds none either.
@@ -161,7 +166,7 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   wider.retry_states = 600;
   Rescue retried(*road, VehicleParams(), kDt, wider);
   retried.Predict(t);
-  EXPECT_FALSE(retried.Next(Ego(50, kRight, 20), {}).has_value());
+  EXPECT_FALSE(retried.Next(Ego(50, kLane0, 20), {}).has_value());
   EXPECT_EQ(retried.searches(), 2);
   EXPECT_GT(retried.checked(), rescue.checked());
 }

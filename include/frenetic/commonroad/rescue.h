@@ -109,6 +109,7 @@ class Rescue {
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;
+  double ego_radius_ = 0;  // m, of the ego's grown box
   std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
   std::vector<KsInput> way_;
   std::vector<std::vector<Node>> layers_;
