@@ -102,6 +102,7 @@ ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem
     p.candidates += c.candidates;
     p.tracking_error_max_m = std::max(p.tracking_error_max_m, c.tracking_error);
     p.not_ok_cycles += c.status != plan::PlanStatus::kOk;
+    p.rescued_cycles += c.rescued;
   }
   p.computation_s = run.computation_s;
   return p;

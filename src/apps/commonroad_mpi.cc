@@ -150,6 +150,7 @@ json ProblemWire(const ProblemReport& p) {
           {"plan_ms", Nums(p.plan_ms)},
           {"candidates", Num(p.candidates)},
           {"not_ok_cycles", p.not_ok_cycles},
+          {"rescued_cycles", p.rescued_cycles},
           {"tracking_error_max_m", Num(p.tracking_error_max_m)},
           {"computation_s", Num(p.computation_s)},
           {"costs", Costs(p.costs)},
@@ -170,6 +171,7 @@ ProblemReport ProblemFrom(const json& j) {
   for (const json& v : j.at("plan_ms")) p.plan_ms.push_back(NumFrom(v));
   p.candidates = NumFrom(j.at("candidates"));
   p.not_ok_cycles = j.at("not_ok_cycles").get<int>();
+  p.rescued_cycles = j.at("rescued_cycles").get<int>();
   p.tracking_error_max_m = NumFrom(j.at("tracking_error_max_m"));
   p.computation_s = NumFrom(j.at("computation_s"));
   p.costs = CostsFrom(j.at("costs"));

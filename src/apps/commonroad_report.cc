@@ -146,6 +146,10 @@ std::string ProblemText(const FileReport& f, const ProblemReport& p) {
                   p.costs.count("JB1") ? p.costs.at("JB1") : 0.0);
     text += buf;
   }
+  if (p.rescued_cycles > 0) {
+    text += "  rescue drove " + std::to_string(p.rescued_cycles) +
+            (p.rescued_cycles == 1 ? " step" : " steps");
+  }
   text += "\n    " + VerdictLine(p) + "\n";
   if (p.reference) text += ReferenceLine(p, f.dt);
   if (p.way_through) {
@@ -188,6 +192,7 @@ json ProblemJson(const ProblemReport& p, double dt) {
                   {"max", Max(p.plan_ms)}};
   j["candidates_mean"] = p.plan_ms.empty() ? 0.0 : p.candidates / p.plan_ms.size();
   j["not_ok_cycles"] = p.not_ok_cycles;
+  j["rescued_cycles"] = p.rescued_cycles;
   j["tracking_error_max_m"] = p.tracking_error_max_m;
   j["computation_s"] = p.computation_s;
   j["costs"] = p.costs;

@@ -50,6 +50,7 @@ struct ProblemReport {
   std::vector<double> plan_ms;  // per cycle (0 without timing)
   double candidates = 0;        // summed over the cycles
   int not_ok_cycles = 0;        // cycles whose plan status was not kOk
+  int rescued_cycles = 0;       // cycles that drove the rescue's way (rescue.h)
   double tracking_error_max_m = 0;
   double computation_s = 0;
   std::map<std::string, double> costs;  // "WX1", "JB1" of the trajectory, when it has states

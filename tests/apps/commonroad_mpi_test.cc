@@ -65,6 +65,7 @@ FileReport Awkward() {
                1e-310, 0.0};
   p.candidates = 1407.0 * 79;
   p.not_ok_cycles = 2;
+  p.rescued_cycles = 5;
   p.tracking_error_max_m = std::nan("");
   p.computation_s = std::numeric_limits<double>::infinity();
   p.costs = {{"WX1", 438.53210987654321}, {"JB1", 7.9}};
@@ -112,6 +113,7 @@ TEST(CommonRoadMpiTest, ReportsReadBackExactly) {
   ASSERT_EQ(q.plan_ms.size(), p.plan_ms.size());
   for (size_t i = 0; i < p.plan_ms.size(); ++i) EXPECT_TRUE(SameBits(q.plan_ms[i], p.plan_ms[i])) << i;
   EXPECT_TRUE(std::isnan(q.tracking_error_max_m));
+  EXPECT_EQ(q.rescued_cycles, 5);
   EXPECT_EQ(q.computation_s, std::numeric_limits<double>::infinity());
   EXPECT_TRUE(SameBits(b.origin.y, -0.0));
   EXPECT_TRUE(SameBits(q.road_length_m, 1.0 / 3.0));
