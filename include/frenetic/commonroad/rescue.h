@@ -15,11 +15,14 @@
 // predictions), else each car carried on at its velocity. States share grid cells; above
 // `max_states` valid states a step keeps a spread over coarse strata of position and speed.
 //
-// The way kept is the one that lasts longest, and of those the one farthest along the road.
-// Each later cycle the rest of it is checked again from the ego's state against the new
-// predictions and kept while it stays clear for at least half the horizon; otherwise a new
-// search runs. The way only stands in for the planner's path while that path still hits, and
-// only when it lasts longer than that path.
+// The way kept is the first found to meet a goal region (in its window, with its speed and
+// heading), else one that lasts the whole horizon, the nearest a goal region at its end (then
+// the farthest along the road); with none of either, no way (the planner's least harm knows
+// the goals). The search steps the KS model by Simpson's rule; the ego drives SimulateKs.
+// Each later cycle the rest of the way is checked again with SimulateKs from the ego's state
+// against the new predictions and kept while it stays clear to its end and is at least half
+// the horizon long; otherwise a new search runs. The way only stands in for the planner's path
+// while that path still hits a car.
 #pragma once
 
 #include <cstdint>

@@ -15,6 +15,8 @@
 // KS input (steering rate, acceleration) that best lands it on the planned state dt ahead
 // (position, orientation, steering angle, speed: a few Gauss-Newton steps on SimulateKs, the
 // inputs within the vehicle's limits), so the trajectory is a KS trajectory by construction.
+// When the planned path would run into a predicted car, the ego drives the rescue's way instead
+// (rescue.h; RunOptions::rescue), the KS input it found, exactly.
 // The run ends at the first step that meets a goal state, after the last goal time window (or,
 // for goals without one, the scenario's last recorded step), once the ego has driven past every
 // goal region, at the first step its box overlaps an obstacle or leaves the road (the verdict's
