@@ -2,8 +2,13 @@
 // hash that orders their checks.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace frenetic::commonroad::reach {
 
@@ -23,6 +28,24 @@ inline std::uint64_t Mix(std::uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
   return z ^ (z >> 31);
+}
+
+// The order a capped step checks its new states in: round-robin over coarse strata (the
+// stratum_of(state) keys), each in the order of a hash of the cells (deterministic, and
+// unrelated to where they are), so that a capped step keeps a spread. `next` holds (cell,
+// state) pairs: the cells become their hashes and the pairs are sorted by them; `rank` receives
+// (rank in its stratum, index in next), sorted. `strata` is scratch.
+template <typename State, typename StratumOf>
+void SpreadOrder(std::vector<std::pair<std::uint64_t, State>>& next, StratumOf stratum_of,
+                 std::unordered_map<std::uint64_t, std::size_t>& strata,
+                 std::vector<std::pair<std::size_t, std::size_t>>& rank) {
+  for (auto& [cell, state] : next) cell = Mix(cell);
+  std::sort(next.begin(), next.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  strata.clear();
+  rank.resize(next.size());
+  for (std::size_t i = 0; i < next.size(); ++i) rank[i] = {strata[stratum_of(next[i].second)]++, i};
+  std::sort(rank.begin(), rank.end());
 }
 
 }  // namespace frenetic::commonroad::reach

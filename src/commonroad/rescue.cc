@@ -30,6 +30,14 @@ bool FutureAt(const plan::CarFuture& f, double t, double* x, double* y, double* 
   return std::isfinite(*x) && std::isfinite(*y) && std::isfinite(*heading);
 }
 
+// How far (m) (s, d) lies from goal region g's box (its d span turned by d_slope): 0 inside.
+double RegionGap(const cost::GoalRegion& g, double s, double d) {
+  const double d_off = g.d_slope * (s - g.s_ref);
+  const double ds = std::max({g.s_lo - s, s - g.s_hi, 0.0});
+  const double dd = std::max({g.d_lo + d_off - d, d - g.d_hi - d_off, 0.0});
+  return std::hypot(ds, dd);
+}
+
 }  // namespace
 
 double Rescue::GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const {
@@ -39,10 +47,7 @@ double Rescue::GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals
   for (int pass = 0; pass < 2 && !std::isfinite(best); ++pass) {
     for (const cost::GoalRegion& g : goals) {
       if (pass == 0 && g.t_hi < t_end) continue;
-      const double d_off = g.d_slope * (n.s - g.s_ref);
-      const double ds = std::max({g.s_lo - n.s, n.s - g.s_hi, 0.0});
-      const double dd = std::max({g.d_lo + d_off - n.d, n.d - g.d_hi - d_off, 0.0});
-      best = std::min(best, std::hypot(ds, dd));
+      best = std::min(best, RegionGap(g, n.s, n.d));
     }
   }
   return std::isfinite(best) ? best : 0.0;
@@ -53,10 +58,12 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
     : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
   options_.steps = std::max(options_.steps, 1);
   options_.max_states = std::max(options_.max_states, 1);
+  options_.retry_states = std::max(options_.retry_states, 0);
   cars_.resize(options_.steps);
   layers_.resize(options_.steps + 1);
-  ego_radius_ = std::hypot(0.5 * vehicle_.length + options_.ego_margin,
-                           0.5 * vehicle_.width + options_.ego_margin);
+  half_length_ = 0.5 * vehicle_.length + options_.ego_margin;
+  half_width_ = 0.5 * vehicle_.width + options_.ego_margin;
+  ego_radius_ = std::hypot(half_length_, half_width_);
 }
 
 void Rescue::Predict(const plan::Telemetry& t) {
@@ -76,7 +83,18 @@ void Rescue::Predict(const plan::Telemetry& t) {
     for (const plan::CarFuture& f : t.futures) {
       if (f.id == car.id && f.start <= 0) future = &f;
     }
-    const double speed = std::hypot(car.vx, car.vy);
+    if (future != nullptr) {
+      for (int k = 1; k <= options_.steps; ++k) {
+        double x, y, heading;
+        if (FutureAt(*future, k * dt_, &x, &y, &heading)) add(k, x, y, heading, length, width);
+      }
+      continue;
+    }
+    if (std::hypot(car.vx, car.vy) <= 0.1) {
+      const double side = std::max(length, width);
+      for (int k = 1; k <= options_.steps; ++k) add(k, car.x, car.y, 0.0, side, side);
+      continue;
+    }
     // Without a future: on along the road at its speed along the road, at its offset from the
     // line (the planner's own prediction keeps a car in its lane too; a straight line would
     // run a car on a curving ramp into the next lane).
@@ -86,17 +104,8 @@ void Rescue::Predict(const plan::Telemetry& t) {
     const double along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
     const double rel = std::atan2(car.vy, car.vx) - road_heading;
     for (int k = 1; k <= options_.steps; ++k) {
-      double x, y, heading;
-      if (future != nullptr) {
-        if (!FutureAt(*future, k * dt_, &x, &y, &heading)) continue;
-        add(k, x, y, heading, length, width);
-      } else if (speed > 0.1) {
-        const map::CartesianPose at = line.ToCartesian(fe.s + along * k * dt_, fe.d);
-        add(k, at.x, at.y, at.heading + rel, length, width);
-      } else {
-        const double side = std::max(length, width);
-        add(k, car.x, car.y, 0.0, side, side);
-      }
+      const map::CartesianPose at = line.ToCartesian(fe.s + along * k * dt_, fe.d);
+      add(k, at.x, at.y, at.heading + rel, length, width);
     }
   }
   for (const plan::CarFuture& f : t.futures) {
@@ -114,8 +123,7 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
   ++checked_;
   if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.orientation)) return false;
   // The road: the box's extent along the line and across it between the edges at both ends.
-  const double hl = 0.5 * vehicle_.length + options_.ego_margin;
-  const double hw = 0.5 * vehicle_.width + options_.ego_margin;
+  const double hl = half_length_, hw = half_width_;
   const map::ReferenceLine& line = road_.line();
   const map::FrenetPoint fe = line.ToFrenet(s.x, s.y, s_hint);
   *at = fe;
@@ -130,9 +138,7 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
 }
 
 bool Rescue::ClearOfCars(const KsState& s, int k) const {
-  const double hl = 0.5 * vehicle_.length + options_.ego_margin;
-  const double hw = 0.5 * vehicle_.width + options_.ego_margin;
-  const traj::OrientedBox ego{s.x, s.y, s.orientation, hl, hw};
+  const traj::OrientedBox ego{s.x, s.y, s.orientation, half_length_, half_width_};
   const double cos_e = std::cos(s.orientation), sin_e = std::sin(s.orientation);
   for (const Car& car : cars_[k - 1]) {
     const double reach = ego_radius_ + car.radius;
@@ -191,8 +197,8 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   return way_.front();
 }
 
-int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
-                   int max_states) {
+void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
+                    int max_states) {
   ++searches_;
   way_.clear();
   const VehicleParams& p = vehicle_;
@@ -215,10 +221,7 @@ int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goal
     const double t = k * dt_;
     for (const cost::GoalRegion& g : goals) {
       if (t < g.t_lo || t > g.t_hi) continue;
-      const double d_off = g.d_slope * (n.s - g.s_ref);
-      const double ds = std::max({g.s_lo - n.s, n.s - g.s_hi, 0.0});
-      const double dd = std::max({g.d_lo + d_off - n.d, n.d - g.d_hi - d_off, 0.0});
-      double dist = std::hypot(ds, dd);
+      double dist = RegionGap(g, n.s, n.d);
       if (dist == 0) {
         const double tangent = std::tan(n.state.orientation - line.At(n.s).heading);
         const bool fits = n.state.velocity >= g.v_lo && n.state.velocity <= g.v_hi &&
@@ -285,22 +288,16 @@ int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goal
         }
       }
     }
-    // Checked round-robin over the strata, each in the order of a hash of the cells, until
-    // max_states are valid.
-    for (auto& [cell, node] : next_) cell = reach::Mix(cell);
-    std::sort(next_.begin(), next_.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    strata_.clear();
-    rank_.resize(next_.size());
-    for (std::size_t i = 0; i < next_.size(); ++i) {
-      const KsState& q = next_[i].second.state;
-      const std::uint64_t stratum = reach::CellOf(q.x, q.y, q.velocity, q.orientation,
-                                                  q.steering_angle, kStrata);
-      rank_[i] = {strata_[stratum]++, i};
-    }
-    std::sort(rank_.begin(), rank_.end());
+    // Checked round-robin over the strata until max_states are valid.
+    reach::SpreadOrder(
+        next_,
+        [](const Node& n) {
+          const KsState& q = n.state;
+          return reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kStrata);
+        },
+        strata_, rank_);
     std::vector<Node>& layer = layers_[k];
-    const std::size_t cap = static_cast<std::size_t>(std::max(max_states, 1));
+    const std::size_t cap = static_cast<std::size_t>(max_states);
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
       Node node = next_[rank_[v].second].second;
       map::FrenetPoint at;
@@ -315,7 +312,7 @@ int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goal
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && depth < options_.steps) return 0;
+  if (met < 0 && depth < options_.steps) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];
@@ -333,7 +330,6 @@ int Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goal
     way_[k - 1] = node.input;
     i = node.parent;
   }
-  return depth;
 }
 
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {

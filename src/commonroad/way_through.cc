@@ -100,21 +100,10 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
         }
       }
     }
-    // Checked round-robin over coarse strata (2 m of position, 1 m/s of speed), each in the
-    // order of a hash of the cells (deterministic, and unrelated to where they are), until
+    // Checked round-robin over coarse strata (2 m of position, 1 m/s of speed) until
     // max_states are valid: a capped step keeps a spread over positions and speeds, the rare
     // slow states (the ones that stop before a wall) with the many fast ones.
-    for (auto& [cell, q] : next) cell = reach::Mix(cell);
-    std::sort(next.begin(), next.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    strata.clear();
-    rank.resize(next.size());
-    for (std::size_t i = 0; i < next.size(); ++i) {
-      const Point& q = next[i].second;
-      const std::uint64_t stratum = CellOf(q, strata_cells);
-      rank[i] = {strata[stratum]++, i};
-    }
-    std::sort(rank.begin(), rank.end());
+    reach::SpreadOrder(next, [&](const Point& q) { return CellOf(q, strata_cells); }, strata, rank);
     const std::size_t n = next.size(), cap = std::max(options.max_states, 1);
     now.clear();
     std::size_t visited = 0;

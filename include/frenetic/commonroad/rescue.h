@@ -32,8 +32,8 @@
 #include <vector>
 
 #include "frenetic/commonroad/ks_model.h"
-#include "frenetic/cost/goal_region.h"
 #include "frenetic/commonroad/vehicle_params.h"
+#include "frenetic/cost/goal_region.h"
 #include "frenetic/map/road.h"
 #include "frenetic/plan/telemetry.h"
 #include "frenetic/traj/box.h"
@@ -99,9 +99,9 @@ class Rescue {
   // The same for the cars alone.
   bool ClearOfCars(const KsState& s, int k) const;
   // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
-  // horizon, the nearest a goal region at its end (then the farthest along the road); its
-  // length in steps, 0 when none (way_ empty).
-  int Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states);
+  // horizon, the nearest a goal region at its end (then the farthest along the road), in way_
+  // (empty when none), with at most max_states (>= 1) states a step.
+  void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states);
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;
@@ -112,7 +112,8 @@ class Rescue {
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;
-  double ego_radius_ = 0;  // m, of the ego's grown box
+  double half_length_ = 0, half_width_ = 0;  // m, of the ego's box grown by ego_margin
+  double ego_radius_ = 0;                     // m, its circumradius
   std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
   std::vector<KsInput> way_;
   std::vector<std::vector<Node>> layers_;
