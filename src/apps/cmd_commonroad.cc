@@ -414,14 +414,17 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_flag("--no-timing", args->no_timing,
                 "Report planning times as 0 (byte-stable output for the same files)");
   sub->add_flag("--no-rescue", args->no_rescue,
-                "Drive the planner's path even when it would hit a predicted car. By default the "
-                "path is checked against the predictions (the cars' boxes every step, 4 s ahead) "
-                "and, when it hits one, a search of the vehicle's own KS inputs (five "
-                "accelerations and five steering rates a step, within 97% of its limits and the "
-                "friction circle, the ego's box 0.05 m wider, on the road between its edges, at "
-                "most 150 states a step) looks for a way that meets a goal region or lasts the 4 "
-                "s; the ego drives its first step, and the rest of it while it stays clear. Its "
-                "time counts as planning time. Default: off (the rescue runs)");
+                "Drive the planner's path even when it would hit a predicted car or miss the "
+                "goal. By default the path is checked against the predictions (the cars' boxes "
+                "every step, 4 s ahead) and, when it hits one, a search of the vehicle's own KS "
+                "inputs (five accelerations and five steering rates a step, within 97% of its "
+                "limits and the friction circle, the ego's box 0.05 m wider, on the road between "
+                "its edges, at most 150 states a step) looks for a way that meets a goal region "
+                "or lasts the 4 s; when the path meets no goal region while every one closes "
+                "within it or lies behind its end, the search looks for a way that meets one. "
+                "The ego drives its first step, and the rest of it while it stays clear (and "
+                "still meets the goal). Its time counts as planning time. Default: off (the "
+                "rescue runs)");
   sub->add_option("--rescue-retry", args->rescue_retry,
                   "States a step (count) of a second rescue search when the first (150 a step) "
                   "finds no way; 0 = none. A narrow way through a box-in may need thousands: on "

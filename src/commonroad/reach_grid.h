@@ -33,19 +33,23 @@ inline std::uint64_t Mix(std::uint64_t z) {
 // The order a capped step checks its new states in: round-robin over coarse strata (the
 // stratum_of(state) keys), each in the order of a hash of the cells (deterministic, and
 // unrelated to where they are), so that a capped step keeps a spread. `next` holds (cell,
-// state) pairs: the cells become their hashes and the pairs are sorted by them; `rank` receives
-// (rank in its stratum, index in next), sorted. `strata` is scratch.
+// state) pairs, left as they are; `rank` receives (rank in its stratum, index in next) sorted by
+// the rank, then the hash. `strata` and `keys` are scratch (the states are not moved: only
+// (hash, index) pairs are sorted).
 template <typename State, typename StratumOf>
-void SpreadOrder(std::vector<std::pair<std::uint64_t, State>>& next, StratumOf stratum_of,
+void SpreadOrder(const std::vector<std::pair<std::uint64_t, State>>& next, StratumOf stratum_of,
                  std::unordered_map<std::uint64_t, std::size_t>& strata,
+                 std::vector<std::pair<std::uint64_t, std::size_t>>& keys,
                  std::vector<std::pair<std::size_t, std::size_t>>& rank) {
-  for (auto& [cell, state] : next) cell = Mix(cell);
-  std::sort(next.begin(), next.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  const std::size_t n = next.size();
+  keys.resize(n);
+  for (std::size_t i = 0; i < n; ++i) keys[i] = {Mix(next[i].first), i};
+  std::sort(keys.begin(), keys.end());  // the cells differ, so do their hashes
   strata.clear();
-  rank.resize(next.size());
-  for (std::size_t i = 0; i < next.size(); ++i) rank[i] = {strata[stratum_of(next[i].second)]++, i};
+  rank.resize(n);
+  for (std::size_t p = 0; p < n; ++p) rank[p] = {strata[stratum_of(next[keys[p].second].second)]++, p};
   std::sort(rank.begin(), rank.end());
+  for (auto& [r, at] : rank) at = keys[at].second;
 }
 
 }  // namespace frenetic::commonroad::reach

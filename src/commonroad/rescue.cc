@@ -168,39 +168,109 @@ int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y) 
   return 0;
 }
 
-int Rescue::Lasts(const KsState& ego) {
+int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals) {
   KsState s = ego;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
   const int n = std::min(static_cast<int>(way_.size()), options_.steps);
+  map::FrenetPoint at{};
   for (int k = 1; k <= n; ++k) {
     s = SimulateKs(s, way_[k - 1], dt_, vehicle_, 1);
-    map::FrenetPoint at;
     if (!Clear(s, k, s_hint, &at)) return k - 1;
     s_hint = at.s;
+  }
+  if (goals != nullptr && (n == 0 || GoalDistance(at.s, at.d, s.velocity, s.orientation,
+                                                  n * dt_, *goals) != 0)) {
+    return -1;
   }
   return n;
 }
 
 std::optional<KsInput> Rescue::Next(const KsState& ego,
-                                    const std::vector<cost::GoalRegion>& goals) {
+                                    const std::vector<cost::GoalRegion>& goals, bool goal_only) {
   if (!way_.empty()) way_.erase(way_.begin());  // the step driven since
   const int rest = static_cast<int>(way_.size());
-  const bool keep = rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
+  // A way to a goal is kept while it still meets it; another while it lasts long enough.
+  const bool keep = goal_way_ ? Lasts(ego, &goals) == rest
+                              : !goal_only && rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
   if (!keep) {
-    Search(ego, goals, options_.max_states);
+    Search(ego, goals, options_.max_states, goal_only);
     // None at the usual size: once more with more states a step (a narrow way through).
     if (way_.empty() && options_.retry_states > options_.max_states) {
-      Search(ego, goals, options_.retry_states);
+      Search(ego, goals, options_.retry_states, goal_only);
     }
   }
   if (way_.empty()) return std::nullopt;
   return way_.front();
 }
 
+double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
+                            const std::vector<cost::GoalRegion>& goals) const {
+  double best = std::numeric_limits<double>::infinity();
+  // The windows come a little inside the verdict's whole steps (up to half a step each end; a
+  // window of one step is an instant between two): a step within a window's inset ends by
+  // 0.75 of a step is one of its whole steps, and one outside it is a step or more away.
+  const double slack = 0.75 * dt_;
+  for (const cost::GoalRegion& g : goals) {
+    if (t < g.t_lo - slack || t > g.t_hi + slack) continue;
+    double dist = RegionGap(g, s, d);
+    if (dist == 0) {
+      const double tangent = std::tan(orientation - road_.line().At(s).heading);
+      const bool fits = v >= g.v_lo && v <= g.v_hi && -tangent >= g.h_lo && -tangent <= g.h_hi;
+      if (!fits) dist = 1e-3;  // there, not yet as the region asks
+    }
+    best = std::min(best, dist);
+  }
+  return best;
+}
+
+bool Rescue::MayMeetGoal(double s, double v, double t,
+                         const std::vector<cost::GoalRegion>& goals) const {
+  const double horizon = options_.steps * dt_;
+  for (const cost::GoalRegion& g : goals) {
+    const double t_last = std::min(g.t_hi + 0.75 * dt_, horizon);  // GoalDistance's slack
+    if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
+    const double time = t_last - t;
+    if (s + v * time + 0.5 * vehicle_.a_max * time * time >= g.s_lo) return true;
+  }
+  return false;
+}
+
+bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
+                        const std::vector<cost::GoalRegion>& goals) const {
+  if (goals.empty()) return false;
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  const int n = static_cast<int>(std::min(x.size(), y.size()));
+  const map::ReferenceLine& line = road_.line();
+  double s_hint = std::numeric_limits<double>::quiet_NaN();
+  double t_end = 0, s_end = -std::numeric_limits<double>::infinity();
+  for (int k = 1; k <= options_.steps; ++k) {
+    const int j = k * ticks - 1;
+    if (j + 1 >= n) break;
+    const int a = std::max(0, j - 1);
+    const double dx = x[j + 1] - x[a], dy = y[j + 1] - y[a];
+    if (!std::isfinite(x[j]) || !std::isfinite(y[j]) || !std::isfinite(dx) || !std::isfinite(dy)) {
+      return false;  // not a path to judge
+    }
+    const map::FrenetPoint fe = line.ToFrenet(x[j], y[j], s_hint);
+    s_hint = fe.s;
+    const double v = std::hypot(dx, dy) / ((j + 1 - a) * kTick);
+    if (GoalDistance(fe.s, fe.d, v, std::atan2(dy, dx), k * dt_, goals) == 0) return false;
+    t_end = k * dt_;
+    s_end = fe.s;
+  }
+  for (const cost::GoalRegion& g : goals) {
+    if (!(g.t_hi <= t_end || s_end > g.s_hi)) return false;  // still ahead, and still open
+  }
+  return true;
+}
+
 void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
-                    int max_states) {
-  ++searches_;
+                    int max_states, bool goal_only) {
   way_.clear();
+  goal_way_ = false;
+  const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
+  if (goal_only && !MayMeetGoal(fe0.s, ego.velocity, 0.0, goals)) return;  // out of reach
+  ++searches_;
   const VehicleParams& p = vehicle_;
   const double share = options_.limit_share;
   const double wheelbase = p.Wheelbase();
@@ -211,27 +281,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   for (std::vector<Node>& layer : layers_) layer.clear();
   KsState start = ego;
   start.time_step = 0;
-  const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
   layers_[0].push_back({start, fe0.s, fe0.d, -1, {}});
-  // The distance (s, d) of a state from the nearest goal region it is in the time window of
-  // (0 inside it, with its speed and heading), +inf when no window holds step k.
-  const map::ReferenceLine& line = road_.line();
-  const auto goal_distance = [&](const Node& n, int k) {
-    double best = std::numeric_limits<double>::infinity();
-    const double t = k * dt_;
-    for (const cost::GoalRegion& g : goals) {
-      if (t < g.t_lo || t > g.t_hi) continue;
-      double dist = RegionGap(g, n.s, n.d);
-      if (dist == 0) {
-        const double tangent = std::tan(n.state.orientation - line.At(n.s).heading);
-        const bool fits = n.state.velocity >= g.v_lo && n.state.velocity <= g.v_hi &&
-                          -tangent >= g.h_lo && -tangent <= g.h_hi;
-        if (!fits) dist = 1e-3;  // there, not yet as the region asks
-      }
-      best = std::min(best, dist);
-    }
-    return best;
-  };
   int depth = 0, met = -1;
   for (int k = 1; k <= options_.steps; ++k) {
     next_.clear();
@@ -295,7 +345,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
           const KsState& q = n.state;
           return reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kStrata);
         },
-        strata_, rank_);
+        strata_, keys_, rank_);
     std::vector<Node>& layer = layers_[k];
     const std::size_t cap = static_cast<std::size_t>(max_states);
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
@@ -304,15 +354,17 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
       if (Clear(node.state, k, node.s, &at)) {
         node.s = at.s;
         node.d = at.d;
+        if (goal_only && !MayMeetGoal(node.s, node.state.velocity, k * dt_, goals)) continue;
         layer.push_back(node);
-        if (met < 0 && goal_distance(node, k) == 0) met = static_cast<int>(layer.size()) - 1;
+        if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
+                                               k * dt_, goals) == 0) met = static_cast<int>(layer.size()) - 1;
       }
     }
     if (layer.empty()) break;
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && depth < options_.steps) return;
+  if (met < 0 && (goal_only || depth < options_.steps)) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];
@@ -324,6 +376,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
       if (dist[i] < dist[best] || (dist[i] == dist[best] && last[i].s > last[best].s)) best = i;
     }
   }
+  goal_way_ = met >= 0;
   way_.resize(depth);
   for (int k = depth, i = best; k >= 1; --k) {
     const Node& node = layers_[k][i];

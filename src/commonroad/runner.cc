@@ -447,7 +447,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         (*planner)->set_trace(nullptr, 0);
       }
       // The planner's path against the predictions: when it hits a car, the rescue's way if
-      // one lasts longer.
+      // one lasts longer; when it misses the goal for good, the rescue's way to it if there is
+      // one.
       std::optional<KsInput> rescue_input;
       if (rescue) {
         rescue->Predict(t);
@@ -462,6 +463,17 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                         "({:.3f} ms) {}",
                         sc.benchmark_id, problem.id, k, hit, r_ms,
                         rescue_input ? "drives its way" : "found no way");
+        } else if (rescue->GoalAtRisk(res.x, res.y, t.goals)) {
+          const auto r0 = std::chrono::steady_clock::now();
+          rescue_input = rescue->Next(ego, t.goals, true);
+          const double r_ms =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
+                  .count();
+          spdlog::debug("{} #{} step {}: the planner's path misses a closing goal; rescue "
+                        "({:.3f} ms) {}",
+                        sc.benchmark_id, problem.id, k, r_ms,
+                        rescue_input ? "drives a way to it" : "found no way to it");
+          if (!rescue_input) rescue->Drop();
         } else {
           rescue->Drop();
         }

@@ -76,6 +76,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   std::unordered_set<std::uint64_t> seen;
   std::unordered_map<std::uint64_t, std::size_t> strata;
   std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
+  std::vector<std::pair<std::uint64_t, std::size_t>> keys;
   for (int k = 1; k <= horizon; ++k) {
     const int step = first + k;
     next.clear();
@@ -103,7 +104,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
     // Checked round-robin over coarse strata (2 m of position, 1 m/s of speed) until
     // max_states are valid: a capped step keeps a spread over positions and speeds, the rare
     // slow states (the ones that stop before a wall) with the many fast ones.
-    reach::SpreadOrder(next, [&](const Point& q) { return CellOf(q, strata_cells); }, strata, rank);
+    reach::SpreadOrder(next, [&](const Point& q) { return CellOf(q, strata_cells); }, strata, keys, rank);
     const std::size_t n = next.size(), cap = std::max(options.max_states, 1);
     now.clear();
     std::size_t visited = 0;

@@ -1,7 +1,8 @@
 // The closed loop's rescue (rescue.h) on a hand-made straight road of two 3.5 m lanes: the step
 // a path runs into a predicted car, a way found past a car closing from behind that stays clear
 // of it and on the road, the way into a goal region's lane, and no way when the cars of both
-// lanes close in side by side.
+// lanes close in side by side; when a planner's path misses a goal that is closing, a way to it
+// (kept while it still meets it), and no search for a goal out of reach.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -169,6 +170,99 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   EXPECT_FALSE(retried.Next(Ego(50, kLane0, 20), {}).has_value());
   EXPECT_EQ(retried.searches(), 2);
   EXPECT_GT(retried.checked(), rescue.checked());
+}
+
+// A goal region in lane 0 (d in [0.5, 3]) from s 60 to s_hi, open from t_lo to t_hi s.
+cost::GoalRegion Lane0Goal(double t_lo, double t_hi, double s_hi = 400) {
+  cost::GoalRegion goal;
+  goal.s_lo = 60;
+  goal.s_hi = s_hi;
+  goal.d_lo = 0.5;
+  goal.d_hi = 3.0;
+  goal.t_lo = t_lo;
+  goal.t_hi = t_hi;
+  return goal;
+}
+
+TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  std::vector<double> lane0_x, lane0_y, lane1_x, lane1_y;
+  Straight(50, kLane0, 20, 100, &lane0_x, &lane0_y);  // 2 s, as the planner sends
+  Straight(50, kLane1, 20, 100, &lane1_x, &lane1_y);
+  // Closing within the path's 2 s: lane 1 misses it, lane 0 meets it.
+  EXPECT_TRUE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(1.0, 1.5)}));
+  EXPECT_FALSE(rescue.GoalAtRisk(lane0_x, lane0_y, {Lane0Goal(1.0, 1.5)}));
+  // Open beyond the path and not passed: later cycles may still meet it.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(0.0, 10.0)}));
+  // Open, but the path runs past its end (s 80; the path reaches s 90).
+  EXPECT_TRUE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(0.0, 10.0, 80)}));
+  // At risk only when every goal is: another one still ahead and open.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(1.0, 1.5), Lane0Goal(0.0, 10.0)}));
+  // A window of one whole step comes as an instant between two steps (1.05 s): a step next to
+  // it counts.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane0_x, lane0_y, {Lane0Goal(1.05, 1.05)}));
+  // No goal: nothing at risk.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {}));
+}
+
+TEST(RescueTest, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 50;
+  rescue.Predict(t);
+  std::vector<cost::GoalRegion> goals = {Lane0Goal(1.5, 2.0)};
+  const KsState ego = Ego(50, kLane1, 20);
+  const std::optional<KsInput> u = rescue.Next(ego, goals, true);
+  ASSERT_TRUE(u.has_value());
+  EXPECT_EQ(rescue.searches(), 1);
+  // The way ends at the step it meets the region: within its window (1.5-2.0 s, 15-20 steps),
+  // in lane 0's part of it.
+  std::vector<double> x, y;
+  rescue.Points(ego, &x, &y);
+  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  const int steps = static_cast<int>(x.size()) / ticks;
+  EXPECT_GE(steps, 15);
+  EXPECT_LE(steps, 20);
+  ASSERT_FALSE(y.empty());
+  EXPECT_GE(y.back(), -3.0);
+  EXPECT_LE(y.back(), -0.5);
+  // A step on, with the window a step nearer: the rest of the way is kept, no new search.
+  const KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  for (cost::GoalRegion& g : goals) {
+    g.t_lo -= kDt;
+    g.t_hi -= kDt;
+  }
+  ASSERT_TRUE(rescue.Next(next, goals, true).has_value());
+  EXPECT_EQ(rescue.searches(), 1);
+  // A goal that moved out of the way's reach (its window now closes before the way gets
+  // there): a new search, and a way to it only if there is one.
+  goals = {Lane0Goal(0.1, 0.2, 62)};
+  EXPECT_FALSE(rescue.Next(next, goals, true).has_value());
+}
+
+TEST(RescueTest, NoSearchForAGoalOutOfReachOrPassed) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 50;
+  rescue.Predict(t);
+  const KsState ego = Ego(50, kLane1, 20);
+  // 350 m ahead, closing in 1 s: out of reach even at full acceleration.
+  cost::GoalRegion far = Lane0Goal(0.0, 1.0);
+  far.s_lo = 400;
+  far.s_hi = 420;
+  EXPECT_FALSE(rescue.Next(ego, {far}, true).has_value());
+  // Behind the ego.
+  cost::GoalRegion behind = Lane0Goal(0.0, 10.0);
+  behind.s_lo = 0;
+  behind.s_hi = 40;
+  EXPECT_FALSE(rescue.Next(ego, {behind}, true).has_value());
+  EXPECT_EQ(rescue.searches(), 0);
+  // Without goal_only a way that lasts is enough (the hit case).
+  EXPECT_TRUE(rescue.Next(ego, {far}).has_value());
+  EXPECT_EQ(rescue.searches(), 1);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
-// The closed loop's rescue: when the path the planner sends would hit a predicted car, or
-// leave the road, within a few seconds, a search of the vehicle's own KS inputs looks for a way
-// that does not, and the ego drives that way's first input instead.
+// The closed loop's rescue: when the path the planner sends would hit a predicted car within a
+// few seconds, or misses every goal region while the last of them closes or is passed, a search
+// of the vehicle's own KS inputs looks for a way that does not, and the ego drives that way's
+// first input instead.
 //
 // The lattice planner's candidates are a few thousand smooth Frenet manoeuvres; in recorded
 // highway traffic the only way through a box-in is sometimes none of them: full acceleration
@@ -21,8 +22,13 @@
 // the goals). The search steps the KS model by Simpson's rule; the ego drives SimulateKs.
 // Each later cycle the rest of the way is checked again with SimulateKs from the ego's state
 // against the new predictions and kept while it stays clear to its end and is at least half
-// the horizon long; otherwise a new search runs. The way only stands in for the planner's path
-// while that path still hits a car.
+// the horizon long (a way to a goal: while it still meets it); otherwise a new search runs. The
+// way only stands in for the planner's path while that path still hits a car or misses the goal.
+//
+// For a goal the planner's path misses (GoalAtRisk: every region either closes within the path
+// or lies behind its end), only a way that meets a region will do; the search leaves out the
+// states that can no longer meet one (window closed, region passed, or its start beyond reach at
+// full acceleration), so a goal out of reach costs no search at all.
 #pragma once
 
 #include <cstdint>
@@ -70,14 +76,25 @@ class Rescue {
   // meets a goal region of `goals`, the telemetry's) is found: the rest of the last way while
   // it is still clear to its end and at least half the horizon long, else a new search's.
   // nullopt when none does (the planner's path is driven then: its least harm knows the goals).
-  std::optional<KsInput> Next(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
+  // goal_only: only a way that meets a goal region (the planner's path misses a goal).
+  std::optional<KsInput> Next(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
+                              bool goal_only = false);
 
   // The way's centre points every plan::kTickSeconds from `ego` (the first one tick on): the
   // path sent in its place.
   void Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const;
 
+  // Whether a path (as PathHit's) meets no goal region of `goals` (in its window, with its
+  // speed and heading) while some region's window closes within the path, or the path runs past
+  // the region's end.
+  bool GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
+                  const std::vector<cost::GoalRegion>& goals) const;
+
   // Forget the way (the planner's path is clear again).
-  void Drop() { way_.clear(); }
+  void Drop() {
+    way_.clear();
+    goal_way_ = false;
+  }
 
   int searches() const { return searches_; }
   std::int64_t checked() const { return checked_; }
@@ -101,12 +118,24 @@ class Rescue {
   // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
   // horizon, the nearest a goal region at its end (then the farthest along the road), in way_
   // (empty when none), with at most max_states (>= 1) states a step.
-  void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states);
+  // goal_only: none unless it meets a goal region.
+  void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states,
+              bool goal_only = false);
+  // The distance (s, d) of a state (speed v, heading) at t s from the nearest goal region whose
+  // window holds t (0 inside it with its speed and heading, 1e-3 inside without), +inf when
+  // none does.
+  // Whether a state at s (m along the road) with speed v (m/s), t s from now, may still meet a
+  // goal region within the horizon: one whose window is open at t or later, not passed, and
+  // whose start lies within reach at the vehicle's full acceleration before its window closes.
+  bool MayMeetGoal(double s, double v, double t, const std::vector<cost::GoalRegion>& goals) const;
+  double GoalDistance(double s, double d, double v, double orientation, double t,
+                      const std::vector<cost::GoalRegion>& goals) const;
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;
   // How many steps of way_ stay clear from `ego`.
-  int Lasts(const KsState& ego);
+  // With goals: -1 unless the way's end meets one of them.
+  int Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals = nullptr);
 
   const map::Road& road_;
   VehicleParams vehicle_;
@@ -116,11 +145,13 @@ class Rescue {
   double ego_radius_ = 0;                     // m, its circumradius
   std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
   std::vector<KsInput> way_;
+  bool goal_way_ = false;  // way_ ends in a goal region
   std::vector<std::vector<Node>> layers_;
   std::vector<std::pair<std::uint64_t, Node>> next_;
   std::unordered_set<std::uint64_t> seen_;
   std::unordered_map<std::uint64_t, std::size_t> strata_;
   std::vector<std::pair<std::size_t, std::size_t>> rank_;
+  std::vector<std::pair<std::uint64_t, std::size_t>> keys_;
   int searches_ = 0;
   mutable std::int64_t checked_ = 0;
 };
