@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/commonroad/ks_model.h"
+#include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/road.h"
 #include "frenetic/map/track.h"
@@ -50,6 +52,13 @@ struct Scene {
   // scenes, which are planned on map_path's line with the benchmark's configuration.
   std::shared_ptr<const map::Road> road;
   std::shared_ptr<const plan::PlannerConfig> config;
+  // CommonRoad scenes, per message: the vehicle's state and the path the planner sent (what the
+  // closed loop's rescue is given, commonroad::Rescue::Step); the scenario's step (s) and the
+  // vehicle.
+  std::vector<commonroad::KsState> ego;
+  std::vector<std::vector<double>> path_x, path_y;
+  double dt = 0;
+  commonroad::VehicleParams vehicle;
 };
 
 inline std::string SceneDir() { return FRENETIC_SOURCE_DIR "/bench/scenes"; }

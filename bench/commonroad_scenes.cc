@@ -3,7 +3,9 @@
 // runner (commonroad::RunScenario) drives each file's problem closed-loop as `frenetic commonroad`
 // does, and hands out every cycle's planner input (RunOptions::on_cycle): the telemetry (ego,
 // previous path, sensor rows, recorded futures, goals), the road built from the lanelets, and
-// the problem's configuration. BM_PlanCommonRoad replays them like the Udacity scenes.
+// the problem's configuration; and after it (on_plan) the path the planner sent, which with the
+// vehicle's state is what the loop's rescue checks. BM_PlanCommonRoad replays them like the
+// Udacity scenes, BM_RescueCommonRoadSet replays the rescue.
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -50,7 +52,15 @@ StatusOr<Scene> Capture(const std::string& path) {
     }
     scene.t.push_back(in.step * scenario->dt);
     scene.messages.push_back(in.telemetry);
+    scene.ego.push_back(in.ego);
   };
+  options.on_plan = [&](const commonroad::CycleInput& in, const plan::PlanResult& result) {
+    if (in.problem.id != problem) return;
+    scene.path_x.push_back(result.x);
+    scene.path_y.push_back(result.y);
+  };
+  scene.dt = scenario->dt;
+  scene.vehicle = *vehicle;
   const commonroad::ScenarioRun run = commonroad::RunScenario(*scenario, *config, options);
   if (!run.problems.empty() && !run.problems[0].road.ok()) return run.problems[0].road;
   return scene;

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../tests/common/malloc_counter.h"
 #include "bench_util.h"
+#include "frenetic/commonroad/rescue.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 
@@ -254,6 +256,69 @@ void PlanCommonRoad(benchmark::State& state, const std::vector<std::string>& pat
   state.counters["lanes"] = lanes;
 }
 
+// The closed loop's rescue (commonroad::Rescue::Step) on every cycle of CommonRoad scenes
+// (captured on first use), scene after scene, each cycle in order with one rescue per problem as
+// the runner keeps it: the time it adds to a cycle's Plan(). The same decisions as the run's (the
+// vehicle's states are the run's, which drove them).
+void RescueCommonRoad(benchmark::State& state, const std::vector<std::string>& paths) {
+  std::vector<const Scene*> scenes;
+  for (const std::string& path : paths) {
+    auto scene = CommonRoadScene(path);
+    if (!scene.ok()) return state.SkipWithError(scene.message().c_str());
+    const Scene& sc = **scene;
+    if (sc.ego.empty() || sc.ego.size() != sc.path_x.size()) continue;  // infeasible at start
+    scenes.push_back(&sc);
+  }
+  if (scenes.empty()) return state.SkipWithError("no scene with a cycle");
+  std::vector<double> us, cpu_us;
+  us.reserve(1 << 16);
+  cpu_us.reserve(1 << 16);
+  double hits = 0, goals = 0, driven = 0;
+  int searches = 0;
+  std::optional<commonroad::Rescue> rescue;
+  std::size_t s = 0, i = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Scene& scene = *scenes[s];
+    if (i == 0) {
+      if (rescue) searches += rescue->searches();
+      rescue.emplace(*scene.road, scene.vehicle, scene.dt);
+    }
+    state.ResumeTiming();
+    const double cpu0 = ThreadCpuSeconds();
+    const auto t0 = Clock::now();
+    const commonroad::RescueStep r =
+        rescue->Step(scene.messages[i], scene.path_x[i], scene.path_y[i], scene.ego[i]);
+    const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+    const double cpu = ThreadCpuSeconds() - cpu0;
+    state.PauseTiming();
+    us.push_back(dt * 1e6);
+    cpu_us.push_back(cpu * 1e6);
+    hits += r.why == commonroad::RescueStep::Why::kHit;
+    goals += r.why == commonroad::RescueStep::Why::kGoal;
+    driven += r.input.has_value();
+    if (++i == scene.ego.size()) {
+      i = 0;
+      s = (s + 1) % scenes.size();
+    }
+    state.ResumeTiming();
+  }
+  if (rescue) searches += rescue->searches();
+  const double n = static_cast<double>(us.size());
+  if (n == 0) return;
+  auto& c = state.counters;
+  c["hit"] = hits / n;          // share of cycles whose path hits a predicted car
+  c["goal"] = goals / n;        // ... that miss a closing goal
+  c["driven"] = driven / n;     // ... where the rescue's way is driven
+  c["searches"] = searches / n; // new searches per cycle
+  c["scenes"] = static_cast<double>(scenes.size());
+  c["p50_us"] = Percentile(&us, 0.50);
+  c["p99_us"] = Percentile(&us, 0.99);
+  c["max_us"] = us.back();
+  c["p50_cpu_us"] = Percentile(&cpu_us, 0.50);
+  c["p99_cpu_us"] = Percentile(&cpu_us, 0.99);
+}
+
 }  // namespace
 
 void RegisterCommonRoadBenchmarks() {
@@ -273,12 +338,19 @@ void RegisterCommonRoadBenchmarks() {
   benchmark::RegisterBenchmark("BM_PlanCommonRoadSet/US101", [files](benchmark::State& st) {
     PlanCommonRoad(st, files);
   })->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark("BM_RescueCommonRoadSet/US101", [files](benchmark::State& st) {
+    RescueCommonRoad(st, files);
+  })->Unit(benchmark::kMicrosecond);
   // highD: recorded German motorway traffic (3 lanes, traffic at up to twice the ego's pace:
   // box-ins where every candidate collides), every problem feasible at start.
   const std::vector<std::string> highd = CommonRoadSceneFiles("highD");
   if (highd.empty()) return;
   benchmark::RegisterBenchmark("BM_PlanCommonRoadSet/highD", [highd](benchmark::State& st) {
     PlanCommonRoad(st, highd);
+  })->Unit(benchmark::kMicrosecond);
+  // The rescue's time on the same cycles: the closed loop's cycle is the two together.
+  benchmark::RegisterBenchmark("BM_RescueCommonRoadSet/highD", [highd](benchmark::State& st) {
+    RescueCommonRoad(st, highd);
   })->Unit(benchmark::kMicrosecond);
 }
 

@@ -25,8 +25,13 @@ bool FutureAt(const plan::CarFuture& f, double t, double* x, double* y, double* 
   const int i = std::min(static_cast<int>(std::lround(at)), n - 1);
   const double beyond = std::max(0.0, at - (n - 1)) * f.dt;
   *heading = f.heading[i];
-  *x = f.x[i] + beyond * f.v[i] * std::cos(f.heading[i]);
-  *y = f.y[i] + beyond * f.v[i] * std::sin(f.heading[i]);
+  if (beyond > 0) {
+    *x = f.x[i] + beyond * f.v[i] * std::cos(f.heading[i]);
+    *y = f.y[i] + beyond * f.v[i] * std::sin(f.heading[i]);
+  } else {  // the same values without the trigonometry (0 times a finite product)
+    *x = std::isfinite(f.v[i]) ? f.x[i] : NAN;
+    *y = f.y[i];
+  }
   return std::isfinite(*x) && std::isfinite(*y) && std::isfinite(*heading);
 }
 
@@ -66,15 +71,36 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
   ego_radius_ = std::hypot(half_length_, half_width_);
 }
 
+RescueStep Rescue::Step(const plan::Telemetry& t, const std::vector<double>& x,
+                        const std::vector<double>& y, const KsState& ego) {
+  Predict(t);
+  RescueStep r;
+  r.hit = PathHit(x, y);
+  if (r.hit > 0) {
+    r.why = RescueStep::Why::kHit;
+    r.input = Next(ego, t.goals);
+  } else if (GoalAtRisk(x, y, t.goals)) {
+    r.why = RescueStep::Why::kGoal;
+    r.input = Next(ego, t.goals, true);
+    if (!r.input) Drop();
+  } else {
+    Drop();
+  }
+  return r;
+}
+
 void Rescue::Predict(const plan::Telemetry& t) {
-  for (std::vector<Car>& step : cars_) step.clear();
-  const auto add = [this](int k, double x, double y, double heading, double length, double width) {
-    Car c;
-    c.box = {x, y, heading, 0.5 * length, 0.5 * width};
-    c.cos_h = std::cos(heading);
-    c.sin_h = std::sin(heading);
-    c.radius = 0.5 * std::hypot(length, width);
-    cars_[k - 1].push_back(c);
+  // What each car's boxes come from; the boxes themselves are laid out step by step as the
+  // checks reach them (CarsAt): a path's check mostly needs the first 2 s only.
+  sources_.clear();
+  ready_ = 0;
+  const auto add = [this](Source::Kind kind, double length, double width) -> Source& {
+    Source& src = sources_.emplace_back();
+    src.kind = kind;
+    src.half_length = 0.5 * length;
+    src.half_width = 0.5 * width;
+    src.radius = 0.5 * std::hypot(length, width);
+    return src;
   };
   for (const plan::SensorCar& car : t.sensor_fusion) {
     const double length = car.length > 0 ? car.length : options_.car_length;
@@ -84,15 +110,14 @@ void Rescue::Predict(const plan::Telemetry& t) {
       if (f.id == car.id && f.start <= 0) future = &f;
     }
     if (future != nullptr) {
-      for (int k = 1; k <= options_.steps; ++k) {
-        double x, y, heading;
-        if (FutureAt(*future, k * dt_, &x, &y, &heading)) add(k, x, y, heading, length, width);
-      }
+      add(Source::kFuture, length, width).future = future;
       continue;
     }
     if (std::hypot(car.vx, car.vy) <= 0.1) {
       const double side = std::max(length, width);
-      for (int k = 1; k <= options_.steps; ++k) add(k, car.x, car.y, 0.0, side, side);
+      Source& src = add(Source::kStill, side, side);
+      src.x = car.x;
+      src.y = car.y;
       continue;
     }
     // Without a future: on along the road at its speed along the road, at its offset from the
@@ -101,22 +126,43 @@ void Rescue::Predict(const plan::Telemetry& t) {
     const map::ReferenceLine& line = road_.line();
     const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
     const double road_heading = line.At(fe.s).heading;
-    const double along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
-    const double rel = std::atan2(car.vy, car.vx) - road_heading;
-    for (int k = 1; k <= options_.steps; ++k) {
-      const map::CartesianPose at = line.ToCartesian(fe.s + along * k * dt_, fe.d);
-      add(k, at.x, at.y, at.heading + rel, length, width);
-    }
+    Source& src = add(Source::kAlong, length, width);
+    src.x = fe.s;
+    src.y = fe.d;
+    src.along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
+    src.rel = std::atan2(car.vy, car.vx) - road_heading;
   }
   for (const plan::CarFuture& f : t.futures) {
     if (f.start <= 0) continue;  // a present car's, above
     const double length = f.length > 0 ? f.length : options_.car_length;
     const double width = f.width > 0 ? f.width : options_.car_width;
-    for (int k = 1; k <= options_.steps; ++k) {
-      double x, y, heading;
-      if (FutureAt(f, k * dt_, &x, &y, &heading)) add(k, x, y, heading, length, width);
+    add(Source::kFuture, length, width).future = &f;
+  }
+}
+
+const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
+  for (; ready_ < k; ++ready_) {
+    const int step = ready_ + 1;
+    std::vector<Car>& cars = cars_[ready_];
+    cars.clear();
+    for (const Source& src : sources_) {
+      double x = src.x, y = src.y, heading = 0.0;
+      if (src.kind == Source::kFuture) {
+        if (!FutureAt(*src.future, step * dt_, &x, &y, &heading)) continue;
+      } else if (src.kind == Source::kAlong) {
+        const map::CartesianPose at = road_.line().ToCartesian(src.x + src.along * step * dt_, src.y);
+        x = at.x;
+        y = at.y;
+        heading = at.heading + src.rel;
+      }
+      Car& c = cars.emplace_back();
+      c.box = {x, y, heading, src.half_length, src.half_width};
+      c.cos_h = std::cos(heading);
+      c.sin_h = std::sin(heading);
+      c.radius = src.radius;
     }
   }
+  return cars_[k - 1];
 }
 
 bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const {
@@ -140,7 +186,7 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
 bool Rescue::ClearOfCars(const KsState& s, int k) const {
   const traj::OrientedBox ego{s.x, s.y, s.orientation, half_length_, half_width_};
   const double cos_e = std::cos(s.orientation), sin_e = std::sin(s.orientation);
-  for (const Car& car : cars_[k - 1]) {
+  for (const Car& car : CarsAt(k)) {
     const double reach = ego_radius_ + car.radius;
     const double dx = car.box.cx - s.x, dy = car.box.cy - s.y;
     if (dx * dx + dy * dy > reach * reach) continue;

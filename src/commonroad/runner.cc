@@ -424,7 +424,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       const bool tracing = spdlog::should_log(spdlog::level::trace);
       plan::CycleTrace trace;
       if (tracing) (*planner)->set_trace(&trace, 200);
-      const CycleInput input{problem, k, built->road, problem_config, t};
+      const CycleInput input{problem, k, built->road, problem_config, t, ego};
       if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
       const plan::PlanResult& res = (*planner)->Plan(t);
@@ -451,31 +451,22 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       // one.
       std::optional<KsInput> rescue_input;
       if (rescue) {
-        rescue->Predict(t);
-        const int hit = rescue->PathHit(res.x, res.y);
-        if (hit > 0) {
-          const auto r0 = std::chrono::steady_clock::now();
-          rescue_input = rescue->Next(ego, t.goals);
-          const double r_ms =
-              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
-                  .count();
+        const auto r0 = std::chrono::steady_clock::now();
+        const RescueStep step = rescue->Step(t, res.x, res.y, ego);
+        const double r_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
+                .count();
+        rescue_input = step.input;
+        if (step.why == RescueStep::Why::kHit) {
           spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue "
                         "({:.3f} ms) {}",
-                        sc.benchmark_id, problem.id, k, hit, r_ms,
+                        sc.benchmark_id, problem.id, k, step.hit, r_ms,
                         rescue_input ? "drives its way" : "found no way");
-        } else if (rescue->GoalAtRisk(res.x, res.y, t.goals)) {
-          const auto r0 = std::chrono::steady_clock::now();
-          rescue_input = rescue->Next(ego, t.goals, true);
-          const double r_ms =
-              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
-                  .count();
+        } else if (step.why == RescueStep::Why::kGoal) {
           spdlog::debug("{} #{} step {}: the planner's path misses a closing goal; rescue "
                         "({:.3f} ms) {}",
                         sc.benchmark_id, problem.id, k, r_ms,
                         rescue_input ? "drives a way to it" : "found no way to it");
-          if (!rescue_input) rescue->Drop();
-        } else {
-          rescue->Drop();
         }
       }
       const double ms =

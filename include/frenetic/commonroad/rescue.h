@@ -56,15 +56,33 @@ struct RescueOptions {
   double car_width = 2.0;
 };
 
+// What the rescue made of one cycle's path (Rescue::Step).
+struct RescueStep {
+  enum class Why { kNone, kHit, kGoal };
+  Why why = Why::kNone;  // kNone: the path is left as it is
+  int hit = 0;           // kHit: the step (1..steps) at which the path hits a predicted car
+  // The way's input to drive instead of the path; none: the path is driven.
+  std::optional<KsInput> input;
+};
+
 class Rescue {
  public:
   // `road` must outlive the rescue; dt: the scenario's step, s.
   Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
          const RescueOptions& options = {});
 
+  // One cycle of the closed loop: the telemetry's cars predicted (Predict), then the path the
+  // planner sends for it (points every plan::kTickSeconds, the first one tick on) checked: a
+  // way (Next) when it hits a car, else a way to a goal (Next, goal_only) when GoalAtRisk; else
+  // (or when no way to the goal is found) the way is forgotten. `ego`: the vehicle's state.
+  RescueStep Step(const plan::Telemetry& t, const std::vector<double>& x,
+                  const std::vector<double>& y, const KsState& ego);
+
   // The predicted boxes of the telemetry's cars at steps 1..steps from its instant: a car's
   // future where it has one (a car to come appears at its start), else its row carried on at
   // its velocity (a car with no speed is a square of its longer side: its heading is unknown).
+  // The boxes are laid out as the checks reach their steps, from t's futures: t must outlive the
+  // calls up to the next Predict (Step's own telemetry does).
   void Predict(const plan::Telemetry& t);
 
   // The first step (1..steps) at which a path of points every plan::kTickSeconds (the first one
@@ -104,6 +122,16 @@ class Rescue {
     traj::OrientedBox box;
     double cos_h, sin_h, radius;
   };
+  // Where a car's boxes come from (Predict): its future, its row standing (x, y), or its row
+  // carried on along the road (x, y: its s and d; along: m/s along the road; rel: its heading
+  // less the road's).
+  struct Source {
+    enum Kind { kFuture, kStill, kAlong };
+    Kind kind = kStill;
+    const plan::CarFuture* future = nullptr;
+    double x = 0, y = 0, along = 0, rel = 0;
+    double half_length = 0, half_width = 0, radius = 0;
+  };
   struct Node {
     KsState state;
     double s, d;  // in the road's frame (s: the Frenet hint of its children)
@@ -113,6 +141,8 @@ class Rescue {
   // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
   // s along the road (from the hint s_hint).
   bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
+  // The predicted cars at step k (1..steps), laid out up to k on first use.
+  const std::vector<Car>& CarsAt(int k) const;
   // The same for the cars alone.
   bool ClearOfCars(const KsState& s, int k) const;
   // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
@@ -143,7 +173,9 @@ class Rescue {
   RescueOptions options_;
   double half_length_ = 0, half_width_ = 0;  // m, of the ego's box grown by ego_margin
   double ego_radius_ = 0;                     // m, its circumradius
-  std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
+  std::vector<Source> sources_;
+  mutable std::vector<std::vector<Car>> cars_;  // [k - 1]: the predicted cars at step k
+  mutable int ready_ = 0;                       // steps of cars_ laid out
   std::vector<KsInput> way_;
   bool goal_way_ = false;  // way_ ends in a goal region
   std::vector<std::vector<Node>> layers_;

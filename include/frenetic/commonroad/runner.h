@@ -57,6 +57,7 @@ struct CycleInput {
   const std::shared_ptr<const map::Road>& road;
   const plan::PlannerConfig& config;  // the problem's (its speed limit raised: CommonRoadConfig)
   const plan::Telemetry& telemetry;
+  const KsState& ego;  // the vehicle's state the telemetry is read from
 };
 
 struct RunOptions {
