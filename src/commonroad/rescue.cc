@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "commonroad/reach_grid.h"
+#include "frenetic/commonroad/reach_grid.h"
 #include "frenetic/plan/planner.h"
 
 namespace frenetic::commonroad {
@@ -168,7 +168,9 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
 bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const {
   ++checked_;
   if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.orientation)) return false;
-  // The road: the box's extent along the line and across it between the edges at both ends.
+  // The cars first (cheaper, and in a box-in most states fail there), then the road: the box's
+  // extent along the line and across it between the edges at both ends.
+  if (!ClearOfCars(s, k)) return false;
   const double hl = half_length_, hw = half_width_;
   const map::ReferenceLine& line = road_.line();
   const map::FrenetPoint fe = line.ToFrenet(s.x, s.y, s_hint);
@@ -180,7 +182,7 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
     const map::Road::Span e = road_.EdgesAt(at);
     if (!e.exists || fe.d - across < e.left || fe.d + across > e.right) return false;
   }
-  return ClearOfCars(s, k);
+  return true;
 }
 
 bool Rescue::ClearOfCars(const KsState& s, int k) const {
@@ -331,7 +333,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   int depth = 0, met = -1;
   for (int k = 1; k <= options_.steps; ++k) {
     next_.clear();
-    seen_.clear();
+    seen_.Clear();
     const std::vector<Node>& now = layers_[k - 1];
     for (int i = 0; i < static_cast<int>(now.size()); ++i) {
       const KsState& s = now[i].state;
@@ -380,7 +382,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
           q.y = ry + h / 6 * (s.velocity * s0 + 4 * vm * sm + v1 * s1) + p.b * s1;
           const std::uint64_t cell =
               reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kCells);
-          if (seen_.insert(cell).second) next_.push_back({cell, Node{q, now[i].s, now[i].d, i, {r, a}}});
+          if (seen_.Insert(cell)) next_.push_back({cell, Node{q, now[i].s, now[i].d, i, {r, a}}});
         }
       }
     }
@@ -391,7 +393,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
           const KsState& q = n.state;
           return reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kStrata);
         },
-        strata_, keys_, rank_);
+        spread_, rank_);
     std::vector<Node>& layer = layers_[k];
     const std::size_t cap = static_cast<std::size_t>(max_states);
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {

@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "frenetic/commonroad/ks_model.h"
-#include "commonroad/reach_grid.h"
+#include "frenetic/commonroad/reach_grid.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -73,14 +71,13 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   // Strata of position and speed; the 1e3 cells leave of heading and curvature only their sign.
   const Cells strata_cells{2.0, 1.0, 1e3, 1e3};
   std::vector<std::pair<std::uint64_t, Point>> next;
-  std::unordered_set<std::uint64_t> seen;
-  std::unordered_map<std::uint64_t, std::size_t> strata;
+  reach::CellTable seen;
+  reach::SpreadScratch spread;
   std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
-  std::vector<std::pair<std::uint64_t, std::size_t>> keys;
   for (int k = 1; k <= horizon; ++k) {
     const int step = first + k;
     next.clear();
-    seen.clear();
+    seen.Clear();
     for (const Point& p : now) {
       const double up = vehicle.MaxAcceleration(p.v);
       const double forward[5] = {-vehicle.a_max, -0.5 * vehicle.a_max, 0.0, 0.5 * up, up};
@@ -97,14 +94,14 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
           const Point q{p.x + v_mid * dt * std::cos(h_mid), p.y + v_mid * dt * std::sin(h_mid), v1,
                         h1, k1};
           const std::uint64_t cell = CellOf(q, cells);
-          if (seen.insert(cell).second) next.push_back({cell, q});
+          if (seen.Insert(cell)) next.push_back({cell, q});
         }
       }
     }
     // Checked round-robin over coarse strata (2 m of position, 1 m/s of speed) until
     // max_states are valid: a capped step keeps a spread over positions and speeds, the rare
     // slow states (the ones that stop before a wall) with the many fast ones.
-    reach::SpreadOrder(next, [&](const Point& q) { return CellOf(q, strata_cells); }, strata, keys, rank);
+    reach::SpreadOrder(next, [&](const Point& q) { return CellOf(q, strata_cells); }, spread, rank);
     const std::size_t n = next.size(), cap = std::max(options.max_states, 1);
     now.clear();
     std::size_t visited = 0;

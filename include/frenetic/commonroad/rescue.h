@@ -33,11 +33,10 @@
 
 #include <cstdint>
 #include <optional>
-#include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "frenetic/commonroad/ks_model.h"
+#include "frenetic/commonroad/reach_grid.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/cost/goal_region.h"
 #include "frenetic/map/road.h"
@@ -180,10 +179,9 @@ class Rescue {
   bool goal_way_ = false;  // way_ ends in a goal region
   std::vector<std::vector<Node>> layers_;
   std::vector<std::pair<std::uint64_t, Node>> next_;
-  std::unordered_set<std::uint64_t> seen_;
-  std::unordered_map<std::uint64_t, std::size_t> strata_;
+  reach::CellTable seen_;
+  reach::SpreadScratch spread_;
   std::vector<std::pair<std::size_t, std::size_t>> rank_;
-  std::vector<std::pair<std::uint64_t, std::size_t>> keys_;
   int searches_ = 0;
   mutable std::int64_t checked_ = 0;
 };
