@@ -46,7 +46,7 @@ struct Trajectory1d {
   Polynomial5 poly;
   double duration = 0;  // s, of the polynomial
   double delay = 0;     // s before the polynomial starts
-  Polynomial5 back;
+  Polynomial5 back{};
   double hold = 0, back_duration = 0;  // s
   double end_time() const {
     return back_duration > 0 ? delay + duration + hold + back_duration : delay + duration;
