@@ -160,8 +160,14 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   t.sensor_fusion = {Row(1, 20, kLane0, 40.0), Row(2, 20, kLane1, 40.0)};
   rescue.Predict(t);
   EXPECT_FALSE(rescue.Next(Ego(50, kLane0, 20), {}).has_value());
-  EXPECT_EQ(rescue.searches(), 1);
+  EXPECT_EQ(rescue.searches(), 2);  // the first, and the default retry with twice the states
   EXPECT_GT(rescue.checked(), 0);
+  RescueOptions once;
+  once.retry_states = 0;
+  Rescue single(*road, VehicleParams(), kDt, once);
+  single.Predict(t);
+  EXPECT_FALSE(single.Next(Ego(50, kLane0, 20), {}).has_value());
+  EXPECT_EQ(single.searches(), 1);
   // With a retry: a second, larger search, which finds none either.
   RescueOptions wider;
   wider.retry_states = 600;

@@ -48,7 +48,7 @@ namespace frenetic::commonroad {
 struct RescueOptions {
   int steps = 40;             // steps searched ahead (4 s at the benchmark's 0.1 s)
   int max_states = 150;       // valid states kept per step (a spread when more)
-  int retry_states = 0;       // when none is found, once more with this many (0: no retry)
+  int retry_states = 300;     // when none is found, once more with this many (0: no retry)
   double limit_share = 0.97;  // of the vehicle's acceleration, steering and steering-rate limits
   double ego_margin = 0.05;   // m added to each side of the ego's box
   double car_length = 5.0;    // m, the footprint of a car whose row gives none

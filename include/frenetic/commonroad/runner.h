@@ -68,8 +68,9 @@ struct RunOptions {
   // rescue finds instead (rescue.h); its time counts as planning time.
   bool rescue = true;
   // States a step of a second rescue search when the first (RescueOptions::max_states) finds no
-  // way; 0: none. A narrow way needs thousands, and such a search takes up to a second.
-  int rescue_retry_states = 0;
+  // way; 0: none. Twice the first's by default; a narrow way may need thousands, and such a
+  // search takes up to a second.
+  int rescue_retry_states = RescueOptions().retry_states;
   // Called before each Plan() with its input (bench/ keeps cycles to time Plan() on); may be empty.
   std::function<void(const CycleInput&)> on_cycle;
   // Called after each Plan() with its input and result (the ego has not moved yet; the time it
