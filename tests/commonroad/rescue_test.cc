@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
@@ -127,12 +128,19 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   EXPECT_EQ(rescue.searches(), searches);
 }
 
-TEST(RescueTest, TheWayEndsInTheGoalRegionsLane) {
-  const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 50;
-  rescue.Predict(t);  // no cars: every way lasts, the goal decides
+// A rescue on the two lanes with no car at all: every way lasts, the goals decide.
+class RescueOnAnEmptyRoad : public ::testing::Test {
+ protected:
+  RescueOnAnEmptyRoad() {
+    t_.x = 50;
+    rescue_.Predict(t_);
+  }
+  std::shared_ptr<const map::Road> road_ = TwoLanes();
+  Rescue rescue_{*road_, VehicleParams(), kDt};
+  plan::Telemetry t_;
+};
+
+TEST_F(RescueOnAnEmptyRoad, TheWayEndsInTheGoalRegionsLane) {
   // A goal in lane 0 (d in [0, 3.5]) along the stretch every way ends on (50 m on from
   // 20 m/s, 4 s: 80-160 m), open all along: the lane decides.
   cost::GoalRegion goal;
@@ -141,9 +149,9 @@ TEST(RescueTest, TheWayEndsInTheGoalRegionsLane) {
   goal.d_lo = 0.5;
   goal.d_hi = 3.0;
   const KsState ego = Ego(50, kLane1, 20);
-  ASSERT_TRUE(rescue.Next(ego, {goal}).has_value());
+  ASSERT_TRUE(rescue_.Next(ego, {goal}).has_value());
   std::vector<double> x, y;
-  rescue.Points(ego, &x, &y);
+  rescue_.Points(ego, &x, &y);
   ASSERT_FALSE(y.empty());
   // It meets the goal (the way ends there: inside d [0.5, 3], y [-3, -0.5]) or ends nearest it.
   EXPECT_GE(y.back(), -3.0 - 1e-6);
@@ -153,41 +161,35 @@ TEST(RescueTest, TheWayEndsInTheGoalRegionsLane) {
 
 TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
   plan::Telemetry t;
   t.x = 50;
   // 2 m wide cars in both lanes: 1.5 m between them, 0.75 m to each edge; the ego is 1.61 m.
   t.sensor_fusion = {Row(1, 20, kLane0, 40.0), Row(2, 20, kLane1, 40.0)};
-  rescue.Predict(t);
-  EXPECT_FALSE(rescue.Next(Ego(50, kLane0, 20), {}).has_value());
-  EXPECT_EQ(rescue.searches(), 2);  // the first, and the default retry with twice the states
-  EXPECT_GT(rescue.checked(), 0);
-  RescueOptions once;
-  once.retry_states = 0;
-  Rescue single(*road, VehicleParams(), kDt, once);
-  single.Predict(t);
-  EXPECT_FALSE(single.Next(Ego(50, kLane0, 20), {}).has_value());
-  EXPECT_EQ(single.searches(), 1);
-  // With a retry: a second, larger search, which finds none either.
-  RescueOptions wider;
-  wider.retry_states = 600;
-  Rescue retried(*road, VehicleParams(), kDt, wider);
-  retried.Predict(t);
-  EXPECT_FALSE(retried.Next(Ego(50, kLane0, 20), {}).has_value());
-  EXPECT_EQ(retried.searches(), 2);
-  EXPECT_GT(retried.checked(), rescue.checked());
+  // The searches one Next makes with a retry of that many states a step (0: none), and the
+  // states they checked; none finds a way.
+  const auto searches = [&](int retry_states, std::int64_t* checked) {
+    RescueOptions options;
+    options.retry_states = retry_states;
+    Rescue rescue(*road, VehicleParams(), kDt, options);
+    rescue.Predict(t);
+    EXPECT_FALSE(rescue.Next(Ego(50, kLane0, 20), {}).has_value()) << retry_states;
+    *checked = rescue.checked();
+    return rescue.searches();
+  };
+  std::int64_t once = 0, twice = 0, wider = 0;
+  EXPECT_EQ(searches(0, &once), 1);
+  // By default once more with twice the states; a larger retry checks more again.
+  EXPECT_EQ(RescueOptions().retry_states, 2 * RescueOptions().max_states);
+  EXPECT_EQ(searches(RescueOptions().retry_states, &twice), 2);
+  EXPECT_EQ(searches(600, &wider), 2);
+  EXPECT_GT(once, 0);
+  EXPECT_GT(twice, once);
+  EXPECT_GT(wider, twice);
 }
 
 // A goal region in lane 0 (d in [0.5, 3]) from s 60 to s_hi, open from t_lo to t_hi s.
 cost::GoalRegion Lane0Goal(double t_lo, double t_hi, double s_hi = 400) {
-  cost::GoalRegion goal;
-  goal.s_lo = 60;
-  goal.s_hi = s_hi;
-  goal.d_lo = 0.5;
-  goal.d_hi = 3.0;
-  goal.t_lo = t_lo;
-  goal.t_hi = t_hi;
-  return goal;
+  return {.s_lo = 60, .s_hi = s_hi, .d_lo = 0.5, .d_hi = 3.0, .t_lo = t_lo, .t_hi = t_hi};
 }
 
 TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
@@ -212,21 +214,16 @@ TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
   EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {}));
 }
 
-TEST(RescueTest, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
-  const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 50;
-  rescue.Predict(t);
+TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
   std::vector<cost::GoalRegion> goals = {Lane0Goal(1.5, 2.0)};
   const KsState ego = Ego(50, kLane1, 20);
-  const std::optional<KsInput> u = rescue.Next(ego, goals, true);
+  const std::optional<KsInput> u = rescue_.Next(ego, goals, true);
   ASSERT_TRUE(u.has_value());
-  EXPECT_EQ(rescue.searches(), 1);
+  EXPECT_EQ(rescue_.searches(), 1);
   // The way ends at the step it meets the region: within its window (1.5-2.0 s, 15-20 steps),
   // in lane 0's part of it.
   std::vector<double> x, y;
-  rescue.Points(ego, &x, &y);
+  rescue_.Points(ego, &x, &y);
   const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
   const int steps = static_cast<int>(x.size()) / ticks;
   EXPECT_GE(steps, 15);
@@ -240,35 +237,30 @@ TEST(RescueTest, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
     g.t_lo -= kDt;
     g.t_hi -= kDt;
   }
-  ASSERT_TRUE(rescue.Next(next, goals, true).has_value());
-  EXPECT_EQ(rescue.searches(), 1);
+  ASSERT_TRUE(rescue_.Next(next, goals, true).has_value());
+  EXPECT_EQ(rescue_.searches(), 1);
   // A goal that moved out of the way's reach (its window now closes before the way gets
   // there): a new search, and a way to it only if there is one.
   goals = {Lane0Goal(0.1, 0.2, 62)};
-  EXPECT_FALSE(rescue.Next(next, goals, true).has_value());
+  EXPECT_FALSE(rescue_.Next(next, goals, true).has_value());
 }
 
-TEST(RescueTest, NoSearchForAGoalOutOfReachOrPassed) {
-  const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 50;
-  rescue.Predict(t);
+TEST_F(RescueOnAnEmptyRoad, NoSearchForAGoalOutOfReachOrPassed) {
   const KsState ego = Ego(50, kLane1, 20);
   // 350 m ahead, closing in 1 s: out of reach even at full acceleration.
   cost::GoalRegion far = Lane0Goal(0.0, 1.0);
   far.s_lo = 400;
   far.s_hi = 420;
-  EXPECT_FALSE(rescue.Next(ego, {far}, true).has_value());
+  EXPECT_FALSE(rescue_.Next(ego, {far}, true).has_value());
   // Behind the ego.
   cost::GoalRegion behind = Lane0Goal(0.0, 10.0);
   behind.s_lo = 0;
   behind.s_hi = 40;
-  EXPECT_FALSE(rescue.Next(ego, {behind}, true).has_value());
-  EXPECT_EQ(rescue.searches(), 0);
+  EXPECT_FALSE(rescue_.Next(ego, {behind}, true).has_value());
+  EXPECT_EQ(rescue_.searches(), 0);
   // Without goal_only a way that lasts is enough (the hit case).
-  EXPECT_TRUE(rescue.Next(ego, {far}).has_value());
-  EXPECT_EQ(rescue.searches(), 1);
+  EXPECT_TRUE(rescue_.Next(ego, {far}).has_value());
+  EXPECT_EQ(rescue_.searches(), 1);
 }
 
 }  // namespace
