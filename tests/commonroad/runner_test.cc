@@ -321,6 +321,24 @@ TEST(RunnerTest, StopsBeforeTheMapsEndForATimeOnlyGoal) {
   EXPECT_GT(front, 100.0);  // it used the road, not a panic stop
 }
 
+TEST(RunnerTest, TheRescueMeetsAGoalThePlannersPathMisses) {
+  // A goal region in the left lane (y 0 to 3.5) for 0.7-0.8 s only, around where the ego gets
+  // by then at 20 m/s in the right lane (y -1.75): its centre has to cross 1.75 m sideways in
+  // 0.7 s, quicker than any of the planner's swerves (without the rescue the run ends beside
+  // the region, at y -0.7). The rescue's search of the vehicle's own inputs finds such a way
+  // once the planner's path misses the region for good, and drives it.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20,
+                                    {GoalRectangleXml({32, 1.75}, 24, 3.5, 0, 7, 8)});
+  const ProblemRun p = RunOne(xml);
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  int rescued = 0;
+  for (const RunCycle& c : p.cycles) rescued += c.rescued;
+  EXPECT_GT(rescued, 0);
+  ASSERT_FALSE(p.trajectory.empty());
+  EXPECT_GT(p.trajectory.back().y, 0.0);  // its centre in the region's lane
+}
+
 TEST(RunnerTest, ARunEndsOnceEveryGoalRegionIsBehind) {
   // A goal region 17-23 m ahead asks to stand (0-1 m/s) in it from 2 s on; at 25 m/s the ego
   // cannot stop in it (27 m at the vehicle's full braking) and drives past. The run then ends
