@@ -15,6 +15,11 @@ constexpr double kTick = plan::kTickSeconds;
 // speed; the 1e3 cells leave of heading and steering only their sign).
 constexpr double kCells[5] = {0.25, 0.25, 0.25, 0.01, 0.005};
 constexpr double kStrata[5] = {2.0, 2.0, 1.0, 1e3, 1e3};
+// The runner insets goal windows from the verdict's whole steps by up to half a step at each end
+// (a window of one step becomes an instant between two): a step within this many steps of a
+// window's inset ends is one of its whole steps, and one outside the window is a step or more
+// away.
+constexpr double kWindowSlack = 0.75;
 
 // A future's centre and heading at t s from its telemetry's instant; false when the car is not
 // there yet. Past its last sample it keeps its last speed and heading.
@@ -41,6 +46,22 @@ double RegionGap(const cost::GoalRegion& g, double s, double d) {
   const double ds = std::max({g.s_lo - s, s - g.s_hi, 0.0});
   const double dd = std::max({g.d_lo + d_off - d, d - g.d_hi - d_off, 0.0});
   return std::hypot(ds, dd);
+}
+
+// The point of a path (points every plan::kTickSeconds, the first one tick on) at step k of dt
+// s, its heading (from the points either side) and speed; false when the path ends before it.
+struct PathPoint {
+  double x, y, heading, speed;
+};
+bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, int k, int ticks,
+                 PathPoint* p) {
+  const int n = static_cast<int>(std::min(x.size(), y.size()));
+  const int j = k * ticks - 1;
+  if (j + 1 >= n) return false;
+  const int a = std::max(0, j - 1);
+  const double dx = x[j + 1] - x[a], dy = y[j + 1] - y[a];
+  *p = {x[j], y[j], std::atan2(dy, dx), std::hypot(dx, dy) / ((j + 1 - a) * kTick)};
+  return true;
 }
 
 }  // namespace
@@ -199,15 +220,12 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
 
 int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y) const {
   const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
-  const int n = static_cast<int>(std::min(x.size(), y.size()));
-  for (int k = 1; k <= options_.steps; ++k) {
-    const int j = k * ticks - 1;
-    if (j + 1 >= n) break;
-    const int a = std::max(0, j - 1);
+  PathPoint p;
+  for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
     KsState st;
-    st.x = x[j];
-    st.y = y[j];
-    st.orientation = std::atan2(y[j + 1] - y[a], x[j + 1] - x[a]);
+    st.x = p.x;
+    st.y = p.y;
+    st.orientation = p.heading;
     if (!std::isfinite(st.x) || !std::isfinite(st.y) || !std::isfinite(st.orientation) ||
         !ClearOfCars(st, k)) {
       return k;
@@ -254,10 +272,7 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
 double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
                             const std::vector<cost::GoalRegion>& goals) const {
   double best = std::numeric_limits<double>::infinity();
-  // The windows come a little inside the verdict's whole steps (up to half a step each end; a
-  // window of one step is an instant between two): a step within a window's inset ends by
-  // 0.75 of a step is one of its whole steps, and one outside it is a step or more away.
-  const double slack = 0.75 * dt_;
+  const double slack = kWindowSlack * dt_;
   for (const cost::GoalRegion& g : goals) {
     if (t < g.t_lo - slack || t > g.t_hi + slack) continue;
     double dist = RegionGap(g, s, d);
@@ -275,7 +290,7 @@ bool Rescue::MayMeetGoal(double s, double v, double t,
                          const std::vector<cost::GoalRegion>& goals) const {
   const double horizon = options_.steps * dt_;
   for (const cost::GoalRegion& g : goals) {
-    const double t_last = std::min(g.t_hi + 0.75 * dt_, horizon);  // GoalDistance's slack
+    const double t_last = std::min(g.t_hi + kWindowSlack * dt_, horizon);
     if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
     const double time = t_last - t;
     if (s + v * time + 0.5 * vehicle_.a_max * time * time >= g.s_lo) return true;
@@ -287,22 +302,18 @@ bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>&
                         const std::vector<cost::GoalRegion>& goals) const {
   if (goals.empty()) return false;
   const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
-  const int n = static_cast<int>(std::min(x.size(), y.size()));
   const map::ReferenceLine& line = road_.line();
   double s_hint = std::numeric_limits<double>::quiet_NaN();
   double t_end = 0, s_end = -std::numeric_limits<double>::infinity();
-  for (int k = 1; k <= options_.steps; ++k) {
-    const int j = k * ticks - 1;
-    if (j + 1 >= n) break;
-    const int a = std::max(0, j - 1);
-    const double dx = x[j + 1] - x[a], dy = y[j + 1] - y[a];
-    if (!std::isfinite(x[j]) || !std::isfinite(y[j]) || !std::isfinite(dx) || !std::isfinite(dy)) {
+  PathPoint p;
+  for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.heading) ||
+        !std::isfinite(p.speed)) {
       return false;  // not a path to judge
     }
-    const map::FrenetPoint fe = line.ToFrenet(x[j], y[j], s_hint);
+    const map::FrenetPoint fe = line.ToFrenet(p.x, p.y, s_hint);
     s_hint = fe.s;
-    const double v = std::hypot(dx, dy) / ((j + 1 - a) * kTick);
-    if (GoalDistance(fe.s, fe.d, v, std::atan2(dy, dx), k * dt_, goals) == 0) return false;
+    if (GoalDistance(fe.s, fe.d, p.speed, p.heading, k * dt_, goals) == 0) return false;
     t_end = k * dt_;
     s_end = fe.s;
   }
@@ -418,10 +429,13 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   const std::vector<Node>& last = layers_[depth];
   int best = std::max(met, 0);
   if (met < 0) {
-    std::vector<double> dist(last.size());
-    for (std::size_t i = 0; i < last.size(); ++i) dist[i] = GoalGap(last[i], goals);
+    double best_gap = GoalGap(last[0], goals);
     for (int i = 1; i < static_cast<int>(last.size()); ++i) {
-      if (dist[i] < dist[best] || (dist[i] == dist[best] && last[i].s > last[best].s)) best = i;
+      const double gap = GoalGap(last[i], goals);
+      if (gap < best_gap || (gap == best_gap && last[i].s > last[best].s)) {
+        best = i;
+        best_gap = gap;
+      }
     }
   }
   goal_way_ = met >= 0;
