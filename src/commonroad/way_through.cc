@@ -71,7 +71,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   // Strata of position and speed; the 1e3 cells leave of heading and curvature only their sign.
   const Cells strata_cells{2.0, 1.0, 1e3, 1e3};
   std::vector<std::pair<std::uint64_t, Point>> next;
-  reach::CellTable seen;
+  KeyTable seen;
   reach::SpreadScratch spread;
   std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
   for (int k = 1; k <= horizon; ++k) {

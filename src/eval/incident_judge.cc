@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "eval/incident_judge_internal.h"
-#include "eval/key_set.h"
+#include "frenetic/key_table.h"
 
 namespace frenetic::sim {
 namespace judge {
@@ -394,7 +394,7 @@ class Search {
   bool out_of_budget_ = false;
   Pass pass_ = kPasses.back();
   double s0_ = 0;
-  KeySet visited_;
+  KeyTable visited_;
   std::vector<Step> path_;
 };
 

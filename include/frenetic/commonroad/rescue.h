@@ -179,7 +179,7 @@ class Rescue {
   bool goal_way_ = false;  // way_ ends in a goal region
   std::vector<std::vector<Node>> layers_;
   std::vector<std::pair<std::uint64_t, Node>> next_;
-  reach::CellTable seen_;
+  KeyTable seen_;
   reach::SpreadScratch spread_;
   std::vector<std::pair<std::size_t, std::size_t>> rank_;
   int searches_ = 0;
