@@ -17,6 +17,50 @@
 #include "commonroad/lanelet_network.h"
 
 namespace frenetic::commonroad {
+
+LaneletStations ProjectLanelet(const Lanelet& l, const map::ReferenceLine& line) {
+  std::vector<Vec2> left = l.left, right = l.right;
+  if (left.size() != right.size()) {
+    const int n = static_cast<int>(std::max(l.CleanLeft().size(), l.CleanRight().size()));
+    left = ResamplePolyline(l.left, n);
+    right = ResamplePolyline(l.right, n);
+  }
+  // Pairs of border points at most kStationStep apart on either side: each pair of
+  // consecutive points with as many evenly spaced pairs between as the longer side needs.
+  std::vector<Vec2> dense_left, dense_right;
+  for (size_t i = 0; i < left.size(); ++i) {
+    if (i > 0) {
+      const double gap = std::max(Distance(left[i - 1], left[i]), Distance(right[i - 1], right[i]));
+      const int parts = std::isfinite(gap) ? static_cast<int>(std::ceil(gap / kStationStep)) : 1;
+      for (int q = 1; q < std::min(parts, 100000); ++q) {
+        const double f = static_cast<double>(q) / parts;
+        dense_left.push_back({left[i - 1].x + f * (left[i].x - left[i - 1].x),
+                              left[i - 1].y + f * (left[i].y - left[i - 1].y)});
+        dense_right.push_back({right[i - 1].x + f * (right[i].x - right[i - 1].x),
+                               right[i - 1].y + f * (right[i].y - right[i - 1].y)});
+      }
+    }
+    dense_left.push_back(left[i]);
+    dense_right.push_back(right[i]);
+  }
+  left = std::move(dense_left);
+  right = std::move(dense_right);
+  LaneletStations out;
+  double hint = NAN;
+  for (size_t i = 0; i < left.size(); ++i) {
+    const map::FrenetPoint fl = std::isfinite(hint) ? line.ToFrenet(left[i].x, left[i].y, hint)
+                                                    : line.ToFrenet(left[i].x, left[i].y);
+    const map::FrenetPoint fr = line.ToFrenet(right[i].x, right[i].y, fl.s);
+    hint = fl.s;
+    const double s = 0.5 * (fl.s + fr.s);
+    if (!(fr.d - fl.d > kMinStationWidth) || (!out.s.empty() && !(s > out.s.back() + 1e-6))) continue;
+    out.s.push_back(s);
+    out.left.push_back(fl.d);
+    out.right.push_back(fr.d);
+  }
+  return out;
+}
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -25,8 +69,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kJumpBlend = 25.0;
 // m: lanelets of one lane this far apart along s (or closer) are one stretch of it.
 constexpr double kLaneGap = 1.0;
-// m: narrower stations (a lanelet's pointed end) are left out of a lane's profile.
-constexpr double kMinWidth = 0.05;
 // m: how far a lane goes on past an open end of the lanelet network (RoadArea's margin).
 constexpr double kOpenEnd = RoadArea::kDefaultOpenEndMargin;
 // m: lanes ending within kMapEndSlack of the map's last (or first) metre are the map's end and
@@ -35,34 +77,6 @@ constexpr double kMapEndSlack = 10.0;
 constexpr double kMapRunOn = 300.0;
 // m: a lane farther than this from the lane on its left is apart from it there.
 constexpr double kDetached = 0.5;
-
-// The projected borders of a lanelet: stations (s increasing) with the left and right d.
-struct Stations {
-  std::vector<double> s, left, right;
-};
-
-Stations Project(const Lanelet& l, const map::ReferenceLine& line) {
-  std::vector<Vec2> left = l.left, right = l.right;
-  if (left.size() != right.size()) {
-    const int n = static_cast<int>(std::max(l.CleanLeft().size(), l.CleanRight().size()));
-    left = ResamplePolyline(l.left, n);
-    right = ResamplePolyline(l.right, n);
-  }
-  Stations out;
-  double hint = NAN;
-  for (size_t i = 0; i < left.size(); ++i) {
-    const map::FrenetPoint fl = std::isfinite(hint) ? line.ToFrenet(left[i].x, left[i].y, hint)
-                                                    : line.ToFrenet(left[i].x, left[i].y);
-    const map::FrenetPoint fr = line.ToFrenet(right[i].x, right[i].y, fl.s);
-    hint = fl.s;
-    const double s = 0.5 * (fl.s + fr.s);
-    if (!(fr.d - fl.d > kMinWidth) || (!out.s.empty() && !(s > out.s.back() + 1e-6))) continue;
-    out.s.push_back(s);
-    out.left.push_back(fl.d);
-    out.right.push_back(fr.d);
-  }
-  return out;
-}
 
 // A lane profile's left (right: right) border at s, false outside its stations.
 bool BorderAt(const map::LaneProfile& l, double s, bool right, double* out) {
@@ -224,13 +238,13 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   // its lateral position.
   struct Piece {
     int lanelet;
-    Stations st;
+    LaneletStations st;
   };
   std::map<int, std::vector<Piece>> by_position;
   std::set<int> placed;
   auto place = [&](int j, int pos) {
     if (!placed.insert(j).second) return;
-    Stations st = Project(net.at(j), **line);
+    LaneletStations st = ProjectLanelet(net.at(j), **line);
     if (st.s.size() >= 2) by_position[pos].push_back({j, std::move(st)});
   };
   for (const Section& sec : sections) {
@@ -260,7 +274,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     Lanelet reversed = net.at(o);
     reversed.left.assign(net.at(o).right.rbegin(), net.at(o).right.rend());
     reversed.right.assign(net.at(o).left.rbegin(), net.at(o).left.rend());
-    Stations st = Project(reversed, **line);
+    LaneletStations st = ProjectLanelet(reversed, **line);
     if (st.s.size() < 2) continue;
     by_position[pos].push_back({o, std::move(st)});
     oncoming.insert(o);

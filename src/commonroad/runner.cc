@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/goal_frenet.h"
 #include "frenetic/commonroad/observation.h"
 #include "frenetic/commonroad/road_builder.h"
 #include "frenetic/cost/goal_region.h"
@@ -24,140 +25,9 @@ constexpr double kTick = plan::kTickSeconds;
 // The planner's limits sit this far inside the verdict's: it measures them on its own path,
 // which the KS ego follows to within centimetres, not exactly.
 constexpr double kLimitMargin = 0.85;
-// Insets of the goal regions the planner aims at (Inset): m along, m across, m/s, rad, and
-// steps of the time window.
-constexpr double kInsetS = 1.0, kInsetD = 0.2, kInsetV = 0.5, kInsetH = 0.02, kTimeInset = 0.5;
 // The planner's top speed: this share of the vehicle's v_max (the path's speed is checked on its
 // 0.02 s points, which the KS ego tracks to within centimetres per second).
 constexpr double kTopSpeedShare = 0.97;
-
-// The goal states as regions of the road's Frenet frame (times in steps; shifted per cycle).
-struct FrenetGoal {
-  cost::GoalRegion region;  // times: steps (absolute), converted per cycle
-  bool timed_lo = false, timed_hi = false;
-};
-
-void AddBox(const map::ReferenceLine& line, const std::vector<Vec2>& pts, cost::GoalRegion* r) {
-  r->s_lo = r->d_lo = std::numeric_limits<double>::infinity();
-  r->s_hi = r->d_hi = -std::numeric_limits<double>::infinity();
-  for (const Vec2& p : pts) {
-    const map::FrenetPoint f = line.ToFrenet(p.x, p.y);
-    r->s_lo = std::min(r->s_lo, f.s);
-    r->s_hi = std::max(r->s_hi, f.s);
-    r->d_lo = std::min(r->d_lo, f.d);
-    r->d_hi = std::max(r->d_hi, f.d);
-  }
-}
-
-// A goal rectangle: its long axis in the Frenet frame (the centre's s and d, the slope of d
-// along s), the s range of its ends and the d half-width across it, the corners' s range for a
-// wide one. Exact for a rectangle on a straight stretch of the line.
-void AddRectangle(const map::ReferenceLine& line, const Shape& sh, cost::GoalRegion* r) {
-  const bool long_axis = sh.length >= sh.width;
-  const double along = long_axis ? sh.orientation : sh.orientation + 0.5 * 3.141592653589793;
-  const double half_len = 0.5 * std::max(sh.length, sh.width), half_wid = 0.5 * std::min(sh.length, sh.width);
-  const Vec2 u{std::cos(along), std::sin(along)};
-  const map::FrenetPoint a = line.ToFrenet(sh.center.x - half_len * u.x, sh.center.y - half_len * u.y);
-  const map::FrenetPoint b = line.ToFrenet(sh.center.x + half_len * u.x, sh.center.y + half_len * u.y);
-  const map::FrenetPoint c = line.ToFrenet(sh.center.x, sh.center.y);
-  const double ds = b.s - a.s;
-  const double slope = std::abs(ds) > 1e-6 ? (b.d - a.d) / ds : 0.0;
-  if (std::abs(slope) > 1.0) {  // turned across the road: its bounding box will do
-    AddBox(line, sh.Vertices(), r);
-    return;
-  }
-  r->s_ref = c.s;
-  r->d_slope = slope;
-  const double half_d = half_wid * std::sqrt(1 + slope * slope);  // across, measured along d
-  r->d_lo = c.d - half_d;
-  r->d_hi = c.d + half_d;
-  const double spread = half_wid * std::abs(slope) / std::sqrt(1 + slope * slope);
-  r->s_lo = std::min(a.s, b.s) - spread;
-  r->s_hi = std::max(a.s, b.s) + spread;
-}
-
-// The region the planner aims at: a little inside the goal's intervals (a quarter of each, at
-// most the margin), so that the ego's state at a whole step lies inside, not on the edge the
-// plan touched between two steps.
-double InsetBy(double lo, double hi, double margin) {
-  return std::isfinite(lo) && std::isfinite(hi) ? std::min(margin, 0.25 * (hi - lo)) : 0.0;
-}
-cost::GoalRegion Inset(cost::GoalRegion r) {
-  const double s = InsetBy(r.s_lo, r.s_hi, kInsetS), d = InsetBy(r.d_lo, r.d_hi, kInsetD);
-  const double v = InsetBy(r.v_lo, r.v_hi, kInsetV), h = InsetBy(r.h_lo, r.h_hi, kInsetH);
-  r.s_lo += s;
-  r.s_hi -= s;
-  r.d_lo += d;
-  r.d_hi -= d;
-  r.v_lo += v;
-  r.v_hi -= v;
-  r.h_lo += h;
-  r.h_hi -= h;
-  return r;
-}
-
-// The goal's orientation interval as a heading against the road's in the region (its s mid):
-// a vehicle turned left of the road moves toward smaller d, so h = road - orientation.
-void AddHeading(const map::ReferenceLine& line, const GoalState& g, cost::GoalRegion* r) {
-  if (!g.orientation || !(g.orientation->end - g.orientation->start < 2 * 3.141592653589793)) {
-    return;
-  }
-  const double road = line.At(0.5 * (r->s_lo + r->s_hi)).heading;
-  const double half = 0.5 * (g.orientation->end - g.orientation->start);
-  const double mid = WrapAngle(road - g.orientation->Mid());
-  constexpr double kQuarter = 1.5;  // rad: headings beyond stay at its tangent
-  r->h_lo = std::tan(std::clamp(mid - half, -kQuarter, kQuarter));
-  r->h_hi = std::tan(std::clamp(mid + half, -kQuarter, kQuarter));
-}
-
-std::vector<FrenetGoal> FrenetGoals(const Scenario& sc, const PlanningProblem& p,
-                                    const map::ReferenceLine& line) {
-  std::vector<FrenetGoal> out;
-  for (const GoalState& g : p.goals) {
-    FrenetGoal base;
-    if (g.time) {
-      base.region.t_lo = g.time->start;
-      base.region.t_hi = g.time->end;
-      base.timed_lo = base.timed_hi = true;
-    }
-    if (g.velocity) {
-      base.region.v_lo = g.velocity->start;
-      base.region.v_hi = g.velocity->end;
-    }
-    if (!g.HasPosition()) {
-      out.push_back(base);
-      continue;
-    }
-    for (const Shape& sh : g.shapes) {
-      FrenetGoal fg = base;
-      if (sh.kind == Shape::Kind::kRectangle) {
-        AddRectangle(line, sh, &fg.region);
-        AddHeading(line, g, &fg.region);
-        out.push_back(fg);
-        continue;
-      }
-      std::vector<Vec2> pts = sh.Vertices();
-      if (sh.kind == Shape::Kind::kCircle) {
-        for (int i = 0; i < 8; ++i) {
-          const double a = i * 0.25 * 3.141592653589793;
-          pts.push_back({sh.center.x + sh.radius * std::cos(a), sh.center.y + sh.radius * std::sin(a)});
-        }
-      }
-      AddBox(line, pts, &fg.region);
-      AddHeading(line, g, &fg.region);
-      out.push_back(fg);
-    }
-    for (int id : g.lanelets) {
-      const Lanelet* l = sc.FindLanelet(id);
-      if (l == nullptr) continue;
-      FrenetGoal fg = base;
-      AddBox(line, l->Polygon(), &fg.region);
-      AddHeading(line, g, &fg.region);
-      out.push_back(fg);
-    }
-  }
-  return out;
-}
 
 // The step after which the run ends: the last goal window's end, else the last step an
 // obstacle is recorded at (at least 10 s), capped.
@@ -179,19 +49,6 @@ int EndStep(const Scenario& sc, const PlanningProblem& p) {
     end = std::max(end, last);
   }
   return std::min(end, p.initial.time_step + kMaxSteps);
-}
-
-// m: the ego's centre this far past the far end (s) of every goal region has missed them all.
-constexpr double kPassedMargin = 1.0;
-
-// Whether the ego at s has driven past every goal region (all of them with a position): the
-// planner never reverses, so none can be met any more.
-bool PassedEveryGoal(const std::vector<FrenetGoal>& goals, double s) {
-  if (goals.empty()) return false;
-  for (const FrenetGoal& g : goals) {
-    if (!(std::isfinite(g.region.s_hi) && s > g.region.s_hi + kPassedMargin)) return false;
-  }
-  return true;
 }
 
 // Signed Menger curvature of three points (left positive).

@@ -17,6 +17,7 @@ namespace {
 using testing::AddCurvedRoad;
 using testing::AddStraightRoad;
 using testing::AddTwoWayRoad;
+using testing::AddZipperMerge;
 using testing::GoalLaneletXml;
 using testing::GoalRectangleXml;
 using testing::GoalTimeOnlyXml;
@@ -135,6 +136,35 @@ TEST(RoadBuilderTest, CurvedRoadKeepsItsWidth) {
     EXPECT_NEAR(a.width(), 4.0, 0.05) << s;
     EXPECT_NEAR(a.centre(), 0.0, 0.2) << s;
   }
+}
+
+TEST(RoadBuilderTest, ABorderDrawnInTwoPointsIsExactWhereTheLineBendsOffIt) {
+  // The reference line follows 25 into 28, and the smooth fit bends (it overshoots before the
+  // junction) where the borders, two points each over 160 m, run straight: the lanes' borders
+  // are read at stations at most kStationStep apart, not at the lanelets' points alone.
+  ScenarioXml xml;
+  AddZipperMerge(xml).Problem(1, {-110, 8.75}, 0, 9, {GoalLaneletXml(24, 84, 85)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.skeleton.front(), 25);
+  ASSERT_EQ(b.road->num_lanes(), 2);
+  const map::ReferenceLine& line = b.road->line();
+  double bend = 0;  // how far the line strays from lanelet 25's centre (y 8.75) before x = -20
+  for (double x = -175; x <= -25; x += 1.0) {
+    const map::FrenetPoint f = line.ToFrenet(x, 8.75);
+    bend = std::max(bend, std::abs(f.d));
+    // Both borders of the left lane (lane 0) where they really are, y = 10.5 and y = 7.
+    const map::Road::Span lane = b.road->LaneAt(0, f.s);
+    ASSERT_TRUE(lane.exists) << x;
+    EXPECT_NEAR(line.ToCartesian(f.s, lane.left).y, 10.5, 0.02) << "x " << x;
+    EXPECT_NEAR(line.ToCartesian(f.s, lane.right).y, 7.0, 0.02) << "x " << x;
+  }
+  EXPECT_GT(bend, 0.05);  // the scene tests what it means to: the line does bend off the border
+  // A lanelet's stations: its two points and enough between them, at most kStationStep apart.
+  const Scenario sc = Parse(xml);
+  const LaneletStations st = ProjectLanelet(*sc.FindLanelet(25), line);
+  ASSERT_GE(st.s.size(), 80u);
+  for (size_t i = 1; i < st.s.size(); ++i) EXPECT_LE(st.s[i] - st.s[i - 1], kStationStep + 0.1) << i;
 }
 
 TEST(RoadBuilderTest, GoalByRectangleRoutesIntoItsLane) {

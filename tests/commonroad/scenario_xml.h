@@ -285,6 +285,28 @@ inline ScenarioXml& AddCurvedRoad(ScenarioXml& xml, double radius, double sweep,
   return xml.Lanelet(l);
 }
 
+// A hand-crafted zipper merge drawn as such files are, each border straight in a few points:
+// two lanes along +x from x = -180 to -20 (lanelet 25 left, y in [7, 10.5]; 26 right, y in
+// [3.5, 7]), each border in three points; 25 goes on into 28, which moves 3.5 m right over 20 m,
+// and 26 into 27, straight; both meet in 24 (x 0 to 150, y in [3.5, 7]).
+inline ScenarioXml& AddZipperMerge(ScenarioXml& xml) {
+  LaneletXml l25 = Lane(25, {{-180, 10.5}, {-100, 10.5}, {-20, 10.5}}, {{-180, 7}, {-100, 7}, {-20, 7}});
+  l25.adjacent_right = {{26, true}};
+  l25.successors = {28};
+  LaneletXml l26 = Lane(26, {{-180, 7}, {-100, 7}, {-20, 7}}, {{-180, 3.5}, {-100, 3.5}, {-20, 3.5}});
+  l26.adjacent_left = {{25, true}};
+  l26.successors = {27};
+  LaneletXml l28 = Lane(28, {{-20, 10.5}, {0, 7}}, {{-20, 7}, {0, 3.5}});
+  l28.predecessors = {25};
+  l28.successors = {24};
+  LaneletXml l27 = Lane(27, {{-20, 7}, {0, 7}}, {{-20, 3.5}, {0, 3.5}});
+  l27.predecessors = {26};
+  l27.successors = {24};
+  LaneletXml l24 = Lane(24, {{0, 7}, {150, 7}}, {{0, 3.5}, {150, 3.5}});
+  l24.predecessors = {27, 28};
+  return xml.Lanelet(l25).Lanelet(l26).Lanelet(l28).Lanelet(l27).Lanelet(l24);
+}
+
 // The 1-based line of the first occurrence of `needle` in `text` (0 when absent).
 inline int LineOf(std::string_view text, std::string_view needle) {
   const size_t at = text.find(needle);
