@@ -77,6 +77,9 @@ constexpr double kMapEndSlack = 10.0;
 constexpr double kMapRunOn = 300.0;
 // m: a lane farther than this from the lane on its left is apart from it there.
 constexpr double kDetached = 0.5;
+// m: a merging lanelet's taper ends where it is narrower (the planner's lane-end car is at
+// least this wide, and would reach into the lane beside).
+constexpr double kMinTaper = 0.5;
 
 // A lane profile's left (right: right) border at s, false outside its stations.
 bool BorderAt(const map::LaneProfile& l, double s, bool right, double* out) {
@@ -278,6 +281,54 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     if (st.s.size() < 2) continue;
     by_position[pos].push_back({o, std::move(st)});
     oncoming.insert(o);
+  }
+  // A lanelet merging into the road: a successor of one of its lanelets that is not part of it
+  // but leads into it (the right half of a zipper merge, drawn converging onto the half the
+  // reference follows, with no adjacency to it). It goes on the lane it comes from, clipped to
+  // the lanes beside that one, up to where it is narrower than kMinTaper: the lane tapers off
+  // where the merge really ends instead of ending with its last lanelet 20 m before.
+  std::vector<std::pair<int, int>> merging;  // lanelet, lateral position
+  for (const auto& [pos, pieces] : by_position) {
+    for (const Piece& p : pieces) {
+      for (int j : net.Successors(p.lanelet)) {
+        if (placed.count(j) > 0) continue;
+        const std::vector<int> next = net.Successors(j);
+        if (std::any_of(next.begin(), next.end(), [&](int k) { return placed.count(k) > 0; })) {
+          merging.push_back({j, pos});
+        }
+      }
+    }
+  }
+  // The border of lateral position `pos` at s (right: its right one), false where it has none.
+  const auto border_at = [&](int pos, double s, bool right, double* out) {
+    const auto it = by_position.find(pos);
+    if (it == by_position.end()) return false;
+    for (const Piece& p : it->second) {
+      const LaneletStations& st = p.st;
+      if (!(s >= st.s.front() && s <= st.s.back())) continue;
+      const size_t i = std::clamp<size_t>(
+          std::upper_bound(st.s.begin(), st.s.end(), s) - st.s.begin(), 1, st.s.size() - 1);
+      const std::vector<double>& b = right ? st.right : st.left;
+      const double f = (s - st.s[i - 1]) / (st.s[i] - st.s[i - 1]);
+      *out = b[i - 1] + f * (b[i] - b[i - 1]);
+      return true;
+    }
+    return false;
+  };
+  for (const auto& [j, pos] : merging) {
+    if (!placed.insert(j).second) continue;
+    const LaneletStations st = ProjectLanelet(net.at(j), **line);
+    LaneletStations kept;
+    for (size_t i = 0; i < st.s.size(); ++i) {
+      double left = st.left[i], right = st.right[i], b = 0;
+      if (border_at(pos - 1, st.s[i], true, &b)) left = std::max(left, b);
+      if (border_at(pos + 1, st.s[i], false, &b)) right = std::min(right, b);
+      if (!(right - left >= kMinTaper)) break;
+      kept.s.push_back(st.s[i]);
+      kept.left.push_back(left);
+      kept.right.push_back(right);
+    }
+    if (kept.s.size() >= 2) by_position[pos].push_back({j, std::move(kept)});
   }
   BuiltRoad out;
   std::vector<map::LaneProfile> lanes;

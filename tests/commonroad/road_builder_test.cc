@@ -167,6 +167,32 @@ TEST(RoadBuilderTest, ABorderDrawnInTwoPointsIsExactWhereTheLineBendsOffIt) {
   for (size_t i = 1; i < st.s.size(); ++i) EXPECT_LE(st.s[i] - st.s[i - 1], kStationStep + 0.1) << i;
 }
 
+TEST(RoadBuilderTest, TheHalfOfAZipperMergeOffTheReferenceTapersOffItsLane) {
+  // The reference follows 25 into 28; 26 goes on into 27, which converges onto 28 with no
+  // adjacency between them. Lane 1 (26) goes on into 27 as far as 27 lies beside 28, a taper
+  // that ends near where the merge does (x = 0: where it is narrower than 0.5 m), not where 26
+  // does (x = -20).
+  ScenarioXml xml;
+  AddZipperMerge(xml).Problem(1, {-110, 8.75}, 0, 9, {GoalLaneletXml(24, 84, 85)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  ASSERT_EQ(b.road->num_lanes(), 2);
+  EXPECT_EQ(b.lane_lanelets[1], (std::vector<int>{26, 27}));
+  const map::ReferenceLine& line = b.road->line();
+  EXPECT_GT(b.road->LaneEnd(1), line.ToFrenet(-6, 5.25).s);  // 26 ends at x = -20
+  EXPECT_LT(b.road->LaneEnd(1), line.ToFrenet(1, 5.25).s);
+  for (double x : {-15.0, -10.0, -5.0}) {
+    const double s = line.ToFrenet(x, 5.25).s;
+    const map::Road::Span left = b.road->LaneAt(0, s), right = b.road->LaneAt(1, s);
+    ASSERT_TRUE(left.exists && right.exists) << x;
+    // Lane 1 from lane 0's right border (28's, moving right) to 27's right border (y = 3.5).
+    EXPECT_NEAR(right.left, left.right, 0.01) << x;
+    EXPECT_NEAR(line.ToCartesian(s, right.right).y, 3.5, 0.05) << x;
+    EXPECT_GT(right.width(), 0.5) << x;
+    EXPECT_LT(right.width(), 3.5) << x;
+  }
+}
+
 TEST(RoadBuilderTest, GoalByRectangleRoutesIntoItsLane) {
   ScenarioXml xml;
   AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20,

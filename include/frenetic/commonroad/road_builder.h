@@ -15,9 +15,13 @@
 //     lanes over) at its lateral position; a lane is the lanelets at one lateral position, their
 //     borders projected onto the reference line; a lane goes on RoadArea::kDefaultOpenEndMargin
 //     (5 m) past an open end of the network (a lanelet without predecessor or successor), as the
-//     verdict's road area does; at the map's own ends (where every lane ends) the lanes run on
-//     straight for 300 m, so that the planner does not stop at the edge of the map (a run ends
-//     at its goal; the verdict holds the ego to the lanelets up to there).
+//     verdict's road area does. A lanelet merging into the road (a successor of one of its
+//     lanelets that leads into it without being part of it: the half of a zipper merge the
+//     reference does not follow, drawn converging onto the other) goes on the lane it comes
+//     from, clipped to the lanes beside, until narrower than 0.5 m. At the map's own ends
+//     (where every lane ends) the lanes run on straight for 300 m, so that the planner does not
+//     stop at the edge of the map (a run ends at its goal; the verdict holds the ego to the
+//     lanelets up to there).
 //  5. Oncoming lane: on a two-way road, the opposite-direction lanelet beside the leftmost
 //     lanelet of each skeleton cross-section is one more lane on the left, marked
 //     LaneProfile::oncoming (for passing only: the `oncoming` cost term); lanelets of the
