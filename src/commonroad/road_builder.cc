@@ -18,6 +18,9 @@
 
 namespace frenetic::commonroad {
 
+// Stations added between two border points at most (a segment of 2 km at kStationStep).
+constexpr double kMaxStationParts = 1000;
+
 LaneletStations ProjectLanelet(const Lanelet& l, const map::ReferenceLine& line) {
   std::vector<Vec2> left = l.left, right = l.right;
   if (left.size() != right.size()) {
@@ -31,8 +34,12 @@ LaneletStations ProjectLanelet(const Lanelet& l, const map::ReferenceLine& line)
   for (size_t i = 0; i < left.size(); ++i) {
     if (i > 0) {
       const double gap = std::max(Distance(left[i - 1], left[i]), Distance(right[i - 1], right[i]));
-      const int parts = std::isfinite(gap) ? static_cast<int>(std::ceil(gap / kStationStep)) : 1;
-      for (int q = 1; q < std::min(parts, 100000); ++q) {
+      // (At most kMaxStationParts: a hostile file's segment of 1e300 m stays cheap, and the
+      // cast defined.)
+      const int parts = std::isfinite(gap) ? static_cast<int>(std::min(
+                                                 std::ceil(gap / kStationStep), kMaxStationParts))
+                                           : 1;
+      for (int q = 1; q < parts; ++q) {
         const double f = static_cast<double>(q) / parts;
         dense_left.push_back({left[i - 1].x + f * (left[i].x - left[i - 1].x),
                               left[i - 1].y + f * (left[i].y - left[i - 1].y)});

@@ -3,6 +3,7 @@
 #include "frenetic/commonroad/road_builder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -165,6 +166,21 @@ TEST(RoadBuilderTest, ABorderDrawnInTwoPointsIsExactWhereTheLineBendsOffIt) {
   const LaneletStations st = ProjectLanelet(*sc.FindLanelet(25), line);
   ASSERT_GE(st.s.size(), 80u);
   for (size_t i = 1; i < st.s.size(); ++i) EXPECT_LE(st.s[i] - st.s[i - 1], kStationStep + 0.1) << i;
+}
+
+TEST(RoadBuilderTest, ALaneletOfAbsurdExtentIsProjectedAtBoundedCost) {
+  // A hostile file's border segment of 1e7 m: at most 1000 stations between two points.
+  const std::vector<map::ReferenceLine::Point> poly{{0, -1.75}, {300, -1.75}};
+  auto line = map::ReferenceLine::FitOpen(poly, map::ReferenceLine::Options(), "test");
+  ASSERT_TRUE(line.ok()) << line.message();
+  Lanelet l;
+  l.left = {{0, 0}, {1e7, 0}};
+  l.right = {{0, -3.5}, {1e7, -3.5}};
+  const LaneletStations st = ProjectLanelet(l, **line);
+  EXPECT_LE(st.s.size(), 1001u);
+  for (size_t i = 0; i < st.s.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(st.s[i]) && std::isfinite(st.left[i]) && std::isfinite(st.right[i]));
+  }
 }
 
 TEST(RoadBuilderTest, TheHalfOfAZipperMergeOffTheReferenceTapersOffItsLane) {
