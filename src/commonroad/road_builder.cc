@@ -88,15 +88,18 @@ constexpr double kDetached = 0.5;
 // least this wide, and would reach into the lane beside).
 constexpr double kMinTaper = 0.5;
 
-// A lane profile's left (right: right) border at s, false outside its stations.
-bool BorderAt(const map::LaneProfile& l, double s, bool right, double* out) {
-  if (l.s.size() < 2 || !(s >= l.s.front() && s <= l.s.back())) return false;
-  const size_t i = std::clamp<size_t>(std::upper_bound(l.s.begin(), l.s.end(), s) - l.s.begin(),
-                                      1, l.s.size() - 1);
-  const std::vector<double>& b = right ? l.right : l.left;
-  const double f = (s - l.s[i - 1]) / (l.s[i] - l.s[i - 1]);
+// A border given at stations (s increasing) read at s, linearly between them; false outside.
+bool BorderAt(const std::vector<double>& st, const std::vector<double>& b, double s, double* out) {
+  if (st.size() < 2 || !(s >= st.front() && s <= st.back())) return false;
+  const size_t i = std::clamp<size_t>(std::upper_bound(st.begin(), st.end(), s) - st.begin(), 1,
+                                      st.size() - 1);
+  const double f = (s - st[i - 1]) / (st[i] - st[i - 1]);
   *out = b[i - 1] + f * (b[i] - b[i - 1]);
   return true;
+}
+// A lane profile's left (right: right) border at s, false outside its stations.
+bool BorderAt(const map::LaneProfile& l, double s, bool right, double* out) {
+  return BorderAt(l.s, right ? l.right : l.left, s, out);
 }
 
 std::string Where(const Scenario& sc, const PlanningProblem& p) {
@@ -311,14 +314,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     const auto it = by_position.find(pos);
     if (it == by_position.end()) return false;
     for (const Piece& p : it->second) {
-      const LaneletStations& st = p.st;
-      if (!(s >= st.s.front() && s <= st.s.back())) continue;
-      const size_t i = std::clamp<size_t>(
-          std::upper_bound(st.s.begin(), st.s.end(), s) - st.s.begin(), 1, st.s.size() - 1);
-      const std::vector<double>& b = right ? st.right : st.left;
-      const double f = (s - st.s[i - 1]) / (st.s[i] - st.s[i - 1]);
-      *out = b[i - 1] + f * (b[i] - b[i - 1]);
-      return true;
+      if (BorderAt(p.st.s, right ? p.st.right : p.st.left, s, out)) return true;
     }
     return false;
   };
