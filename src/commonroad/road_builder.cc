@@ -41,10 +41,8 @@ LaneletStations ProjectLanelet(const Lanelet& l, const map::ReferenceLine& line)
                                            : 1;
       for (int q = 1; q < parts; ++q) {
         const double f = static_cast<double>(q) / parts;
-        dense_left.push_back({left[i - 1].x + f * (left[i].x - left[i - 1].x),
-                              left[i - 1].y + f * (left[i].y - left[i - 1].y)});
-        dense_right.push_back({right[i - 1].x + f * (right[i].x - right[i - 1].x),
-                               right[i - 1].y + f * (right[i].y - right[i - 1].y)});
+        dense_left.push_back(left[i - 1] + f * (left[i] - left[i - 1]));
+        dense_right.push_back(right[i - 1] + f * (right[i] - right[i - 1]));
       }
     }
     dense_left.push_back(left[i]);
