@@ -21,6 +21,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
+  bare_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
   contact_.reserve(ws_.order.capacity());
   group_start_.reserve(ws_.n_steps + 2);
@@ -37,6 +38,7 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
 }
 
 bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
+  bare_known_ = false;
   if (cfg_.check.clear_enough > 0) {
     const int c = CheapestClearEnough(over_budget);
     if (c >= 0) {
@@ -70,6 +72,7 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
     const int c = ws_.order[r];
     rest_.push_back({scorer_.KnownBound(c), c});
   }
+  bare_hit_.resize(ws_.cand_cost.size());
   const auto later = std::greater<BoundIndex>();
   std::make_heap(rest_.begin(), rest_.end(), later);
   for (int k = 0;; ++k) {
@@ -90,16 +93,18 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
       if (!limits_.CandidateBreaksLimits(c)) return c;
       continue;
     }
-    if (rest_.empty()) return -1;
+    if (rest_.empty()) {
+      bare_known_ = true;  // every candidate was tested
+      return -1;
+    }
     // By the bounds as they are (any lower bound gives the same answer): the cheap tests
     // first, the bound completed (Advance) only for a candidate that passes them.
     const int c = rest_.front().second;
     std::pop_heap(rest_.begin(), rest_.end(), later);
     rest_.pop_back();
-    if (collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
-        ws_.n_steps) {
-      continue;
-    }
+    bare_hit_[c] =
+        collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+    if (bare_hit_[c] <= ws_.n_steps) continue;
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
     if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough))
       continue;
@@ -126,6 +131,21 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   known_.assign(n, 0);
   first_hit_.resize(n);
   clearance_.resize(n);
+  latest_ = 0;
+  bounded_ = 0;
+  if (bare_known_ &&
+      std::none_of(order.begin(), order.end(), [&](int c) { return bare_hit_[c] > n_steps; })) {
+    // Every candidate collides, each contact known exactly (CheapestClearEnough): what the
+    // visits below would find, with no test.
+    for (const int c : order) {
+      known_[c] = 1;
+      first_hit_[c] = bare_hit_[c];
+      clearance_[c] = 0.0;
+      latest_ = std::max(latest_, bare_hit_[c]);
+    }
+    *all_known = true;
+    return -1;
+  }
   // The bound's steps: the first ones (where every candidate is still near the start, and the
   // clearance is often smallest) and a few spread over the horizon.
   const int probe[kProbes] = {1, 2, 4, 8, n_steps / 4, n_steps / 2, (3 * n_steps) / 4, n_steps};
@@ -161,8 +181,6 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   };
   int best = -1;
   double best_clr = 0;
-  latest_ = 0;
-  bounded_ = 0;
   lon_hit_.assign(ws_.lon.size(), 0);
   lat_hit_.assign(ws_.lat.size(), 0);
   // Visits c: whether it beats the best one so far.
@@ -173,7 +191,13 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       // one that hits before the latest contact so far, only a step it hits at (LatestContact
       // finds its contact if that is ever needed).
       clearance_[c] = 0.0;
-      Contact(c);
+      if (bare_known_) {  // its exact contact is known (CheapestClearEnough)
+        known_[c] = 1;
+        first_hit_[c] = bare_hit_[c];
+        if (first_hit_[c] <= n_steps) latest_ = std::max(latest_, first_hit_[c]);
+      } else {
+        Contact(c);
+      }
       if (first_hit_[c] <= n_steps) return;
       const CollisionChecker::Rows rows = collisions_.StepRows(c);
       clearance_[c] = ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
@@ -183,6 +207,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       best_clr = clearance_[c];
       return;
     }
+    if (bare_known_ && bare_hit_[c] <= n_steps) return;  // it collides: it cannot win
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
     const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
     if (clr < best_clr) return;
@@ -190,8 +215,8 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       scorer_.ExactCost(c);
       if (!Cheaper(ws_, c, best)) return;
     }
-    if (collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false) <=
-        n_steps) {
+    if (!bare_known_ && collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0,
+                                                   nullptr, false) <= n_steps) {
       return;
     }
     if (limits_.CandidateBreaksLimits(c)) return;

@@ -174,7 +174,9 @@ class LeastHarm {
   // one that hits before the latest contact latest_, a step it hits at (known_ 2: its exact
   // contact is needed only when no candidate of the latest contact is feasible).
   // unbounded: none may be clear (nothing passed last cycle either): in cost order without
-  // bounds until a clear one is found, then the rest by bound.
+  // bounds until a clear one is found, then the rest by bound. After a CheapestClearEnough that
+  // tested every candidate, their contacts are read from it (exact, known_ 1), and when every
+  // candidate collides nothing is visited.
   int BestClear(bool* over_budget, bool* all_known, bool unbounded);
   // Candidate c's contact on bare boxes as far as the ranking needs it: a step before latest_
   // at which it collides (known_ 2, counted in bounded_), else its first collision step, from
@@ -226,6 +228,10 @@ class LeastHarm {
   // that passed its cheap tests (a heap by a bound raised until it is the exact cost).
   std::vector<BoundIndex> rest_, clear_;
   std::vector<char> visited_;  // BestClear: taken from the heap
+  // CheapestClearEnough: each candidate's first collision step on bare boxes (n_steps + 1:
+  // none), and whether it tested every candidate (then BestClear reads their contacts here).
+  std::vector<int> bare_hit_;
+  bool bare_known_ = false;
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;
   static constexpr int kHeapVisits = 48;  // BestClear: candidates taken best bound first

@@ -315,5 +315,65 @@ TEST(SearchLeastHarmTest, LatestFeasibleContactWhenTheLatestOnesBreakLimits) {
   EXPECT_GE(earlier_group, 5) << "the scenes do not reach an earlier contact group";
 }
 
+// check.clear_enough with no candidate that clear: CheapestClearEnough has tested every
+// candidate on bare boxes, and the harm ranking reads those contacts instead of testing again
+// (every one colliding: no visit at all). The choice is the whole ranking's, boxed in and in
+// mixed traffic alike.
+TEST(SearchLeastHarmTest, TheRankingAfterNoneIsClearEnoughIsTheWholeRankings) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Overlay("check:\n  clear_enough: 20\n", "test").ok());
+  Stages st(config);
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0), gap(6.0, 20.0),
+      slow(0.0, 6.0), beside(-8.0, 8.0);
+  int compared = 0, boxed_in = 0;
+  for (int scene = 0; scene < 80; ++scene) {
+    std::vector<SceneCar> cars;
+    const double v = 14.0 + scene % 8;
+    if (scene % 2 == 0) {  // boxed in: every candidate collides
+      cars = {{kS + gap(rng), st.ws.lane_center[1], slow(rng)},
+              {kS + beside(rng), st.ws.lane_center[0], v},
+              {kS + beside(rng), st.ws.lane_center[2], v},
+              {kS + 15 + beside(rng), st.ws.lane_center[0], v},
+              {kS + 15 + beside(rng), st.ws.lane_center[2], v},
+              {kS - 12, st.ws.lane_center[1], v + 4}};  // and one closing from behind
+    } else {
+      for (int k = 0; k < 3 + scene / 4; ++k) {
+        cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
+      }
+    }
+    Start(st, cars);
+    st.Prepare({kS, v, 0, st.ws.lane_center[1], 0, 0}, cars);
+    st.lattice.Generate();
+    ASSERT_TRUE(st.scorer.Score());
+    bool over_budget = false;
+    const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
+    EXPECT_FALSE(over_budget);
+    ASSERT_TRUE(st.scorer.ResolveAll());
+    bool clear_enough = false, all_collide = true;
+    for (const int c : st.ws.order) {
+      if (st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr,
+                                       false) <= st.ws.n_steps) {
+        continue;
+      }
+      all_collide = false;
+      const CollisionChecker::Rows rows = st.collisions.StepRows(c);
+      clear_enough = clear_enough || ClearanceAbove(st.ws, rows.s, rows.d, 20.0) >= 20.0;
+    }
+    if (clear_enough) continue;  // the cheapest that clear wins (tested above)
+    const int expected = ReferenceChoice(st);
+    ASSERT_EQ(ok, expected >= 0) << "scene " << scene;
+    if (ok) {
+      EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
+    }
+    ++compared;
+    boxed_in += all_collide;
+  }
+  EXPECT_GE(compared, 60);
+  EXPECT_GE(boxed_in, 5) << "the scenes do not box the ego in";
+  EXPECT_LT(boxed_in, compared) << "no scene has a collision-free candidate";
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search
