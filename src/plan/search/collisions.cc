@@ -102,6 +102,34 @@ CollisionChecker::CollisionChecker(const Settings& cfg, Workspace& ws) : cfg_(cf
   tight_reach_.assign(w, 0.0);
   last_hit_.assign(2 * n_lon, LastHit{});
   lat_last_hit_.assign(n_lat, LastHit{});
+  bare_hit_.assign(ws_.order.capacity(), 0);
+  bare_epoch_.assign(ws_.order.capacity(), 0);
+}
+
+int CollisionChecker::BareContact(int c) {
+  const auto uc = static_cast<std::size_t>(c);
+  if (uc >= bare_hit_.size()) {  // beyond the sized candidates: measured, not kept
+    return FirstCollision(StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+  }
+  if (bare_traffic_ != ws_.traffic_stamp || bare_candidates_ != ws_.candidate_stamp) {
+    bare_traffic_ = ws_.traffic_stamp;
+    bare_candidates_ = ws_.candidate_stamp;
+    if (++epoch_ == 0) {  // wrapped: no stale entry may match
+      std::fill(bare_epoch_.begin(), bare_epoch_.end(), 0);
+      epoch_ = 1;
+    }
+  }
+  if (bare_epoch_[uc] != epoch_) {
+    bare_hit_[uc] = FirstCollision(StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+    bare_epoch_[uc] = epoch_;
+  }
+  return bare_hit_[uc];
+}
+
+bool CollisionChecker::BareContactImpliesCollision() const {
+  const Settings::Check& k = cfg_.check;
+  return k.margin_s >= 0 && k.margin_d >= 0 && k.margin_behind >= 0 && k.behind_time >= 0 &&
+         k.headway_min >= 0;
 }
 
 bool CollisionChecker::SampleSteps(const traj::Trajectory1d& tr, int i, BundleRows& rows) {

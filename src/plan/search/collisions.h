@@ -110,6 +110,21 @@ class CollisionChecker {
   // about the same step), which spares the scan of the steps before.
   bool CandidateCollides(int c);
 
+  // Candidate c's first collision step on bare boxes (margin_scale 0, the room behind kept,
+  // no ghosts) over the whole horizon, n_steps + 1 when none: FirstCollision(StepsOf(c, 0.0,
+  // 1.0), 0.0, 1.0, nullptr, false), measured once for the candidates and traffic of a cycle
+  // (later calls read it). The least-harm choice ranks by it.
+  int BareContact(int c);
+  // Whether BareContact(c) is measured already.
+  bool BareContactKnown(int c) const {
+    return bare_traffic_ == ws_.traffic_stamp && bare_candidates_ == ws_.candidate_stamp &&
+           static_cast<std::size_t>(c) < bare_epoch_.size() && bare_epoch_[c] == epoch_;
+  }
+  // Whether a bare-box contact means a collision with the inflated boxes too: the margins
+  // only grow the boxes (none is negative). Then a candidate whose BareContact is within its
+  // check steps collides (CandidateCollides).
+  bool BareContactImpliesCollision() const;
+
   // FirstCollision's reach along s at a step where the ego's s-speed is s_d: no car farther
   // away can collide (+inf when the margins cannot be bounded).
   double ReachS(double s_d, double margin_scale, double behind_scale) const;
@@ -175,6 +190,12 @@ class CollisionChecker {
   };
   std::vector<LastHit> last_hit_;      // two per lon slot, the latest first
   std::vector<LastHit> lat_last_hit_;  // one per lat slot
+  // BareContact per candidate, valid where bare_epoch_[c] is epoch_ for the traffic and
+  // candidates it was measured for.
+  std::vector<int> bare_hit_;
+  std::vector<std::uint32_t> bare_epoch_;
+  std::uint32_t epoch_ = 1;
+  std::uint64_t bare_traffic_ = 0, bare_candidates_ = 0;
 };
 
 // The margin FirstCollision gives a car is at most `widest` (inside <= 1, step_v <=

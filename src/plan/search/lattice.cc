@@ -475,6 +475,7 @@ void Lattice::Generate() {
   ws_.lat.clear();
   ws_.cand_lon.clear();
   ws_.cand_lat.clear();
+  ++ws_.candidate_stamp;
   // Lanes within reach (grid.lane_reach lane widths): the current one and its neighbours.
   bool reachable[cost::kMaxLanes] = {};
   for (int l = 0; l < cfg_.road.num_lanes; ++l) {

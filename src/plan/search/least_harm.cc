@@ -21,7 +21,6 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
-  bare_hit_.reserve(ws_.order.capacity());
   clearance_.reserve(ws_.order.capacity());
   contact_.reserve(ws_.order.capacity());
   group_start_.reserve(ws_.n_steps + 2);
@@ -72,7 +71,6 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
     const int c = ws_.order[r];
     rest_.push_back({scorer_.KnownBound(c), c});
   }
-  bare_hit_.resize(ws_.cand_cost.size());
   const auto later = std::greater<BoundIndex>();
   std::make_heap(rest_.begin(), rest_.end(), later);
   for (int k = 0;; ++k) {
@@ -102,9 +100,7 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
     const int c = rest_.front().second;
     std::pop_heap(rest_.begin(), rest_.end(), later);
     rest_.pop_back();
-    bare_hit_[c] =
-        collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
-    if (bare_hit_[c] <= ws_.n_steps) continue;
+    if (collisions_.BareContact(c) <= ws_.n_steps) continue;
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
     if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough))
       continue;
@@ -133,15 +129,16 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   clearance_.resize(n);
   latest_ = 0;
   bounded_ = 0;
-  if (bare_known_ &&
-      std::none_of(order.begin(), order.end(), [&](int c) { return bare_hit_[c] > n_steps; })) {
+  if (bare_known_ && std::none_of(order.begin(), order.end(), [&](int c) {
+        return collisions_.BareContact(c) > n_steps;
+      })) {
     // Every candidate collides, each contact known exactly (CheapestClearEnough): what the
     // visits below would find, with no test.
     for (const int c : order) {
       known_[c] = 1;
-      first_hit_[c] = bare_hit_[c];
+      first_hit_[c] = collisions_.BareContact(c);
       clearance_[c] = 0.0;
-      latest_ = std::max(latest_, bare_hit_[c]);
+      latest_ = std::max(latest_, first_hit_[c]);
     }
     *all_known = true;
     return -1;
@@ -193,7 +190,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       clearance_[c] = 0.0;
       if (bare_known_) {  // its exact contact is known (CheapestClearEnough)
         known_[c] = 1;
-        first_hit_[c] = bare_hit_[c];
+        first_hit_[c] = collisions_.BareContact(c);
         if (first_hit_[c] <= n_steps) latest_ = std::max(latest_, first_hit_[c]);
       } else {
         Contact(c);
@@ -207,7 +204,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       best_clr = clearance_[c];
       return;
     }
-    if (bare_known_ && bare_hit_[c] <= n_steps) return;  // it collides: it cannot win
+    if (bare_known_ && collisions_.BareContact(c) <= n_steps) return;  // it cannot win
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
     const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
     if (clr < best_clr) return;
@@ -277,9 +274,17 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
 }
 
 void LeastHarm::Contact(int c) {
-  const StepStates steps = collisions_.StepsOf(c, 0.0, 1.0);
   int& lon_hit = lon_hit_[ws_.cand_lon[c]];
   int& lat_hit = lat_hit_[ws_.cand_lat[c]];
+  if (collisions_.BareContactKnown(c)) {  // measured already (Selection): exact, for free
+    first_hit_[c] = collisions_.BareContact(c);
+    known_[c] = 1;
+    if (first_hit_[c] > ws_.n_steps) return;
+    latest_ = std::max(latest_, first_hit_[c]);
+    lon_hit = lat_hit = first_hit_[c];
+    return;
+  }
+  const StepStates steps = collisions_.StepsOf(c, 0.0, 1.0);
   // A step before latest_ that collides: the ones its bundles' last candidates hit at first.
   int hit = 0;
   if (latest_ > 1) {
@@ -429,9 +434,9 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
     }
     const int c = order[r];
     if (known_[c]) continue;
-    const StepStates steps = collisions_.StepsOf(c, 0.0, 1.0);
-    first_hit_[c] = collisions_.FirstCollision(steps, 0.0, 1.0, nullptr, false);
-    clearance_[c] = first_hit_[c] > ws_.n_steps ? ClearanceAt(ws_, steps) : 0.0;
+    first_hit_[c] = collisions_.BareContact(c);
+    clearance_[c] =
+        first_hit_[c] > ws_.n_steps ? ClearanceAt(ws_, collisions_.StepsOf(c, 0.0, 1.0)) : 0.0;
   }
   // Latest contact first, then most room; the cost order breaks ties (a strict total order:
   // std::stable_sort would allocate).

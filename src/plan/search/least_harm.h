@@ -228,9 +228,8 @@ class LeastHarm {
   // that passed its cheap tests (a heap by a bound raised until it is the exact cost).
   std::vector<BoundIndex> rest_, clear_;
   std::vector<char> visited_;  // BestClear: taken from the heap
-  // CheapestClearEnough: each candidate's first collision step on bare boxes (n_steps + 1:
-  // none), and whether it tested every candidate (then BestClear reads their contacts here).
-  std::vector<int> bare_hit_;
+  // Whether CheapestClearEnough tested every candidate on bare boxes (then BestClear reads
+  // their contacts, CollisionChecker::BareContact, instead of visiting).
   bool bare_known_ = false;
   // BestClear's bound: its steps, and the separations' parts there per bundle.
   static constexpr int kProbes = 8;

@@ -101,10 +101,19 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
     ++sum.candidates_feasible;
     return true;
   };
+  // Nothing passed last cycle, and the least-harm choice will want every candidate's contact
+  // on bare boxes (CheapestClearEnough tests them all when none passes): that contact first,
+  // and the inflated test only for a candidate clear of the bare boxes over its check steps
+  // (one that touches them there collides with the inflated boxes too).
+  const bool bare_first = none_passed_before && cfg_.check.clear_enough > 0 &&
+                          collisions_.BareContactImpliesCollision();
   // Whether c collides (counted as checked, and as rejected when it does).
   const auto collides = [&](int c) {
     ++sum.candidates_checked;
-    if (!collisions_.CandidateCollides(c)) return false;
+    if (!(bare_first && collisions_.BareContact(c) <= ws_.CheckSteps(c)) &&
+        !collisions_.CandidateCollides(c)) {
+      return false;
+    }
     ++sum.rejections[static_cast<int>(Reject::kCollision)];
     return true;
   };

@@ -136,6 +136,7 @@ struct Workspace {
   std::vector<double> step_s, step_d, step_v, step_vd, step_dir_s, step_dir_d;
   double step_v_max = std::numeric_limits<double>::infinity();  // >= every step_v (inf: unknown)
   std::uint64_t traffic_stamp = 0;     // changes whenever the traffic arrays above are rewritten
+  std::uint64_t candidate_stamp = 0;   // changes whenever the candidates are generated anew
   std::vector<double> prev_s, prev_d;  // the previous winner at the scoring samples
 
   // Bundles (Lattice): the 1-D trajectories, sampled at the scoring samples ([i * n_samples +

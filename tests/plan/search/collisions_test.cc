@@ -60,6 +60,45 @@ TEST(CollisionCheckerTest, StepsReachMasksAreTheReachTests) {
   EXPECT_GT(near_bits, 1000) << "the scene has cars within reach";
 }
 
+// BareContact is FirstCollision on bare boxes without ghosts, measured once a cycle and read
+// after; a new cycle's traffic measures anew. A bare contact within a candidate's check steps
+// is a collision with the inflated boxes too (Selection skips that test then).
+TEST(CollisionCheckerTest, BareContactIsTheBareFirstCollisionAndImpliesTheInflatedOne) {
+  REQUIRE_UDACITY_MAP();
+  Stages st;
+  ASSERT_TRUE(st.collisions.BareContactImpliesCollision());
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> gap(12.0, 70.0), speed(4.0, 24.0);
+  int touching = 0, clear = 0;
+  for (int scene = 0; scene < 3; ++scene) {
+    std::vector<testing::SceneCar> cars;
+    for (int k = 0; k < 3 + 2 * scene; ++k) {  // ahead and behind, none beside the ego
+      const double s = k % 2 == 0 ? kS + gap(rng) : kS - gap(rng);
+      cars.push_back({s, st.ws.lane_center[k % 3], speed(rng)});
+    }
+    st.Prepare({kS, 12.0 + 4 * scene, 0, st.ws.lane_center[1], 0, 0}, cars);
+    st.lattice.Generate();
+    const int n_cand = static_cast<int>(st.ws.cand_lon.size());
+    for (int c = 0; c < n_cand; c += 3) {
+      EXPECT_EQ(st.collisions.BareContactKnown(c), false) << "scene " << scene;
+      const int bare = st.collisions.BareContact(c);
+      EXPECT_TRUE(st.collisions.BareContactKnown(c));
+      EXPECT_EQ(bare, st.collisions.FirstCollision(st.collisions.StepsOf(c, 0.0, 1.0), 0.0, 1.0,
+                                                   nullptr, false))
+          << "scene " << scene << " candidate " << c;
+      EXPECT_EQ(st.collisions.BareContact(c), bare);
+      if (bare <= st.ws.CheckSteps(c)) {
+        EXPECT_TRUE(st.collisions.CandidateCollides(c)) << "scene " << scene << " candidate " << c;
+        ++touching;
+      } else {
+        ++clear;
+      }
+    }
+  }
+  EXPECT_GT(touching, 100);
+  EXPECT_GT(clear, 100);
+}
+
 TEST(CollisionCheckerTest, FindsBoxOverlapsWithHeadwayAndRoomBehind) {
   REQUIRE_UDACITY_MAP();
   Stages st;
