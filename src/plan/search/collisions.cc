@@ -88,11 +88,11 @@ CollisionChecker::CollisionChecker(const Settings& cfg, Workspace& ws) : cfg_(cf
   const std::size_t w = ws_.n_steps + 1;
   lon_steps_.Resize(n_lon, static_cast<int>(w));
   lat_steps_.Resize(n_lat, static_cast<int>(w));
-  lon_near_.assign(n_lon * w, 0);
+  lon_near_.assign(2 * n_lon * w, 0);
   lat_near_.assign(n_lat * w, 0);
   reach_.assign(w, 0.0);
   lat_reach_.assign(w, ws_.reach_d);
-  lon_near_key_.assign(n_lon, LonNearKey{});
+  lon_near_key_.assign(2 * n_lon, LonNearKey{});
   lat_near_stamp_.assign(n_lat, 0);
   lat_tight_.assign(n_lat * w, 0);
   lat_tight_stamp_.assign(n_lat, 0);
@@ -120,7 +120,11 @@ int CollisionChecker::BareContact(int c) {
     }
   }
   if (bare_epoch_[uc] != epoch_) {
-    bare_hit_[uc] = FirstCollision(StepsOf(c, 0.0, 1.0), 0.0, 1.0, nullptr, false);
+    // With CandidateCollides' narrower lateral test: it bounds the inflated boxes' extent, so a
+    // car it leaves out fails HitsAt on bare boxes too.
+    const StepStates reach = StepsOf(c, 0.0, 1.0);
+    bare_hit_[uc] = FirstCollision(reach.WithNearLat(TightLatNear(ws_.cand_lon[c], ws_.cand_lat[c])),
+                                   0.0, 1.0, nullptr, false);
     bare_epoch_[uc] = epoch_;
   }
   return bare_hit_[uc];
@@ -145,15 +149,23 @@ StepStates CollisionChecker::StepsOf(int c, double margin_scale, double behind_s
       std::min(ws_.num_check_cars, 64);  // ghosts too; FirstCollision may drop them
   // The reach tests of FirstCollision, on the same values (a car is kept unless it fails).
   const bool new_lon = SampleSteps(ws_.lon[i].traj, i, lon_steps_);
-  LonNearKey& lk = lon_near_key_[i];
+  // The bare boxes' masks (the least-harm tests) apart from the others', so that the two
+  // kinds of test taking turns on a bundle do not measure its masks anew each time.
+  const std::size_t slot = (margin_scale == 0.0 && behind_scale == 1.0 ? lon_near_key_.size() / 2
+                                                                         : 0) + i;
+  std::uint64_t* const lon_near = &lon_near_[slot * w];
+  LonNearKey& lk = lon_near_key_[slot];
+  if (new_lon) {  // both kinds are stale
+    lon_near_key_[i].stamp = lon_near_key_[lon_near_key_.size() / 2 + i].stamp = 0;
+  }
   // No branch on which cars pass (ReachMasks).
-  if (new_lon || lk.stamp != ws_.traffic_stamp || lk.margin_scale != margin_scale ||
+  if (lk.stamp != ws_.traffic_stamp || lk.margin_scale != margin_scale ||
       lk.behind_scale != behind_scale) {
     for (int j = 1; j <= ws_.n_steps; ++j) {
       reach_[j] = ReachS(lon_steps_.v[i * w + j], margin_scale, behind_scale);
     }
     ReachMasks(&lon_steps_.p[i * w], reach_.data(), ws_.step_s.data(), w, ws_.n_steps, num_cars,
-               ws_.car_reach_s.data(), &lon_near_[i * w]);
+               ws_.car_reach_s.data(), lon_near);
     lk = {ws_.traffic_stamp, margin_scale, behind_scale};
     lon_tight_stamp_[i] = 0;
   }
@@ -166,7 +178,7 @@ StepStates CollisionChecker::StepsOf(int c, double margin_scale, double behind_s
     lat_tight_stamp_[k] = 0;
   }
   return {lon_steps_.p.data() + i * w, lon_steps_.v.data() + i * w, lat_steps_.p.data() + k * w,
-          lat_steps_.v.data() + k * w, ws_.collision_step, lon_near_.data() + i * w,
+          lat_steps_.v.data() + k * w, ws_.collision_step, lon_near,
           lat_near_.data() + k * w};
 }
 
@@ -175,7 +187,7 @@ CollisionChecker::Rows CollisionChecker::StepRows(int c) {
   const int w = ws_.n_steps + 1;
   // A bundle sampled anew here has no reach tests yet (traffic_stamp is never 0 in a cycle).
   if (SampleSteps(ws_.lon[i].traj, i, lon_steps_)) {
-    lon_near_key_[i].stamp = 0;
+    lon_near_key_[i].stamp = lon_near_key_[lon_near_key_.size() / 2 + i].stamp = 0;
   }
   if (SampleSteps(ws_.lat[k].traj, k, lat_steps_)) {
     lat_near_stamp_[k] = 0;

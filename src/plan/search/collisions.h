@@ -156,7 +156,8 @@ class CollisionChecker {
   // Per bundle slot, the trajectory at the steps (p, v: s and s', or d and d').
   BundleRows lon_steps_, lat_steps_;
   // Per bundle slot and step, the cars passing the lateral (lat) and the longitudinal (lon)
-  // reach tests, with what they were computed for.
+  // reach tests, with what they were computed for; the lon ones twice (the second half for
+  // bare boxes, margin_scale 0 and behind_scale 1).
   struct LonNearKey {
     std::uint64_t stamp = 0;
     double margin_scale = 0, behind_scale = 0;
