@@ -134,28 +134,64 @@ void XyChecker::SetPrefix(const double* x, const double* y, int n) {
 
 XyMeasure XyChecker::MeasureWithPrefix(const double* x, const double* y, int n, int first,
                                         const XyLimits* stop_over) {
-  n = Compute(x, y, n, std::max(1, prefix_));
+  const int from = std::max(1, prefix_);
+  if (stop_over != nullptr) {
+    // Asked whether a limit is broken: the speeds first, and no curvature when they answer.
+    const int m_n = ComputeSpeeds(x, y, n, from);
+    XyMeasure m;
+    if (m_n >= 2 && SpeedOrPaceOver(m_n, first, *stop_over, &m)) return m;
+  }
+  n = Compute(x, y, n, from, stop_over != nullptr);
   return n < 2 ? XyMeasure{} : Worst(n, first, stop_over);
 }
 
-int XyChecker::Compute(const double* x, const double* y, int n, int from) {
+int XyChecker::ComputeSpeeds(const double* x, const double* y, int n, int from) {
   n = std::min(n, static_cast<int>(v_.size()) - 1);
   if (n < 2) return n;
   from = std::clamp(from, 1, n);
-  // v_[i]: speed at tick i (from i-1); kappa_[i]: Menger curvature of (i-1, i, i+1), 0 for the
-  // last point (recomputed once a later point exists).
+  // v_[i]: speed at tick i (from i-1).
   v_[0] = 0;
   for (int i = from; i < n; ++i) v_[i] = Norm(x[i] - x[i - 1], y[i] - y[i - 1]) / kDt;
+  vsum_[0] = 0;
+  for (int i = std::max(0, from - 1); i < n; ++i) vsum_[i + 1] = vsum_[i] + v_[i];
+  // Block means of speed, each block's once (a block's acceleration reads the block before):
+  // those ending before tick from - 1 are the same path's (its sums up to there are unchanged).
+  for (int j = std::max(kBlock - 1, from - 1); j < n; ++j) {
+    vmean_block_[j] = (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock;
+  }
+  return n;
+}
+
+bool XyChecker::SpeedOrPaceOver(int n, int first, const XyLimits& limits, XyMeasure* m) const {
+  first = std::clamp(first, 1, n - 1);
+  for (int i = first; i < n; ++i) m->max_speed = std::max(m->max_speed, v_[i]);
+  if (m->max_speed / limits.max_speed - 1.0 > 0) return true;
+  // The change of the block means alone: the total acceleration is the norm of it and of the
+  // curvature's part, never less (but for rounding: the margin of 1e-12 covers it).
+  double pace = 0;
+  for (int j = std::max(2 * kBlock, first); j < n; ++j) {
+    pace = std::max(pace, std::abs(vmean_block_[j] - vmean_block_[j - kBlock]) / (kBlock * kDt));
+  }
+  if (pace / limits.max_accel - 1.0 > 1e-12) {
+    m->max_accel = pace;
+    return true;
+  }
+  return false;
+}
+
+int XyChecker::Compute(const double* x, const double* y, int n, int from, bool speeds_done) {
+  if (!speeds_done) ComputeSpeeds(x, y, n, from);
+  n = std::min(n, static_cast<int>(v_.size()) - 1);
+  if (n < 2) return n;
+  from = std::clamp(from, 1, n);
+  // kappa_[i]: Menger curvature of (i-1, i, i+1), 0 for the last point (recomputed once a later
+  // point exists).
   kappa_[0] = 0;
   MengerCurvatures(x, y, std::max(1, from - 1), n, kappa_.data());
   kappa_[n - 1] = 0;
-  // Prefix sums make every sliding block mean O(1).
-  vsum_[0] = 0;
+  // Prefix sums make every sliding block mean O(1) (the speeds' are ComputeSpeeds').
   ksum_[0] = 0;
-  for (int i = std::max(0, from - 1); i < n; ++i) {
-    vsum_[i + 1] = vsum_[i] + v_[i];
-    ksum_[i + 1] = ksum_[i] + kappa_[i];
-  }
+  for (int i = std::max(0, from - 1); i < n; ++i) ksum_[i + 1] = ksum_[i] + kappa_[i];
   if (vehicle_.any()) {
     // The curvature's sign (left positive) from the triple's cross product.
     ksigned_sum_[0] = 0;
@@ -167,11 +203,6 @@ int XyChecker::Compute(const double* x, const double* y, int n, int from) {
       }
       ksigned_sum_[i + 1] = ksigned_sum_[i] + k;
     }
-  }
-  // Block means of speed, each block's once (a block's acceleration reads the block before):
-  // those ending before tick from - 1 are the same path's (its sums up to there are unchanged).
-  for (int j = std::max(kBlock - 1, from - 1); j < n; ++j) {
-    vmean_block_[j] = (vsum_[j + 1] - vsum_[j + 1 - kBlock]) / kBlock;
   }
   // Block ending at tick j holds ticks j-9..j; its triples are centred at j-8..j-1.
   auto kmean = [&](int j) { return (ksum_[j] - ksum_[j - 8]) / 8.0; };

@@ -63,14 +63,24 @@ class XyChecker {
   void SetPrefix(const double* x, const double* y, int n);
   // stop_over (optional): when the speed or the acceleration is already over its limit there
   // (value / limit - 1 > 0), the jerk and the vehicle's measures are left at 0, unmeasured (a
-  // caller asking only whether any limit is broken has its answer).
+  // caller asking only whether any limit is broken has its answer); the speed and the
+  // acceleration are then lower bounds, one of them over its limit (the speeds are measured
+  // first, and when the change of their 0.2 s block means alone is over the acceleration's
+  // limit, the curvature is not measured).
   XyMeasure MeasureWithPrefix(const double* x, const double* y, int n, int first,
                               const XyLimits* stop_over = nullptr);
 
  private:
   // Fills the per-tick arrays from index `from` on (1: the whole path), assuming the earlier
-  // entries are those of the same path; returns the path length used.
-  int Compute(const double* x, const double* y, int n, int from);
+  // entries are those of the same path; returns the path length used. speeds_done: the
+  // speeds' part (ComputeSpeeds) is filled already.
+  int Compute(const double* x, const double* y, int n, int from, bool speeds_done = false);
+  // Compute's speeds, their prefix sums and the 0.2 s block means only.
+  int ComputeSpeeds(const double* x, const double* y, int n, int from);
+  // After ComputeSpeeds: whether the speed (m->max_speed, as Worst measures it) or the change
+  // of the block means of speed alone (a lower bound of the total acceleration, m->max_accel)
+  // is over `limits` (as Worst's stop_over tests them): then Worst would stop there too.
+  bool SpeedOrPaceOver(int n, int first, const XyLimits& limits, XyMeasure* m) const;
   XyMeasure Worst(int n, int first, const XyLimits* stop_over = nullptr) const;
   void WorstVehicle(int n, int first, XyMeasure* m) const;
   int prefix_ = 0;
