@@ -70,7 +70,9 @@ double LimitChecker::CandidateViolation(int c, Reject* reason) {
   return CandidateMeasure(c, reason, false);
 }
 
-bool LimitChecker::CandidateBreaksLimits(int c) { return CandidateMeasure(c, nullptr, true) > 0; }
+bool LimitChecker::CandidateBreaksLimits(int c, Reject* first) {
+  return CandidateMeasure(c, first, true) > 0;
+}
 
 double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
@@ -147,10 +149,14 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
     } else {
       off_road = std::max(off_road, EdgeExcess(tk_s[prev], tk_s[i], read));
     }
-    if (any && ((lane_line && worst_straddle > kMaxStraddleTicks) || cfg_.limits.d_min - dmin > 0 ||
-                dmax - cfg_.limits.d_max > 0 || off_road > 0)) {
-      if (reason != nullptr) *reason = Reject::kCount;  // unknown: not measured in full
-      return 1.0;  // a limit is broken (which one is worst is not known)
+    if (any) {
+      const bool astride = lane_line && worst_straddle > kMaxStraddleTicks;
+      if (astride || cfg_.limits.d_min - dmin > 0 || dmax - cfg_.limits.d_max > 0 ||
+          off_road > 0) {
+        // The first one found (which one is worst is not known).
+        if (reason != nullptr) *reason = astride ? Reject::kLaneLine : Reject::kOffRoad;
+        return 1.0;
+      }
     }
     if (i == n_ticks) break;
   }

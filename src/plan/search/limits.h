@@ -59,10 +59,12 @@ class LimitChecker {
   // are left as they are.
   double CandidateViolation(int c, Reject* reason);
   // Whether candidate c breaks a limit: CandidateViolation(c, nullptr) > 0, the same answer,
-  // but the Frenet checks stop at the first limit found broken (the lane-line timer of a car
-  // long astride a line, say), so that no worst excess or reason is known then (a later
-  // CandidateViolation measures it all).
-  bool CandidateBreaksLimits(int c);
+  // but the checks stop at the first limit found broken (the lane-line timer of a car long
+  // astride a line, say, or the speeds braking harder than the acceleration limit), so that
+  // no worst excess is known then (a later CandidateViolation measures it all). first
+  // (optional): a limit it breaks, the first one found (the worst one when a whole verdict
+  // was remembered).
+  bool CandidateBreaksLimits(int c, Reject* first = nullptr);
 
  private:
   // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the

@@ -91,11 +91,12 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
   // Min-heaps by (bound, index) and (cost, index): Cheaper's order on exact costs.
   const auto later = std::greater<std::pair<double, int>>();
   std::make_heap(rest_.begin(), rest_.end(), later);
-  // Whether c passes the hard limits (counted as feasible or rejected).
+  // Whether c passes the hard limits (counted as feasible, or rejected for the first limit
+  // found broken: measuring them all for the worst would cost more than the answer).
   const auto within_limits = [&](int c) {
     Reject why = Reject::kCount;
-    if (limits_.CandidateViolation(c, &why) > 0) {
-      ++sum.rejections[static_cast<int>(why)];
+    if (limits_.CandidateBreaksLimits(c, &why)) {
+      ++sum.rejections[static_cast<int>(why == Reject::kCount ? Reject::kAcceleration : why)];
       return false;
     }
     ++sum.candidates_feasible;
