@@ -21,6 +21,11 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
+  clear_hint_.assign(ws_.lat.capacity(), -1);
+  lon_clear_.assign(ws_.lon.capacity() * kMaxCars, 0);
+  lat_clear_.assign(ws_.lat.capacity() * kMaxCars, 0);
+  lon_clear_done_.reserve(ws_.lon.capacity());
+  lat_clear_done_.reserve(ws_.lat.capacity());
   clearance_.reserve(ws_.order.capacity());
   contact_.reserve(ws_.order.capacity());
   group_start_.reserve(ws_.n_steps + 2);
@@ -73,6 +78,8 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
   }
   const auto later = std::greater<BoundIndex>();
   std::make_heap(rest_.begin(), rest_.end(), later);
+  lon_clear_done_.assign(ws_.lon.size(), 0);
+  lat_clear_done_.assign(ws_.lat.size(), 0);
   for (int k = 0;; ++k) {
     if ((k & 31) == 31 && clock_.ChecksOver(cfg_.budget_ms)) {
       *over_budget = true;
@@ -101,12 +108,55 @@ int LeastHarm::CheapestClearEnough(bool* over_budget) {
     std::pop_heap(rest_.begin(), rest_.end(), later);
     rest_.pop_back();
     if (collisions_.BareContact(c) <= ws_.n_steps) continue;
-    const CollisionChecker::Rows rows = collisions_.StepRows(c);
-    if (!(ClearanceAbove(ws_, rows.s, rows.d, cfg_.check.clear_enough) >= cfg_.check.clear_enough))
-      continue;
+    if (!ClearEnough(c)) continue;
     clear_.push_back({scorer_.KnownBound(c), c});
     std::push_heap(clear_.begin(), clear_.end(), later);
   }
+}
+
+// ClearanceAbove(rows of c, floor) >= floor, the floor check.clear_enough: no separation
+// std::max(a, b) below it, a the separation along s and b along d at a step (a NaN one is
+// ignored). A step keeps it when !(a < floor) (a NaN: ignored) or b >= floor; a keeps it or not
+// whatever the lat bundle, b whatever the lon bundle: one bit per step and car for each part,
+// once a cycle per bundle, and a candidate's test is an or per car.
+bool LeastHarm::ClearEnough(int c) {
+  const double floor = cfg_.check.clear_enough;
+  const int n_steps = ws_.n_steps, num_cars = ws_.ctx.num_cars;
+  const CollisionChecker::Rows rows = collisions_.StepRows(c);
+  if (n_steps > 64 || num_cars > kMaxCars || !(floor <= 1e9)) {
+    return ClearanceAbove(ws_, rows.s, rows.d, floor, &clear_hint_[ws_.cand_lat[c]]) >= floor;
+  }
+  const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
+  const int w = n_steps + 1;
+  if (!lon_clear_done_[i]) {
+    for (int car = 0; car < num_cars; ++car) {
+      const double* cs = ws_.step_s.data() + car * w;
+      const double len = ws_.car_sep_s[car];
+      std::uint64_t bits = 0;
+      for (int j = 1; j <= n_steps; ++j) {
+        bits |= static_cast<std::uint64_t>(!(std::abs(cs[j] - rows.s[j]) - len < floor)) << (j - 1);
+      }
+      lon_clear_[i * kMaxCars + car] = bits;
+    }
+    lon_clear_done_[i] = 1;
+  }
+  if (!lat_clear_done_[k]) {
+    for (int car = 0; car < num_cars; ++car) {
+      const double* cd = ws_.step_d.data() + car * w;
+      const double wid = ws_.car_sep_d[car];
+      std::uint64_t bits = 0;
+      for (int j = 1; j <= n_steps; ++j) {
+        bits |= static_cast<std::uint64_t>(std::abs(cd[j] - rows.d[j]) - wid >= floor) << (j - 1);
+      }
+      lat_clear_[k * kMaxCars + car] = bits;
+    }
+    lat_clear_done_[k] = 1;
+  }
+  const std::uint64_t all = n_steps == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n_steps) - 1;
+  for (int car = 0; car < num_cars; ++car) {
+    if ((lon_clear_[i * kMaxCars + car] | lat_clear_[k * kMaxCars + car]) != all) return false;
+  }
+  return true;
 }
 
 // In harm order the collision-free candidates come first, by clearance, then cost: when one
@@ -206,7 +256,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
     }
     if (bare_known_ && collisions_.BareContact(c) <= n_steps) return;  // it cannot win
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
-    const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
+    const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr, &clear_hint_[ws_.cand_lat[c]]);
     if (clr < best_clr) return;
     if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
