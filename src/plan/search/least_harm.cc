@@ -128,28 +128,26 @@ bool LeastHarm::ClearEnough(int c) {
   }
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = n_steps + 1;
-  if (!lon_clear_done_[i]) {
+  // Per car, bit j - 1 where keeps(|the car's p - row p| - its size) at step j.
+  const auto fill = [&](const double* p, const std::vector<double>& car_p,
+                        const std::vector<double>& size, auto keeps, std::uint64_t* bits) {
     for (int car = 0; car < num_cars; ++car) {
-      const double* cs = ws_.step_s.data() + car * w;
-      const double len = ws_.car_sep_s[car];
-      std::uint64_t bits = 0;
+      const double* cp = car_p.data() + car * w;
+      std::uint64_t b = 0;
       for (int j = 1; j <= n_steps; ++j) {
-        bits |= static_cast<std::uint64_t>(!(std::abs(cs[j] - rows.s[j]) - len < floor)) << (j - 1);
+        b |= static_cast<std::uint64_t>(keeps(std::abs(cp[j] - p[j]) - size[car])) << (j - 1);
       }
-      lon_clear_[i * kMaxCars + car] = bits;
+      bits[car] = b;
     }
+  };
+  if (!lon_clear_done_[i]) {
+    fill(rows.s, ws_.step_s, ws_.car_sep_s, [floor](double a) { return !(a < floor); },
+         &lon_clear_[i * kMaxCars]);
     lon_clear_done_[i] = 1;
   }
   if (!lat_clear_done_[k]) {
-    for (int car = 0; car < num_cars; ++car) {
-      const double* cd = ws_.step_d.data() + car * w;
-      const double wid = ws_.car_sep_d[car];
-      std::uint64_t bits = 0;
-      for (int j = 1; j <= n_steps; ++j) {
-        bits |= static_cast<std::uint64_t>(std::abs(cd[j] - rows.d[j]) - wid >= floor) << (j - 1);
-      }
-      lat_clear_[k * kMaxCars + car] = bits;
-    }
+    fill(rows.d, ws_.step_d, ws_.car_sep_d, [floor](double b) { return b >= floor; },
+         &lat_clear_[k * kMaxCars]);
     lat_clear_done_[k] = 1;
   }
   const std::uint64_t all = n_steps == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n_steps) - 1;
