@@ -21,7 +21,6 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
   rest_.reserve(ws_.order.capacity());
   clear_.reserve(ws_.order.capacity());
   first_hit_.reserve(ws_.order.capacity());
-  clear_hint_.assign(ws_.lat.capacity(), -1);
   lon_clear_.assign(ws_.lon.capacity() * kMaxCars, 0);
   lat_clear_.assign(ws_.lat.capacity() * kMaxCars, 0);
   lon_clear_done_.reserve(ws_.lon.capacity());
@@ -124,7 +123,7 @@ bool LeastHarm::ClearEnough(int c) {
   const int n_steps = ws_.n_steps, num_cars = ws_.ctx.num_cars;
   const CollisionChecker::Rows rows = collisions_.StepRows(c);
   if (n_steps > 64 || num_cars > kMaxCars || !(floor <= 1e9)) {
-    return ClearanceAbove(ws_, rows.s, rows.d, floor, &clear_hint_[ws_.cand_lat[c]]) >= floor;
+    return ClearanceAbove(ws_, rows.s, rows.d, floor) >= floor;
   }
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
   const int w = n_steps + 1;
@@ -236,13 +235,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       // one that hits before the latest contact so far, only a step it hits at (LatestContact
       // finds its contact if that is ever needed).
       clearance_[c] = 0.0;
-      if (bare_known_) {  // its exact contact is known (CheapestClearEnough)
-        known_[c] = 1;
-        first_hit_[c] = collisions_.BareContact(c);
-        if (first_hit_[c] <= n_steps) latest_ = std::max(latest_, first_hit_[c]);
-      } else {
-        Contact(c);
-      }
+      Contact(c);
       if (first_hit_[c] <= n_steps) return;
       const CollisionChecker::Rows rows = collisions_.StepRows(c);
       clearance_[c] = ClearanceAbove(ws_, rows.s, rows.d, -std::numeric_limits<double>::infinity());
@@ -252,18 +245,16 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
       best_clr = clearance_[c];
       return;
     }
-    if (bare_known_ && collisions_.BareContact(c) <= n_steps) return;  // it cannot win
+    // Known to collide (measured before): it cannot win.
+    if (collisions_.BareContactKnown(c) && collisions_.BareContact(c) <= n_steps) return;
     const CollisionChecker::Rows rows = collisions_.StepRows(c);
-    const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr, &clear_hint_[ws_.cand_lat[c]]);
+    const double clr = ClearanceAbove(ws_, rows.s, rows.d, best_clr);
     if (clr < best_clr) return;
     if (clr == best_clr) {  // the cost decides (both exact), then the index
       scorer_.ExactCost(c);
       if (!Cheaper(ws_, c, best)) return;
     }
-    if (!bare_known_ && collisions_.FirstCollision(collisions_.StepsOf(c, 0.0, 1.0), 0.0, 1.0,
-                                                   nullptr, false) <= n_steps) {
-      return;
-    }
+    if (collisions_.BareContact(c) <= n_steps) return;
     if (limits_.CandidateBreaksLimits(c)) return;
     scorer_.ExactCost(c);
     best = c;
@@ -324,7 +315,7 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
 void LeastHarm::Contact(int c) {
   int& lon_hit = lon_hit_[ws_.cand_lon[c]];
   int& lat_hit = lat_hit_[ws_.cand_lat[c]];
-  if (collisions_.BareContactKnown(c)) {  // measured already (Selection): exact, for free
+  if (collisions_.BareContactKnown(c)) {  // measured already (Selection, CheapestClearEnough)
     first_hit_[c] = collisions_.BareContact(c);
     known_[c] = 1;
     if (first_hit_[c] > ws_.n_steps) return;

@@ -7,8 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <cstdint>
+#include <utility>
 #include <vector>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -114,11 +114,8 @@ inline double MinOfMax(const double* a, const double* b, int n) {
 
 // ClearanceAt's value from the rows s, d at the collision-check steps when it is at least
 // `floor`; else a value below `floor` (it stops at the first car that takes it there). The same
-// minimum, car by car: the order does not change a minimum that ignores NaN. hint (optional):
-// a car tried first (the one that took a similar candidate below its floor: mostly it does
-// again), set to the car that takes this one below `floor`.
-inline double ClearanceAbove(const Workspace& ws, const double* s, const double* d, double floor,
-                             int* hint = nullptr) {
+// minimum, car by car: the order does not change a minimum that ignores NaN.
+inline double ClearanceAbove(const Workspace& ws, const double* s, const double* d, double floor) {
   constexpr int kMaxSteps = 256;
   const int n_steps = ws.n_steps;
   if (n_steps >= kMaxSteps) {
@@ -128,27 +125,17 @@ inline double ClearanceAbove(const Workspace& ws, const double* s, const double*
     });
   }
   double sep[kMaxSteps];
-  const auto car_min = [&](int c) {
+  double worst = 1e9;
+  for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
     const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c];
     for (int j = 1; j <= n_steps; ++j) {
       sep[j - 1] = std::max(std::abs(cs[j] - s[j]) - len, std::abs(cd[j] - d[j]) - wid);
     }
-    return MinOf(sep, n_steps);
-  };
-  if (hint != nullptr && *hint >= 0 && *hint < ws.ctx.num_cars) {
-    const double row = car_min(*hint);
-    if (row < floor) return row;
-  }
-  double worst = 1e9;
-  for (int c = 0; c < ws.ctx.num_cars; ++c) {
-    const double row = car_min(c);
+    const double row = MinOf(sep, n_steps);
     worst = row < worst ? row : worst;
-    if (worst < floor) {
-      if (hint != nullptr) *hint = c;
-      break;
-    }
+    if (worst < floor) break;
   }
   return worst;
 }
@@ -242,9 +229,6 @@ class LeastHarm {
   // that passed its cheap tests (a heap by a bound raised until it is the exact cost).
   std::vector<BoundIndex> rest_, clear_;
   std::vector<char> visited_;  // BestClear: taken from the heap
-  // ClearanceAbove's hint per lat bundle slot: the car that took its last candidate below the
-  // floor.
-  std::vector<int> clear_hint_;
   // CheapestClearEnough's test of a clearance of at least check.clear_enough, by parts: per lon
   // (lat) bundle slot and car, bit j - 1 set where step j's separation along s (d) alone keeps
   // it (ClearEnough), filled once a cycle per slot (the done flags).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "plan/search/stages_testing.h"
@@ -152,6 +153,14 @@ TEST(SearchLeastHarmTest, NeverTakesAnInfeasibleCandidate) {
   EXPECT_FALSE(over_budget);
 }
 
+// The default configuration with check.clear_enough set to `metres`.
+PlannerConfig ClearEnoughConfig(double metres) {
+  PlannerConfig config = testing::DefaultConfig();
+  EXPECT_TRUE(
+      config.Overlay("check:\n  clear_enough: " + std::to_string(metres) + "\n", "test").ok());
+  return config;
+}
+
 // The whole ranking as the search planner once did it: every candidate's contact and
 // clearance, sorted, then the first feasible one with the lane-line timer, else without.
 int ReferenceChoice(Stages& st) {
@@ -224,9 +233,7 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
 // candidate than the cheapest could win).
 TEST(SearchLeastHarmTest, ClearEnoughIsTheCheapestThatPassesAfterTheLazyCheck) {
   REQUIRE_UDACITY_MAP();
-  PlannerConfig config = testing::DefaultConfig();
-  ASSERT_TRUE(config.Overlay("check:\n  clear_enough: 0.5\n", "test").ok());
-  Stages st(config);
+  Stages st(ClearEnoughConfig(0.5));
   std::mt19937 rng(23);
   std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0), pick(0.0, 1.0);
   int chosen = 0;
@@ -321,9 +328,7 @@ TEST(SearchLeastHarmTest, LatestFeasibleContactWhenTheLatestOnesBreakLimits) {
 // mixed traffic alike.
 TEST(SearchLeastHarmTest, TheRankingAfterNoneIsClearEnoughIsTheWholeRankings) {
   REQUIRE_UDACITY_MAP();
-  PlannerConfig config = testing::DefaultConfig();
-  ASSERT_TRUE(config.Overlay("check:\n  clear_enough: 20\n", "test").ok());
-  Stages st(config);
+  Stages st(ClearEnoughConfig(20));
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0), gap(6.0, 20.0),
       slow(0.0, 6.0), beside(-8.0, 8.0);
