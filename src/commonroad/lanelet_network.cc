@@ -35,6 +35,8 @@ void Network::InferNeighbours() {
     const double spacing = left_len / (samples - 1);
     for (int j = 0; j < n && inferred_left_[i] < 0; ++j) {
       if (j == i || at(j).adjacent_right.has_value() || inferred_right_[j] >= 0) continue;
+      // (Not the halves of a split: the planner's lanes would jump across at the fork.)
+      if (SharePredecessor(i, j)) continue;
       const std::vector<Vec2> right = at(j).CleanRight();
       const double len = PolylineLength(right);
       int shared = 0;

@@ -78,7 +78,19 @@ class Network {
   // (within kSharedBound of it for kSharedLength m or more, sampled every kSampleSpacing m: the
   // last stretch of a converging ramp will do; the same direction there) and that has no
   // neighbour on its right.
+  // The halves of a split (lanelets with a common predecessor) are never inferred to be
+  // neighbours: they start on top of each other, and where one bends away (an exit ramp) its
+  // bound crosses the other's for a stretch.
   void InferNeighbours();
+  // Whether lanelets i and j (indices) are successors of one lanelet.
+  bool SharePredecessor(int i, int j) const {
+    for (int a : at(i).predecessors) {
+      for (int b : at(j).predecessors) {
+        if (a == b) return true;
+      }
+    }
+    return false;
+  }
 
   const Scenario& sc_;
   std::vector<int> inferred_left_, inferred_right_;

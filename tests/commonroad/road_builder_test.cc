@@ -16,6 +16,7 @@ namespace frenetic::commonroad {
 namespace {
 
 using testing::AddCurvedRoad;
+using testing::AddSplitExit;
 using testing::AddStraightRoad;
 using testing::AddTwoWayRoad;
 using testing::AddZipperMerge;
@@ -236,6 +237,34 @@ TEST(RoadBuilderTest, LanesSharingABoundAreNeighboursWhenTheFileSaysNothing) {
       .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, 0, 100)});
   const Scenario sc = Parse(apart);
   EXPECT_FALSE(BuildRoad(sc, sc.problems[0]).ok());
+}
+
+TEST(RoadBuilderTest, AnExitThatSplitsOffIsFollowedAndTheOtherHalfIsNoNeighbour) {
+  // The ego in the left lane, the goal on the ramp that splits off the right lane. The ramp's
+  // left bound crosses the straight half's right bound where it bends away (x 320-340): that
+  // is no neighbour's bound, so the ramp's lane does not jump across the straight half.
+  ScenarioXml xml;
+  AddSplitExit(xml).Problem(1, {20, 1.75}, 0, 25, {GoalLaneletXml(5, 0, 200)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.route, (std::vector<int>{2, 1, 5}));
+  EXPECT_EQ(b.skeleton, (std::vector<int>{1, 5}));
+  EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{2}, {1, 5}}));
+  // The left lane ends at the fork (its own way on leads elsewhere); the right one goes on
+  // along the ramp, 3.5 m wide about the line.
+  EXPECT_NEAR(b.road->LaneEnd(0), 200, 1.0);
+  for (double s : {100.0, 250.0, 350.0}) {
+    const map::Road::Span r = b.road->LaneAt(1, s);
+    ASSERT_TRUE(r.exists) << s;
+    EXPECT_NEAR(r.width(), 3.5, 0.1) << s;
+    EXPECT_NEAR(r.centre(), 0.0, 0.1) << s;
+  }
+  // The straight half is the route when the goal lies on it.
+  ScenarioXml on;
+  AddSplitExit(on).Problem(1, {20, 1.75}, 0, 25, {GoalLaneletXml(4, 0, 200)});
+  const BuiltRoad straight = Build(Parse(on));
+  ASSERT_NE(straight.road, nullptr);
+  EXPECT_EQ(straight.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1, 4}}));
 }
 
 TEST(RoadBuilderTest, FailuresNameTheProblem) {

@@ -20,6 +20,7 @@ namespace frenetic::commonroad {
 namespace {
 
 using testing::AddCurvedRoad;
+using testing::AddSplitExit;
 using testing::AddStraightRoad;
 using testing::AddTwoWayRoad;
 using testing::GoalLaneletXml;
@@ -190,6 +191,22 @@ TEST(RunnerTest, LeavesAnEndingLaneForTheGoal) {
   const ProblemRun p = RunOne(xml);
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
   EXPECT_EQ(p.lanes, 2);
+}
+
+TEST(RunnerTest, TakesAnExitThatSplitsOffThroughTraffic) {
+  // From the left lane onto the ramp that splits off the right lane at x = 200, between cars
+  // of both lanes (the right lane's go straight on past the fork).
+  ScenarioXml xml;
+  AddSplitExit(xml)
+      .DynamicObstacle(10, 4.5, 1.8, Drive(-10, -1.75, 27, 150))
+      .DynamicObstacle(11, 4.5, 1.8, Drive(45, -1.75, 24, 150))
+      .DynamicObstacle(12, 4.5, 1.8, Drive(110, -1.75, 26, 150))
+      .DynamicObstacle(13, 4.5, 1.8, Drive(70, 1.75, 25, 150))
+      .Problem(1, {20, 1.75}, 0, 25, {GoalLaneletXml(5, 0, 150)});
+  for (PredictionMode mode : {PredictionMode::kRecorded, PredictionMode::kConstantVelocity}) {
+    const ProblemRun p = RunOne(xml, mode);
+    EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  }
 }
 
 TEST(RunnerTest, FollowsACurvedRoadToATimeOnlyGoal) {

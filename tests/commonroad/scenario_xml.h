@@ -285,6 +285,34 @@ inline ScenarioXml& AddCurvedRoad(ScenarioXml& xml, double radius, double sweep,
   return xml.Lanelet(l);
 }
 
+// A motorway exit drawn as a split: two lanes along +x (lanelet 1 right, y in [-3.5, 0], and 2
+// left, y in [0, 3.5], from x = 0 to 200), the left lane going on as 3 (to 500) and the right one
+// splitting at x = 200 into 4 (straight on to 500) and the ramp 5, which starts on top of 4 and
+// bends off to the right (0.0002 (x - 200)^2 m: 3.5 m at x = 332, 8 m at 400, where it ends).
+// No adjacency between the halves of the split; 3 and 4 are neighbours, as are 1 and 2.
+inline ScenarioXml& AddSplitExit(ScenarioXml& xml) {
+  const auto ramp = [](double y) {
+    std::vector<Vec2> out = Line(200, 400, y);
+    for (Vec2& p : out) p.y -= 0.0002 * (p.x - 200) * (p.x - 200);
+    return out;
+  };
+  LaneletXml l1 = Lane(1, Line(0, 200, 0), Line(0, 200, -3.5));
+  l1.adjacent_left = {{2, true}};
+  l1.successors = {4, 5};
+  LaneletXml l2 = Lane(2, Line(0, 200, 3.5), Line(0, 200, 0));
+  l2.adjacent_right = {{1, true}};
+  l2.successors = {3};
+  LaneletXml l3 = Lane(3, Line(200, 500, 3.5), Line(200, 500, 0));
+  l3.adjacent_right = {{4, true}};
+  l3.predecessors = {2};
+  LaneletXml l4 = Lane(4, Line(200, 500, 0), Line(200, 500, -3.5));
+  l4.adjacent_left = {{3, true}};
+  l4.predecessors = {1};
+  LaneletXml l5 = Lane(5, ramp(0), ramp(-3.5));
+  l5.predecessors = {1};
+  return xml.Lanelet(l1).Lanelet(l2).Lanelet(l3).Lanelet(l4).Lanelet(l5);
+}
+
 // A hand-crafted zipper merge drawn as such files are, each border straight in a few points:
 // two lanes along +x from x = -180 to -20 (lanelet 25 left, y in [7, 10.5]; 26 right, y in
 // [3.5, 7]), each border in three points; 25 goes on into 28, which moves 3.5 m right over 20 m,
