@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""Hand-made CommonRoad 2020a problems at motorway ramps, for probing the road builder.
+
+Two 3.5 m lanes along +x (lanelet 1 right, 2 left, x 0-200; then 3 left and 4 right, x 200-500)
+and one of four junctions:
+  exit      the right lane splits at x = 200 into 4 (straight on) and the ramp 5, which starts on
+            top of 4 and bends off to the right (0.0002 (x - 200)^2 m); the goal is lanelet 5,
+            the ego starts in the left lane;
+  straight  the same split, the goal is lanelet 4, the ego starts in the right lane;
+  exitb     a deceleration lane 6 (x 120-220, adjacent right of 4) goes on as the ramp 7; the
+            goal is 7, the ego starts in the left lane;
+  entry     an acceleration lane 5 (x 0-200, adjacent right of 1) ends at x = 200; the ego starts
+            on it, the goal is lanelet 4.
+Traffic (seed > 0): cars at 22-30 m/s in both lanes, 30-70 m apart, each at constant speed
+along its lane (none within 12 m of the ego's start in its lane); seed 0: none.
+
+  scripts/commonroad-ramps.py OUT_DIR [--speeds 15 25 32] [--seeds 0 1 2 3 4 5 6]
+writes OUT_DIR/<kind>_v<speed>_<seed>.xml for every kind, ego speed (m/s) and seed.
+"""
+import argparse
+import os
+import random
+
+W = 3.5
+
+
+def points(xs, f):
+    return ''.join(f'<point><x>{x:.4f}</x><y>{f(x):.4f}</y></point>' for x in xs)
+
+
+def lanelet(i, xs, left, right, pred=(), succ=(), al=None, ar=None):
+    s = (f'<lanelet id="{i}"><leftBound>{points(xs, left)}<lineMarking>dashed</lineMarking>'
+         f'</leftBound><rightBound>{points(xs, right)}<lineMarking>solid</lineMarking></rightBound>')
+    s += ''.join(f'<predecessor ref="{p}"/>' for p in pred)
+    s += ''.join(f'<successor ref="{p}"/>' for p in succ)
+    if al:
+        s += f'<adjacentLeft ref="{al}" drivingDir="same"/>'
+    if ar:
+        s += f'<adjacentRight ref="{ar}" drivingDir="same"/>'
+    return s + '<laneletType>interstate</laneletType></lanelet>\n'
+
+
+def goal_lanelet(i):
+    return ('<goalState><time><intervalStart>0</intervalStart><intervalEnd>200</intervalEnd></time>'
+            f'<position><lanelet ref="{i}"/></position></goalState>')
+
+
+def road(kind):
+    """The lanelets, the goal and the ego's start y of one kind."""
+    x0, x1 = range(0, 201, 10), range(200, 501, 10)
+    out = []
+    if kind in ('exit', 'straight'):
+        def off(x):
+            return -0.0002 * (x - 200) ** 2
+        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4, 5), al=2))
+        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
+        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
+        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
+        out.append(lanelet(5, range(200, 401, 10), off, lambda x: off(x) - W, pred=(1,)))
+        return out, goal_lanelet(5 if kind == 'exit' else 4), (W / 2 if kind == 'exit' else -W / 2)
+    if kind == 'exitb':
+        def off(x):
+            return -0.0002 * (x - 220) ** 2
+        out.append(lanelet(1, range(0, 121, 10), lambda x: 0, lambda x: -W, succ=(4,), al=2))
+        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
+        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
+        out.append(lanelet(4, range(120, 501, 10), lambda x: 0, lambda x: -W, pred=(1,), al=3, ar=6))
+        out.append(lanelet(6, range(120, 221, 10), lambda x: -W, lambda x: -2 * W, succ=(7,), al=4))
+        out.append(lanelet(7, range(220, 421, 10), lambda x: off(x) - W, lambda x: off(x) - 2 * W,
+                           pred=(6,)))
+        return out, goal_lanelet(7), W / 2
+    if kind == 'entry':
+        out.append(lanelet(5, x0, lambda x: -W, lambda x: -2 * W, al=1))
+        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4,), al=2, ar=5))
+        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
+        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
+        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
+        return out, goal_lanelet(4), -1.5 * W
+    raise ValueError(kind)
+
+
+def state(x, y, v, k):
+    return (f'<position><point><x>{x:.3f}</x><y>{y}</y></point></position><orientation><exact>0'
+            f'</exact></orientation><time><exact>{k}</exact></time><velocity><exact>{v:.3f}'
+            '</exact></velocity>')
+
+
+def scenario(kind, speed, seed):
+    lanes, goal, y0 = road(kind)
+    cars = []
+    if seed > 0:
+        rng = random.Random(seed)
+        for lane_y in (W / 2, -W / 2):
+            x = rng.uniform(-40, 20)
+            while x < 250:
+                v = rng.uniform(22, 30)
+                if abs(x - 20) > 12 or abs(lane_y - y0) > 1:
+                    trajectory = ''.join(f'<state>{state(x + v * 0.1 * k, lane_y, v, k)}</state>'
+                                         for k in range(1, 150))
+                    cars.append(
+                        f'<dynamicObstacle id="{100 + len(cars)}"><type>car</type><shape><rectangle>'
+                        '<length>4.5</length><width>1.8</width></rectangle></shape><initialState>'
+                        f'{state(x, lane_y, v, 0)}<yawRate><exact>0</exact></yawRate><slipAngle>'
+                        f'<exact>0</exact></slipAngle></initialState><trajectory>{trajectory}'
+                        '</trajectory></dynamicObstacle>\n')
+                x += rng.uniform(30, 70)
+    problem = (f'<planningProblem id="1"><initialState>{state(20, y0, speed, 0)}<yawRate><exact>0'
+               '</exact></yawRate><slipAngle><exact>0</exact></slipAngle></initialState>'
+               f'{goal}</planningProblem>')
+    return ('<?xml version="1.0" encoding="UTF-8"?>\n<commonRoad timeStepSize="0.1" '
+            'commonRoadVersion="2020a" author="frenetic" affiliation="frenetic" source="hand-made" '
+            f'benchmarkID="ZAM_{kind.capitalize()}-{int(speed)}_{seed}_T-1" date="2026-11-30">\n'
+            + ''.join(lanes) + ''.join(cars) + problem + '\n</commonRoad>\n')
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument('out_dir', help='directory for the files (created if missing)')
+    ap.add_argument('--speeds', type=float, nargs='+', default=[15, 25, 32],
+                    help="the ego's initial speeds, m/s (default: 15 25 32)")
+    ap.add_argument('--seeds', type=int, nargs='+', default=list(range(7)),
+                    help='traffic seeds, 0 = no traffic (default: 0-6)')
+    args = ap.parse_args()
+    os.makedirs(args.out_dir, exist_ok=True)
+    for kind in ('exit', 'straight', 'exitb', 'entry'):
+        for speed in args.speeds:
+            for seed in args.seeds:
+                path = os.path.join(args.out_dir, f'{kind}_v{int(speed)}_{seed}.xml')
+                with open(path, 'w') as f:
+                    f.write(scenario(kind, speed, seed))
+
+
+if __name__ == '__main__':
+    main()
