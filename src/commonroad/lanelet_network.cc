@@ -35,9 +35,13 @@ void Network::InferNeighbours() {
     const double spacing = left_len / (samples - 1);
     for (int j = 0; j < n && inferred_left_[i] < 0; ++j) {
       if (j == i || at(j).adjacent_right.has_value() || inferred_right_[j] >= 0) continue;
-      // (Not the halves of a split: the planner's lanes would jump across at the fork.)
-      if (SharePredecessor(i, j)) continue;
       const std::vector<Vec2> right = at(j).CleanRight();
+      // The halves of a split only when side by side from the fork (a lane widening into two),
+      // not when one bends off the other (the planner's lanes would jump across at the fork).
+      if (SharePredecessor(i, j) && (left.empty() || right.empty() ||
+                                     !(Distance(left.front(), right.front()) <= kSharedBound))) {
+        continue;
+      }
       const double len = PolylineLength(right);
       int shared = 0;
       bool opposite = false;

@@ -78,9 +78,9 @@ class Network {
   // (within kSharedBound of it for kSharedLength m or more, sampled every kSampleSpacing m: the
   // last stretch of a converging ramp will do; the same direction there) and that has no
   // neighbour on its right.
-  // The halves of a split (lanelets with a common predecessor) are never inferred to be
-  // neighbours: they start on top of each other, and where one bends away (an exit ramp) its
-  // bound crosses the other's for a stretch.
+  // The halves of a split (lanelets with a common predecessor) are neighbours only when their
+  // bounds meet at the fork (a lane widening into two): an exit ramp starts on top of the
+  // straight half, and where it bends away its bound crosses the other's for a stretch.
   void InferNeighbours();
   // Whether lanelets i and j (indices) are successors of one lanelet.
   bool SharePredecessor(int i, int j) const {

@@ -267,6 +267,27 @@ TEST(RoadBuilderTest, AnExitThatSplitsOffIsFollowedAndTheOtherHalfIsNoNeighbour)
   EXPECT_EQ(straight.lane_lanelets, (std::vector<std::vector<int>>{{2, 3}, {1, 4}}));
 }
 
+TEST(RoadBuilderTest, TheHalvesOfALaneWideningIntoTwoAreNeighbours) {
+  // Lanelet 1 widens from 3.5 m to 7 m (its right bound moving out) and splits into 4 (left
+  // half) and 5 (right half), side by side from the fork; the file names no adjacency. The
+  // halves are neighbours: the goal's half is the reference's lane, the other one beside it.
+  ScenarioXml xml;
+  std::vector<Vec2> widening;
+  for (double x = 0; x <= 100; x += 10) widening.push_back({x, -3.5 - 0.035 * x});
+  LaneletXml l1 = Lane(1, Line(0, 100, 0), widening);
+  l1.successors = {4, 5};
+  LaneletXml l4 = Lane(4, Line(100, 400, 0), Line(100, 400, -3.5));
+  l4.predecessors = {1};
+  LaneletXml l5 = Lane(5, Line(100, 400, -3.5), Line(100, 400, -7));
+  l5.predecessors = {1};
+  xml.Lanelet(l1).Lanelet(l4).Lanelet(l5).Problem(1, {10, -2}, 0, 20,
+                                                  {GoalLaneletXml(5, 0, 100)});
+  const BuiltRoad b = Build(Parse(xml));
+  ASSERT_NE(b.road, nullptr);
+  EXPECT_EQ(b.route, (std::vector<int>{1, 5}));
+  EXPECT_EQ(b.lane_lanelets, (std::vector<std::vector<int>>{{4}, {1, 5}}));
+}
+
 TEST(RoadBuilderTest, FailuresNameTheProblem) {
   ScenarioXml far;
   AddStraightRoad(far, 300).Problem(7, {10, 50}, 0, 20, {GoalTimeOnlyXml(50, 50)});
