@@ -7,6 +7,10 @@ and one of four junctions:
             top of 4 and bends off to the right (0.0002 (x - 200)^2 m); the goal is lanelet 5,
             the ego starts in the left lane;
   straight  the same split, the goal is lanelet 4, the ego starts in the right lane;
+  exitleft  the split mirrored: the ramp bends off the left lane to the left, the ego starts in
+            the right lane;
+  exitcurve the split with a ramp on an arc of 150 m radius turning right (1.2 rad); the goal is
+            a 10 m box at its end;
   exitb     a deceleration lane 6 (x 120-220, adjacent right of 4) goes on as the ramp 7; the
             goal is 7, the ego starts in the left lane;
   entry     an acceleration lane 5 (x 0-200, adjacent right of 1) ends at x = 200; the ego starts
@@ -15,9 +19,12 @@ Traffic (seed > 0): cars at 22-30 m/s in both lanes, 30-70 m apart, each at cons
 along its lane (none within 12 m of the ego's start in its lane); seed 0: none.
 
   scripts/commonroad-ramps.py OUT_DIR [--speeds 15 25 32] [--seeds 0 1 2 3 4 5 6]
-writes OUT_DIR/<kind>_v<speed>_<seed>.xml for every kind, ego speed (m/s) and seed.
+  [--opens STEP]
+writes OUT_DIR/<kind>_v<speed>_<seed>.xml for every kind, ego speed (m/s) and seed. The goal's
+window runs from step STEP (default 0) to max(200, STEP + 100) (exitcurve: 250).
 """
 import argparse
+import math
 import os
 import random
 
@@ -40,8 +47,12 @@ def lanelet(i, xs, left, right, pred=(), succ=(), al=None, ar=None):
     return s + '<laneletType>interstate</laneletType></lanelet>\n'
 
 
+OPENS = 0  # the goal window's first step (--opens)
+
+
 def goal_lanelet(i):
-    return ('<goalState><time><intervalStart>0</intervalStart><intervalEnd>200</intervalEnd></time>'
+    return (f'<goalState><time><intervalStart>{OPENS}</intervalStart><intervalEnd>'
+            f'{max(200, OPENS + 100)}</intervalEnd></time>'
             f'<position><lanelet ref="{i}"/></position></goalState>')
 
 
@@ -58,6 +69,44 @@ def road(kind):
         out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
         out.append(lanelet(5, range(200, 401, 10), off, lambda x: off(x) - W, pred=(1,)))
         return out, goal_lanelet(5 if kind == 'exit' else 4), (W / 2 if kind == 'exit' else -W / 2)
+    if kind == 'exitleft':
+        def off(x):
+            return 0.0002 * (x - 200) ** 2
+        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4,), al=2))
+        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3, 5), ar=1))
+        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
+        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
+        out.append(lanelet(5, range(200, 401, 10), lambda x: off(x) + W, off, pred=(2,)))
+        return out, goal_lanelet(5), -W / 2
+    if kind == 'exitcurve':
+        # The ramp 5 leaves the right lane at x = 200 on an arc of radius 150 m turning right
+        # (1.2 rad); the goal is a 10 m box at its end.
+        radius, sweep, n = 150.0, 1.2, 40
+        def arc(offset):  # offset: left of the ramp's centre line, m
+            pts = []
+            for q in range(n + 1):
+                a = sweep * q / n
+                r = radius + offset
+                pts.append((200 + r * math.sin(a), -W / 2 - radius + r * math.cos(a)))
+            return pts
+        def bound(pts):
+            return ''.join(f'<point><x>{x:.4f}</x><y>{y:.4f}</y></point>' for x, y in pts)
+        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4, 5), al=2))
+        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
+        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
+        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
+        out.append(f'<lanelet id="5"><leftBound>{bound(arc(W / 2))}<lineMarking>solid</lineMarking>'
+                   f'</leftBound><rightBound>{bound(arc(-W / 2))}<lineMarking>solid</lineMarking>'
+                   '</rightBound><predecessor ref="1"/><laneletType>interstate</laneletType>'
+                   '</lanelet>\n')
+        a = sweep - 10 / radius
+        cx, cy = 200 + radius * math.sin(a), -W / 2 - radius + radius * math.cos(a)
+        goal = (f'<goalState><time><intervalStart>{OPENS}</intervalStart><intervalEnd>'
+                f'{max(250, OPENS + 100)}</intervalEnd>'
+                f'</time><position><rectangle><length>10</length><width>3</width><orientation>'
+                f'{-a:.4f}</orientation><center><x>{cx:.4f}</x><y>{cy:.4f}</y></center></rectangle>'
+                '</position></goalState>')
+        return out, goal, W / 2
     if kind == 'exitb':
         def off(x):
             return -0.0002 * (x - 220) ** 2
@@ -120,9 +169,14 @@ def main():
                     help="the ego's initial speeds, m/s (default: 15 25 32)")
     ap.add_argument('--seeds', type=int, nargs='+', default=list(range(7)),
                     help='traffic seeds, 0 = no traffic (default: 0-6)')
+    ap.add_argument('--opens', type=int, default=0,
+                    help="the goal window's first step (0.1 s steps; default: 0). A window that "
+                         "opens late makes the ego wait in a goal at the map's end")
     args = ap.parse_args()
+    global OPENS
+    OPENS = args.opens
     os.makedirs(args.out_dir, exist_ok=True)
-    for kind in ('exit', 'straight', 'exitb', 'entry'):
+    for kind in ('exit', 'straight', 'exitleft', 'exitcurve', 'exitb', 'entry'):
         for speed in args.speeds:
             for seed in args.seeds:
                 path = os.path.join(args.out_dir, f'{kind}_v{int(speed)}_{seed}.xml')

@@ -457,6 +457,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
       l.right.insert(l.right.begin(), l.right.front());
     }
   }
+  out.map_end = last;
   auto road = map::Road::Make(*line, std::move(lanes), where + "road");
   if (!road.ok()) return road.status();
   out.road = *road;

@@ -200,7 +200,18 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     run.lanes = road.num_lanes();
     run.road_length = line.length();
     run.route = built->route;
-    const std::vector<FrenetGoal> goals = FrenetGoals(sc, problem, line);
+    const std::vector<FrenetGoal> regions = FrenetGoals(sc, problem, line);
+    // The planner's regions: one reaching the map's end (closed: the verdict holds the whole box
+    // to the lanelets, while the planner's lanes run on) ends half the ego's length before it,
+    // so that the ego's centre in it keeps its front on the map when it must wait there for the
+    // window to open. (The run ends past the regions themselves.)
+    std::vector<FrenetGoal> goals = regions;
+    for (FrenetGoal& g : goals) {
+      const double last = built->map_end - 0.5 * vp.length;
+      if (std::isfinite(g.region.s_hi) && g.region.s_hi > last) {
+        g.region.s_hi = std::max(g.region.s_lo, last);
+      }
+    }
     // The top speed is the vehicle's (CommonRoadConfig); the lanes' signs limit it further.
     const plan::PlannerConfig& problem_config = config;
     auto planner = plan::MakePlanner("search", problem_config, built->road);
@@ -258,7 +269,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       t.yaw = ego.orientation;
       t.speed = ego.velocity;
       const map::FrenetPoint fe = line.ToFrenet(ego.x, ego.y);
-      if (PassedEveryGoal(goals, fe.s)) {
+      if (PassedEveryGoal(regions, fe.s)) {
         run.stop_reason = "goal_passed";
         break;
       }

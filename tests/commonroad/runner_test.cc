@@ -338,6 +338,27 @@ TEST(RunnerTest, StopsBeforeTheMapsEndForATimeOnlyGoal) {
   EXPECT_GT(front, 100.0);  // it used the road, not a panic stop
 }
 
+TEST(RunnerTest, WaitsInAGoalAtTheMapsEndUntilItsWindowOpens) {
+  // The goal is the last 60 m of the map (a lanelet of its own, the network's end closed), its
+  // window opening 10 s in; at its 20 m/s the ego would be past the end by then. It stops in the
+  // region before the end and is there when the window opens. A window open from the start is
+  // met on arrival, without slowing for the end.
+  for (const int opens : {100, 0}) {
+    ScenarioXml xml;
+    LaneletXml a = Lane(1, Line(0, 120, 0), Line(0, 120, -3.5));
+    a.successors = {2};
+    LaneletXml b = Lane(2, Line(120, 180, 0), Line(120, 180, -3.5));
+    b.predecessors = {1};
+    xml.Lanelet(a).Lanelet(b).Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, opens, 200)});
+    const ProblemRun p = RunOne(xml);
+    EXPECT_TRUE(p.verdict.solved) << opens << ": " << p.verdict.Summary();
+    if (opens == 0) {
+      ASSERT_FALSE(p.trajectory.empty());
+      EXPECT_GT(p.trajectory.back().velocity, 15.0);
+    }
+  }
+}
+
 TEST(RunnerTest, TheRescueMeetsAGoalThePlannersPathMisses) {
   // A goal region in the left lane (y 0 to 3.5) for 0.7-0.8 s only, around where the ego gets
   // by then at 20 m/s in the right lane (y -1.75): its centre has to cross 1.75 m sideways in

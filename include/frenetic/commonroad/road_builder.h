@@ -47,6 +47,9 @@ struct BuiltRoad {
   // Per road lane (left to right), the lanelets it is made of.
   std::vector<std::vector<int>> lane_lanelets;
   int start_lanelet = 0;
+  // m along the reference line: where the map's lanes end (before the lanes' run-on, which the
+  // planner sees past a closed end that the verdict does not).
+  double map_end = 0;
 };
 
 inline constexpr double kMaxStartDistance = 5.0;  // m
