@@ -35,9 +35,14 @@ def points(xs, f):
     return ''.join(f'<point><x>{x:.4f}</x><y>{f(x):.4f}</y></point>' for x in xs)
 
 
-def lanelet(i, xs, left, right, pred=(), succ=(), al=None, ar=None):
-    s = (f'<lanelet id="{i}"><leftBound>{points(xs, left)}<lineMarking>dashed</lineMarking>'
-         f'</leftBound><rightBound>{points(xs, right)}<lineMarking>solid</lineMarking></rightBound>')
+def lanelet(i, xs, left, right, pred=(), succ=(), al=None, ar=None, left_marking='dashed'):
+    """Bounds as functions of x at xs, or (xs None) as lists of (x, y) points."""
+    def bound(b):
+        if xs is not None:
+            return points(xs, b)
+        return ''.join(f'<point><x>{x:.4f}</x><y>{y:.4f}</y></point>' for x, y in b)
+    s = (f'<lanelet id="{i}"><leftBound>{bound(left)}<lineMarking>{left_marking}</lineMarking>'
+         f'</leftBound><rightBound>{bound(right)}<lineMarking>solid</lineMarking></rightBound>')
     s += ''.join(f'<predecessor ref="{p}"/>' for p in pred)
     s += ''.join(f'<successor ref="{p}"/>' for p in succ)
     if al:
@@ -45,6 +50,16 @@ def lanelet(i, xs, left, right, pred=(), succ=(), al=None, ar=None):
     if ar:
         s += f'<adjacentRight ref="{ar}" drivingDir="same"/>'
     return s + '<laneletType>interstate</laneletType></lanelet>\n'
+
+
+def motorway(succ1=(4,), succ2=(3,), ar1=None, ar4=None, fork=200):
+    """The two lanes: 1 (right) and 2 (left) up to x = 200 (1 up to `fork`), then 3 (left) and
+    4 (right) to x = 500."""
+    x0, x1 = range(0, 201, 10), range(200, 501, 10)
+    return [lanelet(1, range(0, fork + 1, 10), lambda x: 0, lambda x: -W, succ=succ1, al=2, ar=ar1),
+            lanelet(2, x0, lambda x: W, lambda x: 0, succ=succ2, ar=1),
+            lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4),
+            lanelet(4, range(fork, 501, 10), lambda x: 0, lambda x: -W, pred=(1,), al=3, ar=ar4)]
 
 
 OPENS = 0  # the goal window's first step (--opens)
@@ -58,47 +73,29 @@ def goal_lanelet(i):
 
 def road(kind):
     """The lanelets, the goal and the ego's start y of one kind."""
-    x0, x1 = range(0, 201, 10), range(200, 501, 10)
-    out = []
+    ramp = range(200, 401, 10)
     if kind in ('exit', 'straight'):
         def off(x):
             return -0.0002 * (x - 200) ** 2
-        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4, 5), al=2))
-        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
-        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
-        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
-        out.append(lanelet(5, range(200, 401, 10), off, lambda x: off(x) - W, pred=(1,)))
+        out = motorway(succ1=(4, 5))
+        out.append(lanelet(5, ramp, off, lambda x: off(x) - W, pred=(1,)))
         return out, goal_lanelet(5 if kind == 'exit' else 4), (W / 2 if kind == 'exit' else -W / 2)
     if kind == 'exitleft':
         def off(x):
             return 0.0002 * (x - 200) ** 2
-        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4,), al=2))
-        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3, 5), ar=1))
-        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
-        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
-        out.append(lanelet(5, range(200, 401, 10), lambda x: off(x) + W, off, pred=(2,)))
+        out = motorway(succ2=(3, 5))
+        out.append(lanelet(5, ramp, lambda x: off(x) + W, off, pred=(2,)))
         return out, goal_lanelet(5), -W / 2
     if kind == 'exitcurve':
         # The ramp 5 leaves the right lane at x = 200 on an arc of radius 150 m turning right
         # (1.2 rad); the goal is a 10 m box at its end.
         radius, sweep, n = 150.0, 1.2, 40
         def arc(offset):  # offset: left of the ramp's centre line, m
-            pts = []
-            for q in range(n + 1):
-                a = sweep * q / n
-                r = radius + offset
-                pts.append((200 + r * math.sin(a), -W / 2 - radius + r * math.cos(a)))
-            return pts
-        def bound(pts):
-            return ''.join(f'<point><x>{x:.4f}</x><y>{y:.4f}</y></point>' for x, y in pts)
-        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4, 5), al=2))
-        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
-        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
-        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
-        out.append(f'<lanelet id="5"><leftBound>{bound(arc(W / 2))}<lineMarking>solid</lineMarking>'
-                   f'</leftBound><rightBound>{bound(arc(-W / 2))}<lineMarking>solid</lineMarking>'
-                   '</rightBound><predecessor ref="1"/><laneletType>interstate</laneletType>'
-                   '</lanelet>\n')
+            return [(200 + (radius + offset) * math.sin(sweep * q / n),
+                     -W / 2 - radius + (radius + offset) * math.cos(sweep * q / n))
+                    for q in range(n + 1)]
+        out = motorway(succ1=(4, 5))
+        out.append(lanelet(5, None, arc(W / 2), arc(-W / 2), pred=(1,), left_marking='solid'))
         a = sweep - 10 / radius
         cx, cy = 200 + radius * math.sin(a), -W / 2 - radius + radius * math.cos(a)
         goal = (f'<goalState><time><intervalStart>{OPENS}</intervalStart><intervalEnd>'
@@ -110,21 +107,15 @@ def road(kind):
     if kind == 'exitb':
         def off(x):
             return -0.0002 * (x - 220) ** 2
-        out.append(lanelet(1, range(0, 121, 10), lambda x: 0, lambda x: -W, succ=(4,), al=2))
-        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
-        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
-        out.append(lanelet(4, range(120, 501, 10), lambda x: 0, lambda x: -W, pred=(1,), al=3, ar=6))
+        out = motorway(fork=120, ar4=6)
         out.append(lanelet(6, range(120, 221, 10), lambda x: -W, lambda x: -2 * W, succ=(7,), al=4))
         out.append(lanelet(7, range(220, 421, 10), lambda x: off(x) - W, lambda x: off(x) - 2 * W,
                            pred=(6,)))
         return out, goal_lanelet(7), W / 2
     if kind == 'entry':
-        out.append(lanelet(5, x0, lambda x: -W, lambda x: -2 * W, al=1))
-        out.append(lanelet(1, x0, lambda x: 0, lambda x: -W, succ=(4,), al=2, ar=5))
-        out.append(lanelet(2, x0, lambda x: W, lambda x: 0, succ=(3,), ar=1))
-        out.append(lanelet(3, x1, lambda x: W, lambda x: 0, pred=(2,), ar=4))
-        out.append(lanelet(4, x1, lambda x: 0, lambda x: -W, pred=(1,), al=3))
-        return out, goal_lanelet(4), -1.5 * W
+        x0 = range(0, 201, 10)
+        return ([lanelet(5, x0, lambda x: -W, lambda x: -2 * W, al=1)] + motorway(ar1=5),
+                goal_lanelet(4), -1.5 * W)
     raise ValueError(kind)
 
 

@@ -206,8 +206,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     // so that the ego's centre in it keeps its front on the map when it must wait there for the
     // window to open. (The run ends past the regions themselves.)
     std::vector<FrenetGoal> goals = regions;
+    const double last = built->map_end - 0.5 * vp.length;
     for (FrenetGoal& g : goals) {
-      const double last = built->map_end - 0.5 * vp.length;
       if (std::isfinite(g.region.s_hi) && g.region.s_hi > last) {
         g.region.s_hi = std::max(g.region.s_lo, last);
       }
