@@ -10,6 +10,10 @@ taken. Writes one file per vehicle whose recording is long enough.
 
     scripts/commonroad-derive.py SCENARIO.xml OUT_DIR [--horizon 8] [--goal-length 4]
 
+`--goal lane` makes goals like those of the highD problems instead (CommonRoad's traffic-rule set):
+the whole width of the lane the vehicle was in at the horizon, 6.6 m long across its lane's
+heading, the heading +-0.2 rad, the speed +-10 m/s, a time window from step 0 to --window-end.
+
 The derived files are test inputs made from the shared data at run time: not part of the tree.
 """
 import argparse
@@ -74,6 +78,40 @@ def inside(poly, x, y):
     return hit
 
 
+def lane_at(root, x, y):
+    """The lane under (x, y): its centre, width and heading across the nearest section of the
+    lanelet whose outline holds the point (None when no lanelet does)."""
+    for ll in root.findall("lanelet"):
+        left = [(float(p.find("x").text), float(p.find("y").text)) for p in ll.findall("leftBound/point")]
+        right = [(float(p.find("x").text), float(p.find("y").text)) for p in ll.findall("rightBound/point")]
+        if not inside(left + right[::-1], x, y):
+            continue
+        best = None
+        for bound in (left, right):
+            for i in range(len(bound) - 1):
+                (x1, y1), (x2, y2) = bound[i], bound[i + 1]
+                dx, dy = x2 - x1, y2 - y1
+                n2 = dx * dx + dy * dy
+                if n2 == 0.0:
+                    continue
+                t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / n2))
+                px, py = x1 + t * dx, y1 + t * dy
+                d = math.hypot(x - px, y - py)
+                if best is None or d < best[0]:
+                    best = (d, math.atan2(dy, dx))
+        heading = best[1]
+        nx, ny = -math.sin(heading), math.cos(heading)
+
+        def across(bound):  # the bound's point nearest (x, y)
+            return min(bound, key=lambda q: math.hypot(q[0] - x, q[1] - y))
+        lo, hi = (across(left), across(right))
+        o_left = (lo[0] - x) * nx + (lo[1] - y) * ny
+        o_right = (hi[0] - x) * nx + (hi[1] - y) * ny
+        mid = 0.5 * (o_left + o_right)
+        return (x + mid * nx, y + mid * ny), abs(o_left - o_right), heading
+    return None
+
+
 def on_lanelets(polys, state, length, width):
     x, y = position(state)
     h = value(state, "orientation") or 0.0
@@ -93,6 +131,10 @@ def main():
     ap.add_argument("--horizon", type=float, default=8.0, help="s from the start to the goal's window end")
     ap.add_argument("--window", type=float, default=1.0, help="s, the goal's time window length")
     ap.add_argument("--goal-length", type=float, default=4.0, help="m, the goal rectangle's length")
+    ap.add_argument("--goal", choices=("rect", "lane"), default="rect",
+                    help="rect: a rectangle around the vehicle at the horizon, a 1 s window; "
+                         "lane: its lane's width, 6.6 m, speed +-10 m/s, steps 0 to --window-end")
+    ap.add_argument("--window-end", type=int, default=1000, help="steps, the lane goal's window end")
     ap.add_argument("--min-speed", type=float, default=2.0, help="m/s: slower vehicles are not taken")
     args = ap.parse_args()
 
@@ -125,6 +167,18 @@ def main():
         if v_goal is None:  # (a recorded 0.0 is a speed: the vehicle stopped there)
             v_goal = v0
         width = float(obstacle.find("shape/rectangle/width").text) + 1.5
+        goal_length, heading_tol, v_tol = args.goal_length, 0.0873, 3.0
+        time_window = (steps - window, steps)
+        if args.goal == "lane":
+            lane = lane_at(root, gx, gy)
+            if lane is None:
+                print(f"vehicle {obstacle.get('id')}: ends off the lanelets; not taken", file=sys.stderr)
+                continue
+            (gx, gy), width, lane_heading = lane
+            if abs(math.remainder(lane_heading - heading, 2 * math.pi)) < 0.5 * math.pi:
+                heading = lane_heading
+            goal_length, heading_tol, v_tol = 6.6, 0.2, 10.0
+            time_window = (0, args.window_end)
 
         new_root = copy.deepcopy(root)
         for o in new_root.findall("dynamicObstacle"):
@@ -143,15 +197,15 @@ def main():
             ET.SubElement(ET.SubElement(init, name), "exact").text = str(val)
         gs = ET.SubElement(problem, "goalState")
         rect = ET.SubElement(ET.SubElement(gs, "position"), "rectangle")
-        ET.SubElement(rect, "length").text = f"{args.goal_length:.4f}"
+        ET.SubElement(rect, "length").text = f"{goal_length:.4f}"
         ET.SubElement(rect, "width").text = f"{width:.4f}"
         ET.SubElement(rect, "orientation").text = f"{heading:.5f}"
         c = ET.SubElement(rect, "center")
         ET.SubElement(c, "x").text = f"{gx:.4f}"
         ET.SubElement(c, "y").text = f"{gy:.4f}"
-        interval(gs, "orientation", heading - 0.0873, heading + 0.0873)
-        interval(gs, "time", steps - window, steps, integer=True)
-        interval(gs, "velocity", max(0.0, v_goal - 3.0), v_goal + 3.0)
+        interval(gs, "orientation", heading - heading_tol, heading + heading_tol)
+        interval(gs, "time", time_window[0], time_window[1], integer=True)
+        interval(gs, "velocity", max(0.0, v_goal - v_tol), v_goal + v_tol)
         name = f"{base_id}_ego{obstacle.get('id')}"
         if args.horizon != 8.0:  # several horizons side by side
             name += f"_h{args.horizon:g}"

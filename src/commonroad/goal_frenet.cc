@@ -169,4 +169,15 @@ bool PassedEveryGoal(const std::vector<FrenetGoal>& goals, double s) {
   return true;
 }
 
+bool AcrossOpen(const map::Road& road, double start_s, const cost::GoalRegion& r) {
+  if (!std::isfinite(r.s_lo) || !std::isfinite(r.s_hi) || road.num_lanes() < 1) return false;
+  for (int l = 0; l < road.num_lanes(); ++l) {
+    if (!(road.LaneBegin(l) <= start_s && road.LaneEnd(l) >= r.s_hi)) return false;
+  }
+  const map::Road::Span left = road.LaneAt(0, r.s_hi);
+  const map::Road::Span right = road.LaneAt(road.num_lanes() - 1, r.s_hi);
+  const double mid = 0.5 * (r.d_lo + r.d_hi) + r.d_slope * (r.s_hi - r.s_ref);
+  return std::isfinite(mid) && mid >= left.left && mid <= right.right;
+}
+
 }  // namespace frenetic::commonroad

@@ -207,10 +207,12 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     // window to open. (The run ends past the regions themselves.)
     std::vector<FrenetGoal> goals = regions;
     const double last = built->map_end - 0.5 * vp.length;
+    const double start_s = line.ToFrenet(problem.initial.position.x, problem.initial.position.y).s;
     for (FrenetGoal& g : goals) {
       if (std::isfinite(g.region.s_hi) && g.region.s_hi > last) {
         g.region.s_hi = std::max(g.region.s_lo, last);
       }
+      g.region.across_open = AcrossOpen(road, start_s, g.region);
     }
     // The top speed is the vehicle's (CommonRoadConfig); the lanes' signs limit it further.
     const plan::PlannerConfig& problem_config = config;

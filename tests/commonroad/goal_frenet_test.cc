@@ -111,5 +111,30 @@ TEST(GoalFrenetTest, ARectangleAlongTheRoadKeepsItsWidthAndInsetStaysInside) {
   EXPECT_TRUE(PassedEveryGoal(b.goals, 205 + kPassedMargin + 0.1));
 }
 
+TEST(GoalFrenetTest, ARegionOnAPlainRoadIsOpenAcrossAndOnePastAMergeIsNot) {
+  // Two lanes side by side from the start to past the region: a path in the other lane may
+  // still move across to it after its samples.
+  ScenarioXml plain;
+  AddStraightRoad(plain, 300).Problem(1, {10, -1.75}, 0, 20,
+                                      {GoalRectangleXml({200, 1.75}, 10, 3, 0, 0, 100)});
+  const Built a = Build(plain);
+  ASSERT_EQ(a.goals.size(), 1u);
+  const double start_a = a.road.road->line().ToFrenet(10, -1.75).s;
+  EXPECT_TRUE(AcrossOpen(*a.road.road, start_a, a.goals[0].region));
+  cost::GoalRegion endless = a.goals[0].region;  // a region with no far end: nothing is known
+  endless.s_hi = cost::GoalRegion::kInf;
+  EXPECT_FALSE(AcrossOpen(*a.road.road, start_a, endless));
+
+  // A zipper merge: the left lane ends before the region, which lies on the lane both join.
+  ScenarioXml zip;
+  AddZipperMerge(zip).Problem(1, {-120, 8.75}, 0, 8,
+                              {GoalRectangleXml({100, 5.25}, 10, 3, 0, 0, 100)});
+  const Built b = Build(zip);
+  ASSERT_EQ(b.goals.size(), 1u);
+  ASSERT_GT(b.road.road->num_lanes(), 1);
+  const double start_b = b.road.road->line().ToFrenet(-120, 8.75).s;
+  EXPECT_FALSE(AcrossOpen(*b.road.road, start_b, b.goals[0].region));
+}
+
 }  // namespace
 }  // namespace frenetic::commonroad

@@ -167,10 +167,13 @@ TEST(RunnerTest, PassesAParkedTruckBeforeTheOncomingCarComes) {
   const ProblemRun p = RunOne(xml);
   ASSERT_TRUE(p.verdict.solved) << p.verdict.Summary();
   // Without passes the ego waits behind the truck for the car. (The limit ramps off too: with
-  // them it gets there sooner, and by in the oncoming lane before the car without a pass.)
+  // them it gets there sooner, and by in the oncoming lane before the car without a pass. And
+  // the goal's move across after a path's samples: a lane change into the oncoming lane, short
+  // of the goal, then counts as coming back in time, and serves as a pass.)
   plan::PlannerConfig no_passes = Config();
   ASSERT_TRUE(no_passes.Set("grid.passes", 0).ok());
   ASSERT_TRUE(no_passes.Set("grid.limit_ramps", 0).ok());
+  ASSERT_TRUE(no_passes.Set("costs.goal.lateral_pace", 0).ok());
   const ProblemRun waited = RunOne(xml, PredictionMode::kRecorded, &no_passes);
   EXPECT_FALSE(waited.verdict.solved);
   EXPECT_EQ(waited.verdict.Find(FailureKind::kCollision), nullptr) << waited.verdict.Summary();

@@ -62,7 +62,10 @@ class GoalCostTest : public ::testing::Test {
     auto made = CostRegistry::Global().Make("goal");
     ASSERT_TRUE(made.ok()) << made.message();
     term_ = std::move(made.value());
-    const std::vector<double> params = {10.0, 1.75, 5.0, 0.05, 1.0, 10.0, 1.0, 1.0};
+    Configure(0.0);
+  }
+  void Configure(double lateral_pace) {
+    const std::vector<double> params = {10.0, 1.75, 5.0, 0.05, 1.0, 10.0, 1.0, 1.0, lateral_pace};
     term_->Configure(params);
   }
   double Eval(const Case& c) const { return term_->Evaluate(c.ctx, c.in); }
@@ -184,6 +187,38 @@ TEST_F(GoalCostTest, NoPositionMeansTimeAndSpeedOnly) {
   g.v_hi = 5;
   // Braking at 2 m/s^2 from 20: 8 m/s at 6 s, held: 3 m/s too fast at 8 s.
   EXPECT_NEAR(Eval(Case(20, {g}, -2)), 1 + 3.0 / 5.0, 1e-9);
+}
+
+// A candidate along d = 6, beside a region whose d is [0, 4] (the next lane), on a road open
+// across to it (GoalRegion::across_open).
+Case Beside(double v, double s_lo, double s_hi, bool open) {
+  GoalRegion g = Box(s_lo, s_hi, 0, 100);
+  g.across_open = open;
+  Case c(v, {g});
+  std::fill(c.d.begin(), c.d.end(), 6.0);
+  return c;
+}
+
+TEST_F(GoalCostTest, ACandidateShortOfARegionInTheNextLaneMayStillMoveAcross) {
+  // At 10 m/s the samples end at s = 60 (6 s); the region starts 90 m on. At 0.5 m/s across,
+  // the 2 m to its side take 4 s (40 m): inside it before reaching it.
+  const double straight = Eval(Beside(10, 150, 160, true));
+  EXPECT_NEAR(straight, 1.0 + 2.0 / 1.75, 1e-9);  // lateral_pace 0: straight on along d = 6
+  Configure(0.5);
+  EXPECT_EQ(Eval(Beside(10, 150, 160, true)), 0.0);
+  // Not on a road known to be open across (a ramp, a merge): straight on as before.
+  EXPECT_NEAR(Eval(Beside(10, 150, 160, false)), straight, 1e-9);
+}
+
+TEST_F(GoalCostTest, PassingBesideARegionStaysAMissAndASlowerCandidateHasLongerToMove) {
+  Configure(0.5);
+  // At 30 m/s the samples pass [100, 110] along d = 6 (at 3.3-3.7 s): nothing is left to move.
+  EXPECT_NEAR(Eval(Beside(30, 100, 110, true)), 1.0 + 2.0 / 1.75, 1e-9);
+  // [80, 90]: at 10 m/s the samples end at 60, and its far end comes 3 s later with 0.5 m
+  // across still to go; at 5 m/s (samples end at 30) it comes 10 s later, the move long done.
+  const double at10 = Eval(Beside(10, 80, 90, true));
+  EXPECT_NEAR(at10, 1.0 + 0.5 / 1.75, 1e-6);
+  EXPECT_EQ(Eval(Beside(5, 80, 90, true)), 0.0);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "frenetic/commonroad/scenario.h"
 #include "frenetic/commonroad/shape.h"
 #include "frenetic/cost/goal_region.h"
+#include "frenetic/map/road.h"
 #include "frenetic/map/reference_line.h"
 
 namespace frenetic::commonroad {
@@ -54,5 +55,10 @@ inline constexpr double kPassedMargin = 1.0;
 // Whether the ego at s has driven past every goal region (all of them with a position): the
 // planner never reverses, so none can be met any more.
 bool PassedEveryGoal(const std::vector<FrenetGoal>& goals, double s);
+
+// GoalRegion::across_open for a region on `road` and an ego starting at start_s: the region
+// has a far end, every lane of the road runs from start_s (or before) to past it, and its
+// middle at that end lies between the road's edges.
+bool AcrossOpen(const map::Road& road, double start_s, const cost::GoalRegion& r);
 
 }  // namespace frenetic::commonroad

@@ -21,6 +21,10 @@ struct GoalRegion {
   // tangents of a goal orientation interval less the road's heading there (headings within a
   // quarter turn of the road's).
   double h_lo = -kInf, h_hi = kInf;
+  // Every lane of the road runs alongside from the ego's start to past the region (no lane
+  // begins or ends on the way, no ramp or merge): a path may still move across into the region's
+  // lane after its samples (the goal cost's lateral_pace). False: nothing is known of the way.
+  bool across_open = false;
 };
 
 inline constexpr int kMaxGoalRegions = 8;
