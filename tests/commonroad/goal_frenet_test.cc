@@ -92,11 +92,17 @@ TEST(GoalFrenetTest, AGoalLaneletAlongTheLineIsItsWholeWidth) {
   EXPECT_NEAR(r.s_hi, 300, 0.5);
 }
 
-TEST(GoalFrenetTest, ARectangleAlongTheRoadKeepsItsWidthAndInsetStaysInside) {
+// A two-lane straight road, the ego starting in the right lane at x = 10, the goal a 10 m
+// rectangle in the left lane at x = 200.
+Built StraightRoadWithGoalAhead() {
   ScenarioXml xml;
   AddStraightRoad(xml, 300).Problem(1, {10, -1.75}, 0, 20,
                                     {GoalRectangleXml({200, 1.75}, 10, 3, 0, 0, 100)});
-  const Built b = Build(xml);
+  return Build(xml);
+}
+
+TEST(GoalFrenetTest, ARectangleAlongTheRoadKeepsItsWidthAndInsetStaysInside) {
+  const Built b = StraightRoadWithGoalAhead();
   ASSERT_EQ(b.goals.size(), 1u);
   const cost::GoalRegion& r = b.goals[0].region;
   EXPECT_NEAR(r.s_lo, 195, 0.1);
@@ -114,10 +120,7 @@ TEST(GoalFrenetTest, ARectangleAlongTheRoadKeepsItsWidthAndInsetStaysInside) {
 TEST(GoalFrenetTest, ARegionOnAPlainRoadIsOpenAcrossAndOnePastAMergeIsNot) {
   // Two lanes side by side from the start to past the region: a path in the other lane may
   // still move across to it after its samples.
-  ScenarioXml plain;
-  AddStraightRoad(plain, 300).Problem(1, {10, -1.75}, 0, 20,
-                                      {GoalRectangleXml({200, 1.75}, 10, 3, 0, 0, 100)});
-  const Built a = Build(plain);
+  const Built a = StraightRoadWithGoalAhead();
   ASSERT_EQ(a.goals.size(), 1u);
   const double start_a = a.road.road->line().ToFrenet(10, -1.75).s;
   EXPECT_TRUE(AcrossOpen(*a.road.road, start_a, a.goals[0].region));
