@@ -414,9 +414,10 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_flag("--no-timing", args->no_timing,
                 "Report planning times as 0 (byte-stable output for the same files)");
   sub->add_flag("--no-rescue", args->no_rescue,
-                "Drive the planner's path even when it would hit a predicted car or miss the "
-                "goal. By default the path is checked against the predictions (the cars' boxes "
-                "every step, 4 s ahead) and, when it hits one, a search of the vehicle's own KS "
+                "Drive the planner's path even when it would hit a predicted car, leave the road "
+                "or miss the goal. By default the path is checked against the predictions (the "
+                "cars' boxes every step, 4 s ahead) and the road's edges (up to where it meets a "
+                "goal region) and, when it hits one, a search of the vehicle's own KS "
                 "inputs (five accelerations and five steering rates a step, within 97% of its "
                 "limits and the friction circle, the ego's box 0.05 m wider, on the road between "
                 "its edges, at most 150 states a step) looks for a way that meets a goal region "

@@ -96,7 +96,7 @@ RescueStep Rescue::Step(const plan::Telemetry& t, const std::vector<double>& x,
                         const std::vector<double>& y, const KsState& ego) {
   Predict(t);
   RescueStep r;
-  r.hit = PathHit(x, y);
+  r.hit = PathHit(x, y, t.goals);
   if (r.hit > 0) {
     r.why = RescueStep::Why::kHit;
     r.input = Next(ego, t.goals);
@@ -191,7 +191,10 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
   if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.orientation)) return false;
   // The cars first (cheaper, and in a box-in most states fail there), then the road: the box's
   // extent along the line and across it between the edges at both ends.
-  if (!ClearOfCars(s, k)) return false;
+  return ClearOfCars(s, k) && OnRoad(s, s_hint, at);
+}
+
+bool Rescue::OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const {
   const double hl = half_length_, hw = half_width_;
   const map::ReferenceLine& line = road_.line();
   const map::FrenetPoint fe = line.ToFrenet(s.x, s.y, s_hint);
@@ -218,9 +221,13 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
   return true;
 }
 
-int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y) const {
+int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
+                    const std::vector<cost::GoalRegion>& goals) const {
   const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
   PathPoint p;
+  double s_hint = std::numeric_limits<double>::quiet_NaN();
+  map::FrenetPoint at{};
+  bool road = true;  // until the path meets a goal region (the run ends there)
   for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
     KsState st;
     st.x = p.x;
@@ -230,6 +237,10 @@ int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y) 
         !ClearOfCars(st, k)) {
       return k;
     }
+    if (!road) continue;
+    if (!OnRoad(st, s_hint, &at)) return k;
+    s_hint = at.s;
+    road = GoalDistance(at.s, at.d, p.speed, p.heading, k * dt_, goals) != 0;
   }
   return 0;
 }

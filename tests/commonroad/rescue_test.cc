@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -73,6 +74,36 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   // A path that ends before the car: nothing within the steps it covers.
   Straight(10, kLane0, 20, 50, &x, &y);
   EXPECT_EQ(rescue.PathHit(x, y), 0);
+}
+
+TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
+  const auto road = TwoLanes();  // edges at y 0 and -7
+  Rescue rescue(*road, VehicleParams(), kDt);
+  plan::Telemetry t;
+  t.x = 10;
+  rescue.Predict(t);
+  // Along lane 0, then drifting left at 1 m/s from x = 30 (step 10): the box (1.8 m wide, the
+  // margin 0.05 m more) crosses y = 0 when its centre passes y = -0.95, 0.8 s later (step 18).
+  std::vector<double> x, y;
+  for (int i = 1; i <= 250; ++i) {
+    const double tx = 10 + 20 * i * plan::kTickSeconds;
+    x.push_back(tx);
+    y.push_back(kLane0 + std::max(0.0, (tx - 30) / 20));
+  }
+  const int left = rescue.PathHit(x, y);
+  EXPECT_GE(left, 17);
+  EXPECT_LE(left, 19);
+  // The same path meeting a goal region before: the run ends there, what follows is not judged.
+  cost::GoalRegion g;
+  g.s_lo = 20;
+  g.s_hi = 30;
+  g.d_lo = 0;
+  g.d_hi = 3.5;
+  EXPECT_EQ(rescue.PathHit(x, y, {g}), 0);
+  // Nor when the region is met only after it has left the road.
+  g.s_lo = 60;
+  g.s_hi = 80;
+  EXPECT_EQ(rescue.PathHit(x, y, {g}), left);
 }
 
 // The way's states (Points every tick from ego): each step's centre, and whether any is NaN.

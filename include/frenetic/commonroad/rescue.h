@@ -60,6 +60,7 @@ struct RescueStep {
   enum class Why { kNone, kHit, kGoal };
   Why why = Why::kNone;  // kNone: the path is left as it is
   int hit = 0;           // kHit: the step (1..steps) at which the path hits a predicted car
+                         // or leaves the road
   // The way's input to drive instead of the path; none: the path is driven.
   std::optional<KsInput> input;
 };
@@ -85,9 +86,11 @@ class Rescue {
   void Predict(const plan::Telemetry& t);
 
   // The first step (1..steps) at which a path of points every plan::kTickSeconds (the first one
-  // tick from now) hits a predicted car; 0 when it does not within the steps it covers. (The
-  // road's ends are the planner's own limits; past the goal its path may run off the map.)
-  int PathHit(const std::vector<double>& x, const std::vector<double>& y) const;
+  // tick from now) hits a predicted car, or, until it meets a region of `goals` (where the run
+  // ends), leaves the road (OnRoad: the planner's lanes, which run on past the map's ends); 0
+  // when neither within the steps it covers.
+  int PathHit(const std::vector<double>& x, const std::vector<double>& y,
+              const std::vector<cost::GoalRegion>& goals = {}) const;
 
   // The way's input for the next step from `ego`, when a way that lasts the whole horizon (or
   // meets a goal region of `goals`, the telemetry's) is found: the rest of the last way while
@@ -142,8 +145,10 @@ class Rescue {
   bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
   // The predicted cars at step k (1..steps), laid out up to k on first use.
   const std::vector<Car>& CarsAt(int k) const;
-  // The same for the cars alone.
+  // The same for the cars alone, and for the road alone (the box, the margin's wider, between
+  // the road's edges at both its ends; *at as Clear's).
   bool ClearOfCars(const KsState& s, int k) const;
+  bool OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const;
   // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
   // horizon, the nearest a goal region at its end (then the farthest along the road), in way_
   // (empty when none), with at most max_states (>= 1) states a step.
