@@ -3,10 +3,13 @@
 //   out(s, [s_lo, s_hi]) / s_scale + out(d - d_slope (s - s_ref), [d_lo, d_hi]) / d_scale
 //   + out(v, [v_lo, v_hi]) / v_scale + out(h, [h_lo, h_hi]) / h_scale
 // with out(x, [lo, hi]) the distance of x outside the interval and h = d' / s' the tangent of
-// the heading against the line's (GoalRegion's bounds are tangents too), the candidate continued past its samples at its last speed along its last
-// d, or, with `lateral_pace` > 0 and a road whose lanes all run alongside to past the region
-// (GoalRegion::across_open), moving across toward it at that pace (m/s) until its d is inside: a candidate ending short of a region in the next lane can still change lanes
-// before it, one that has passed beside the region cannot, and one slower has longer to. 0 when it passes through a region in its window (and with no goal: the Udacity track), else
+// the heading against the line's (GoalRegion's bounds are tangents too), the candidate continued
+// past its samples at its last speed along its last d, or, with `lateral_pace` > 0 and a road
+// whose lanes all run alongside to past the region (GoalRegion::across_open), moving across
+// toward it at that pace (m/s) until its d is inside: a candidate ending short of a region in
+// the next lane can still change lanes before it, one that has passed beside the region cannot,
+// and one slower has longer to. 0 when it passes through a region in its window (and with no
+// goal: the Udacity track), else
 // `miss` plus that least sum (a goal is reached or not: missing it by a little is still missing
 // it), at most `cap`. Between samples each quantity is taken linear in time, so each term is convex and
 // piecewise linear and their sum is least at a window end, a sample or where a term crosses an
@@ -102,21 +105,24 @@ class GoalCost : public CostTerm {
   At Sample(const CostInput& in, int k) const {
     return {in.s[k], in.d[k], in.s_d[k], Slope(in.s_d[k], in.d_d[k])};
   }
-  // Past the samples: straight on at the last speed, d moved toward the region's sides (those at
-  // the last sample) by lateral_pace per second until inside them.
-  At State(const CostContext& ctx, const CostInput& in, const GoalRegion& g, double t) const {
+  // The move across the continuation makes toward region g's sides (those at the last sample),
+  // m, signed as d: 0 when it is inside them, or keeps its d.
+  double Move(const CostContext& ctx, const CostInput& in, const GoalRegion& g) const {
+    if (!(lateral_pace_ > 0 && g.across_open)) return 0.0;
+    const double across = Across(g, Sample(in, ctx.num_samples - 1));
+    if (across < g.d_lo) return g.d_lo - across;
+    if (across > g.d_hi) return g.d_hi - across;
+    return 0.0;
+  }
+  // Past the samples: straight on at the last speed, d moved by `move` (Move) at lateral_pace.
+  At State(const CostContext& ctx, const CostInput& in, double move, double t) const {
     const int n = ctx.num_samples;
     const double x = t / ctx.dt;
     if (x >= n - 1) {
       const double v = in.s_d[n - 1];
       const double after = t - (n - 1) * ctx.dt;
       At a{in.s[n - 1] + v * after, in.d[n - 1], v, 0.0};
-      if (lateral_pace_ > 0 && g.across_open) {
-        const double shift = lateral_pace_ * after;
-        const double across = Across(g, Sample(in, n - 1));
-        if (across < g.d_lo) a.d += std::min(shift, g.d_lo - across);
-        if (across > g.d_hi) a.d -= std::min(shift, across - g.d_hi);
-      }
+      if (move != 0) a.d += std::copysign(std::min(lateral_pace_ * after, std::abs(move)), move);
       return a;
     }
     const int k = std::max(0, static_cast<int>(x));
@@ -140,7 +146,9 @@ class GoalCost : public CostTerm {
     // An endless window is judged up to a minute past the samples.
     const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
     if (!(t1 >= t0)) return std::numeric_limits<double>::infinity();  // no window left
-    double best = std::min(MissAt(g, State(ctx, in, g, t0)), MissAt(g, State(ctx, in, g, t1)));
+    const double move = Move(ctx, in, g);
+    double best =
+        std::min(MissAt(g, State(ctx, in, move, t0)), MissAt(g, State(ctx, in, move, t1)));
     // The levels that bound something (an absent part's are infinite), and where a linear
     // piece from time ta (state a) to tb (b) crosses them: the state there, interpolated.
     const bool has_s = std::isfinite(g.s_lo) || std::isfinite(g.s_hi);
@@ -197,14 +205,10 @@ class GoalCost : public CostTerm {
     }
     if (t1 > t_end && best > 0) {  // the continuation: straight on, or across and then straight
       const double ta = std::max(t_end, t0);
-      double tc = ta;  // when its move across ends (none: at once)
-      if (lateral_pace_ > 0 && g.across_open) {
-        const double across = Across(g, Sample(in, n - 1));
-        const double gap = std::max({g.d_lo - across, 0.0, across - g.d_hi});
-        if (std::isfinite(gap)) tc = std::clamp(t_end + gap / lateral_pace_, ta, t1);
-      }
-      if (tc > ta) piece(ta, tc, State(ctx, in, g, ta), State(ctx, in, g, tc));
-      if (t1 > tc) piece(tc, t1, State(ctx, in, g, tc), State(ctx, in, g, t1));
+      // when its move across ends (none: at once)
+      const double tc = move != 0 ? std::clamp(t_end + std::abs(move) / lateral_pace_, ta, t1) : ta;
+      if (tc > ta) piece(ta, tc, State(ctx, in, move, ta), State(ctx, in, move, tc));
+      if (t1 > tc) piece(tc, t1, State(ctx, in, move, tc), State(ctx, in, move, t1));
     }
     return best;
   }

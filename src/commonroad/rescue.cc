@@ -96,11 +96,12 @@ RescueStep Rescue::Step(const plan::Telemetry& t, const std::vector<double>& x,
                         const std::vector<double>& y, const KsState& ego) {
   Predict(t);
   RescueStep r;
-  r.hit = PathHit(x, y, t.goals);
+  const PathCheck path = Walk(x, y, t.goals);
+  r.hit = path.hit;
   if (r.hit > 0) {
     r.why = RescueStep::Why::kHit;
     r.input = Next(ego, t.goals);
-  } else if (GoalAtRisk(x, y, t.goals)) {
+  } else if (AtRisk(path, t.goals)) {
     r.why = RescueStep::Why::kGoal;
     r.input = Next(ego, t.goals, true);
     if (!r.input) Drop();
@@ -221,13 +222,13 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
   return true;
 }
 
-int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
-                    const std::vector<cost::GoalRegion>& goals) const {
+Rescue::PathCheck Rescue::Walk(const std::vector<double>& x, const std::vector<double>& y,
+                               const std::vector<cost::GoalRegion>& goals) const {
   const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  PathCheck c;
   PathPoint p;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
   map::FrenetPoint at{};
-  bool road = true;  // until the path meets a goal region (the run ends there)
   for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
     KsState st;
     st.x = p.x;
@@ -235,14 +236,26 @@ int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
     st.orientation = p.heading;
     if (!std::isfinite(st.x) || !std::isfinite(st.y) || !std::isfinite(st.orientation) ||
         !ClearOfCars(st, k)) {
-      return k;
+      c.hit = k;
+      return c;
     }
-    if (!road) continue;
-    if (!OnRoad(st, s_hint, &at)) return k;
+    if (c.met) continue;  // the run ends there: the road past it is not judged
+    if (!OnRoad(st, s_hint, &at)) {
+      c.hit = k;
+      return c;
+    }
     s_hint = at.s;
-    road = GoalDistance(at.s, at.d, p.speed, p.heading, k * dt_, goals) != 0;
+    c.judged = c.judged && std::isfinite(p.speed);
+    c.met = GoalDistance(at.s, at.d, p.speed, p.heading, k * dt_, goals) == 0;
+    c.t_end = k * dt_;
+    c.s_end = at.s;
   }
-  return 0;
+  return c;
+}
+
+int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
+                    const std::vector<cost::GoalRegion>& goals) const {
+  return Walk(x, y, goals).hit;
 }
 
 int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals) {
@@ -311,25 +324,13 @@ bool Rescue::MayMeetGoal(double s, double v, double t,
 
 bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
                         const std::vector<cost::GoalRegion>& goals) const {
-  if (goals.empty()) return false;
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
-  const map::ReferenceLine& line = road_.line();
-  double s_hint = std::numeric_limits<double>::quiet_NaN();
-  double t_end = 0, s_end = -std::numeric_limits<double>::infinity();
-  PathPoint p;
-  for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.heading) ||
-        !std::isfinite(p.speed)) {
-      return false;  // not a path to judge
-    }
-    const map::FrenetPoint fe = line.ToFrenet(p.x, p.y, s_hint);
-    s_hint = fe.s;
-    if (GoalDistance(fe.s, fe.d, p.speed, p.heading, k * dt_, goals) == 0) return false;
-    t_end = k * dt_;
-    s_end = fe.s;
-  }
+  return AtRisk(Walk(x, y, goals), goals);
+}
+
+bool Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals) {
+  if (goals.empty() || path.hit > 0 || !path.judged || path.met) return false;
   for (const cost::GoalRegion& g : goals) {
-    if (!(g.t_hi <= t_end || s_end > g.s_hi)) return false;  // still ahead, and still open
+    if (!(g.t_hi <= path.t_end || path.s_end > g.s_hi)) return false;  // still ahead, and open
   }
   return true;
 }

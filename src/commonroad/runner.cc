@@ -230,8 +230,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                     r.v_lo, r.v_hi, r.h_lo, r.h_hi);
     }
     for (int l = 0; l < road.num_lanes(); ++l) {
-      const map::Road::Span a = road.LaneAt(l, line.ToFrenet(problem.initial.position.x,
-                                                             problem.initial.position.y).s);
+      const map::Road::Span a = road.LaneAt(l, start_s);
       spdlog::debug("{} #{}: lane {} [{:.2f}, {:.2f}] at the start, s [{:.1f}, {:.1f}]",
                     sc.benchmark_id, problem.id, l, a.left, a.right, road.LaneBegin(l),
                     road.LaneEnd(l));

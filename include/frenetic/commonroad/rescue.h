@@ -32,6 +32,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -104,9 +105,9 @@ class Rescue {
   // path sent in its place.
   void Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const;
 
-  // Whether a path (as PathHit's) meets no goal region of `goals` (in its window, with its
-  // speed and heading) while some region's window closes within the path, or the path runs past
-  // the region's end.
+  // Whether a path (as PathHit's, one that neither hits a car nor leaves the road: Step asks
+  // only then) meets no goal region of `goals` (in its window, with its speed and heading) while
+  // every region's window closes within the path, or the path runs past the region's end.
   bool GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
                   const std::vector<cost::GoalRegion>& goals) const;
 
@@ -143,6 +144,19 @@ class Rescue {
   // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
   // s along the road (from the hint s_hint).
   bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
+  // One walk along a path (PathHit's points and checks) for both of Step's questions: the step
+  // it hits a car or leaves the road (0: none), and, up to there, whether a point meets a goal
+  // region (the road past it is not checked), whether every speed is finite, and the last
+  // point's time (s from now) and s.
+  struct PathCheck {
+    int hit = 0;
+    bool met = false, judged = true;
+    double t_end = 0, s_end = -std::numeric_limits<double>::infinity();
+  };
+  PathCheck Walk(const std::vector<double>& x, const std::vector<double>& y,
+                 const std::vector<cost::GoalRegion>& goals) const;
+  // GoalAtRisk of a walked path.
+  static bool AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals);
   // The predicted cars at step k (1..steps), laid out up to k on first use.
   const std::vector<Car>& CarsAt(int k) const;
   // The same for the cars alone, and for the road alone (the box, the margin's wider, between
