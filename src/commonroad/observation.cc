@@ -100,6 +100,10 @@ Footprint AppendFuture(const Obstacle& o, int q, const State& sq, const std::opt
   fut->y.push_back(fq.centre.y);
   fut->v.push_back(vq.speed);
   fut->heading.push_back(vq.heading);
+  if (o.prediction == ObstaclePrediction::kSetBased) {
+    fut->lengths.push_back(fq.length);
+    fut->widths.push_back(fq.width);
+  }
   return fq;
 }
 
@@ -157,6 +161,8 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     fut.y.clear();
     fut.v.clear();
     fut.heading.clear();
+    fut.lengths.clear();
+    fut.widths.clear();
     std::optional<State> prev = before;
     for (int q = step; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
       const std::optional<State> sq = q == step ? st : o.StateAt(q);
@@ -180,6 +186,8 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     fut.y.clear();
     fut.v.clear();
     fut.heading.clear();
+    fut.lengths.clear();
+    fut.widths.clear();
     std::optional<State> prev;
     for (int q = first; q <= std::min(step + kFutureSteps, o.LastStep()); ++q) {
       const std::optional<State> sq = o.StateAt(q);

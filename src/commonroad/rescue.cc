@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
+#include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/reach_grid.h"
 #include "frenetic/plan/planner.h"
 
@@ -21,13 +23,16 @@ constexpr double kStrata[5] = {2.0, 2.0, 1.0, 1e3, 1e3};
 // away.
 constexpr double kWindowSlack = 0.75;
 
-// A future's centre and heading at t s from its telemetry's instant; false when the car is not
-// there yet. Past its last sample it keeps its last speed and heading.
-bool FutureAt(const plan::CarFuture& f, double t, double* x, double* y, double* heading) {
+// A future's centre and heading at t s from its telemetry's instant, and the sample they come
+// from (*sample); false when the car is not there yet. Past its last sample it keeps its last
+// speed and heading.
+bool FutureAt(const plan::CarFuture& f, double t, double* x, double* y, double* heading,
+              int* sample) {
   const int n = static_cast<int>(std::min({f.x.size(), f.y.size(), f.v.size(), f.heading.size()}));
   if (n == 0 || t < f.start - 1e-9) return false;
   const double at = (t - f.start) / f.dt;
   const int i = std::min(static_cast<int>(std::lround(at)), n - 1);
+  *sample = i;
   const double beyond = std::max(0.0, at - (n - 1)) * f.dt;
   *heading = f.heading[i];
   if (beyond > 0) {
@@ -169,8 +174,17 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
     cars.clear();
     for (const Source& src : sources_) {
       double x = src.x, y = src.y, heading = 0.0;
+      double half_length = src.half_length, half_width = src.half_width, radius = src.radius;
       if (src.kind == Source::kFuture) {
-        if (!FutureAt(*src.future, step * dt_, &x, &y, &heading)) continue;
+        const plan::CarFuture& f = *src.future;
+        int i = 0;
+        if (!FutureAt(f, step * dt_, &x, &y, &heading, &i)) continue;
+        if (i < static_cast<int>(std::min(f.lengths.size(), f.widths.size())) &&
+            f.lengths[i] > 0 && f.widths[i] > 0) {  // a footprint of its own at this sample
+          half_length = 0.5 * f.lengths[i];
+          half_width = 0.5 * f.widths[i];
+          radius = std::hypot(half_length, half_width);
+        }
       } else if (src.kind == Source::kAlong) {
         const map::CartesianPose at = road_.line().ToCartesian(src.x + src.along * step * dt_, src.y);
         x = at.x;
@@ -178,10 +192,10 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
         heading = at.heading + src.rel;
       }
       Car& c = cars.emplace_back();
-      c.box = {x, y, heading, src.half_length, src.half_width};
+      c.box = {x, y, heading, half_length, half_width};
       c.cos_h = std::cos(heading);
       c.sin_h = std::sin(heading);
-      c.radius = src.radius;
+      c.radius = radius;
     }
   }
   return cars_[k - 1];
@@ -283,14 +297,32 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   const bool keep = goal_way_ ? Lasts(ego, &goals) == rest
                               : !goal_only && rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
   if (!keep) {
-    Search(ego, goals, options_.max_states, goal_only);
-    // None at the usual size: once more with more states a step (a narrow way through).
-    if (way_.empty() && options_.retry_states > options_.max_states) {
-      Search(ego, goals, options_.retry_states, goal_only);
-    }
+    // A way to a goal whose every window closes within the horizon first, also when the path
+    // hits a car (a way that only lasts may leave the goal out of reach): a search that ends at
+    // the windows' close, with as many states in all as one over the whole horizon.
+    Drop();
+    const int goal_steps = GoalSteps(goals);
+    const auto search = [&](bool to_goal) {
+      const int scale = to_goal ? std::max(1, options_.steps / std::max(goal_steps, 1)) : 1;
+      Search(ego, goals, options_.max_states * scale, to_goal);
+      // None at the usual size: once more with more states a step (a narrow way through).
+      if (way_.empty() && options_.retry_states > options_.max_states) {
+        Search(ego, goals, options_.retry_states * scale, to_goal);
+      }
+    };
+    if (goal_only || goal_steps > 0) search(true);
+    if (way_.empty() && !goal_only) search(false);
   }
   if (way_.empty()) return std::nullopt;
   return way_.front();
+}
+
+int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals) const {
+  if (goals.empty()) return 0;
+  double last = 0;
+  for (const cost::GoalRegion& g : goals) last = std::max(last, g.t_hi + kWindowSlack * dt_);
+  const int steps = static_cast<int>(std::ceil(last / dt_ - 1e-9));
+  return steps >= 1 && steps < options_.steps ? steps : 0;
 }
 
 double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
@@ -301,7 +333,10 @@ double Rescue::GoalDistance(double s, double d, double v, double orientation, do
     if (t < g.t_lo - slack || t > g.t_hi + slack) continue;
     double dist = RegionGap(g, s, d);
     if (dist == 0) {
-      const double tangent = std::tan(orientation - road_.line().At(s).heading);
+      // Against the road's heading where the region's interval was read from it (its s mid,
+      // AddHeading in goal_frenet.cc): the same absolute orientations as the verdict's.
+      const double at_s = std::isfinite(g.s_lo) && std::isfinite(g.s_hi) ? 0.5 * (g.s_lo + g.s_hi) : s;
+      const double tangent = std::tan(orientation - road_.line().At(at_s).heading);
       const bool fits = v >= g.v_lo && v <= g.v_hi && -tangent >= g.h_lo && -tangent <= g.h_hi;
       if (!fits) dist = 1e-3;  // there, not yet as the region asks
     }
@@ -310,16 +345,74 @@ double Rescue::GoalDistance(double s, double d, double v, double orientation, do
   return best;
 }
 
-bool Rescue::MayMeetGoal(double s, double v, double t,
+bool Rescue::MayMeetGoal(double s, double d, const KsState& state, double t,
                          const std::vector<cost::GoalRegion>& goals) const {
   const double horizon = options_.steps * dt_;
+  const double v = state.velocity;
   for (const cost::GoalRegion& g : goals) {
     const double t_last = std::min(g.t_hi + kWindowSlack * dt_, horizon);
     if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
     const double time = t_last - t;
-    if (s + v * time + 0.5 * vehicle_.a_max * time * time >= g.s_lo) return true;
+    if (s + v * time + 0.5 * vehicle_.a_max * time * time < g.s_lo) continue;
+    // Across: the band's nearest edge at s (its slope over the reach added as slack) within
+    // the most the vehicle can move toward it in the time left.
+    const double slack = std::abs(g.d_slope) * (v * time + 0.5 * vehicle_.a_max * time * time);
+    const double d_off = g.d_slope * (s - g.s_ref);
+    const double below = g.d_lo + d_off - slack - d, above = d - (g.d_hi + d_off + slack);
+    if (below <= 0 && above <= 0) return true;
+    const double gap = std::max(below, above);
+    if (gap <= LateralReach(s, state, below > 0 ? 1 : -1, time)) return true;
   }
   return false;
+}
+
+double Rescue::LateralReach(double s, const KsState& state, int toward, double time) const {
+  // An upper bound of the KS model's displacement across the road toward +d (toward 1) or -d
+  // (-1) in `time` s, of its centre: the rear axle's (the KS model's point, which moves along
+  // the heading) and the centre's turn about it. The steering turned toward it at the largest
+  // rate from the present angle
+  // (the curvature tan(delta) / l growing at most at rate / (l cos^2 of the largest angle
+  // reachable), up to the steering limit and the friction circle at the lowest speed
+  // reachable), the heading's rate at the speed that makes it largest, the road's own curvature
+  // over the reach added against the vehicle, the displacement at the highest speed reachable
+  // (the lowest while heading away). Small steps, each taken at its largest rate.
+  const VehicleParams& p = vehicle_;
+  const double l = p.Wheelbase();
+  const double a = p.a_max;
+  const double v = std::max(0.0, state.velocity);
+  const double v_hi = v + a * time, v_lo = std::max(0.0, v - a * time);
+  const double steer_max = std::max(std::abs(p.steering_min), std::abs(p.steering_max));
+  const double rate = std::max(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
+  const double delta_reach = std::min(steer_max, std::abs(state.steering_angle) + rate * time);
+  const double cos_reach = std::cos(delta_reach);
+  const double kappa_rate = rate / (l * cos_reach * cos_reach);
+  double kappa_cap = std::tan(steer_max) / l;
+  if (v_lo > 0) kappa_cap = std::min(kappa_cap, a / (v_lo * v_lo));
+  const map::ReferenceLine& line = road_.line();
+  double road_kappa = 0;
+  for (const double f : {0.0, 0.5, 1.0}) {
+    road_kappa = std::max(road_kappa, std::abs(line.At(s + f * v_hi * time).kappa));
+  }
+  // d grows as the heading turns clockwise from the road's: the heading toward the band is
+  // -toward * (orientation - road heading), its curvature -toward * kappa.
+  double phi = -toward * WrapAngle(state.orientation - line.At(s).heading);
+  if (std::abs(phi) > 0.5 * std::numbers::pi) return std::numeric_limits<double>::infinity();
+  const double phi0 = phi;
+  double kappa = std::min(kappa_cap, -toward * std::tan(state.steering_angle) / l);
+  constexpr int kSteps = 16;
+  const double h = time / kSteps;
+  double reach = 0;
+  for (int i = 0; i < kSteps; ++i) {
+    const double k_end = std::min(kappa_cap, kappa + kappa_rate * h);
+    const double turn = (k_end >= 0 ? v_hi * k_end : v_lo * k_end) + v_hi * road_kappa;
+    const double phi_end = std::min(0.5 * std::numbers::pi, phi + h * turn);
+    const double sin_hi = std::sin(std::max(phi, phi_end));
+    reach += h * (sin_hi >= 0 ? v_hi * sin_hi : v_lo * sin_hi);
+    phi = phi_end;
+    kappa = k_end;
+  }
+  // The rear axle's move; the centre, b ahead of it, turns with the heading.
+  return reach + p.b * (std::sin(phi) - std::sin(phi0));
 }
 
 bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
@@ -340,7 +433,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   way_.clear();
   goal_way_ = false;
   const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
-  if (goal_only && !MayMeetGoal(fe0.s, ego.velocity, 0.0, goals)) return;  // out of reach
+  if (goal_only && !MayMeetGoal(fe0.s, fe0.d, ego, 0.0, goals)) return;  // out of reach
   ++searches_;
   const VehicleParams& p = vehicle_;
   const double share = options_.limit_share;
@@ -425,7 +518,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
       if (Clear(node.state, k, node.s, &at)) {
         node.s = at.s;
         node.d = at.d;
-        if (goal_only && !MayMeetGoal(node.s, node.state.velocity, k * dt_, goals)) continue;
+        if (goal_only && !MayMeetGoal(node.s, node.d, node.state, k * dt_, goals)) continue;
         layer.push_back(node);
         if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
                                                k * dt_, goals) == 0) met = static_cast<int>(layer.size()) - 1;

@@ -2,7 +2,8 @@
 // a path runs into a predicted car, a way found past a car closing from behind that stays clear
 // of it and on the road, the way into a goal region's lane, and no way when the cars of both
 // lanes close in side by side; when a planner's path misses a goal that is closing, a way to it
-// (kept while it still meets it), and no search for a goal out of reach.
+// (kept while it still meets it), and no search for a goal out of reach, along the road or
+// across it; a bound of the swerve across the road; a predicted car whose footprint grows.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -104,6 +105,69 @@ TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
   g.s_lo = 60;
   g.s_hi = 80;
   EXPECT_EQ(rescue.PathHit(x, y, {g}), left);
+}
+
+TEST(RescueTest, LateralReachBoundsTheVehiclesHardestSwerve) {
+  const auto road = TwoLanes();
+  const VehicleParams vp;
+  Rescue rescue(*road, vp, kDt);
+  // From lane 1 toward lane 0 (y grows, d shrinks: toward -1) at 20 m/s, the steering turned at
+  // its full rate (past the friction circle, which the bound also lets through at the lowest
+  // speed reachable): at every step the bound holds the centre's lateral move (the rear axle's,
+  // and the centre b ahead of it turned with the heading), and it is not loose by more than its
+  // own approximations.
+  const KsState ego = Ego(50, kLane1, 20);
+  KsState s = ego;
+  for (int k = 1; k <= 10; ++k) {
+    s = SimulateKs(s, {vp.steering_rate_max, 0.0}, kDt, vp);
+    const double moved = s.y - kLane1, bound = rescue.LateralReach(50, ego, -1, k * kDt);
+    EXPECT_LE(moved, bound) << k;
+    EXPECT_LE(bound, 2.5 * moved + 0.05) << k;
+  }
+  // A lane change (3.5 m) at 20 m/s from a straight start takes more than 0.3 s.
+  EXPECT_LT(rescue.LateralReach(50, ego, -1, 0.3), 1.0);
+  // Steering already turned the other way gives less; heading toward the band gives more.
+  KsState away = ego;
+  away.steering_angle = -0.05;  // clockwise: toward +d
+  EXPECT_LT(rescue.LateralReach(50, away, -1, 0.5), rescue.LateralReach(50, ego, -1, 0.5));
+  KsState toward = ego;
+  toward.orientation = 0.1;  // counter-clockwise: toward -d
+  EXPECT_GT(rescue.LateralReach(50, toward, -1, 0.5), rescue.LateralReach(50, ego, -1, 0.5) + 0.9);
+  // Symmetric on a straight road.
+  EXPECT_NEAR(rescue.LateralReach(50, ego, 1, 0.7), rescue.LateralReach(50, ego, -1, 0.7), 1e-9);
+}
+
+TEST(RescueTest, APredictedCarWhoseFootprintGrowsIsCheckedAtEachSamplesSize) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kDt);
+  // A car standing 40 m ahead in the ego's lane, known by its future (a set-based prediction's
+  // bounding boxes): 4.5 m long now, 2 m longer every step.
+  plan::Telemetry t;
+  t.x = 10;
+  t.sensor_fusion = {Row(1, 50, kLane0, 0.0)};
+  plan::CarFuture f;
+  f.id = 1;
+  for (int k = 0; k <= 40; ++k) {
+    f.x.push_back(50);
+    f.y.push_back(kLane0);
+    f.v.push_back(0);
+    f.heading.push_back(0);
+  }
+  t.futures = {f};
+  std::vector<double> x, y;
+  Straight(10, kLane0, 10, 250, &x, &y);  // 1 m a step
+  rescue.Predict(t);
+  // Its own size all along: the ego's front (2.25 + 0.05 m) meets the car's rear (47.75 m) at
+  // step 36 (10 + k + 2.3 >= 47.75).
+  const int fixed = rescue.PathHit(x, y);
+  EXPECT_EQ(fixed, 36);
+  for (int k = 0; k <= 40; ++k) {
+    t.futures[0].lengths.push_back(4.5 + 2.0 * k);
+    t.futures[0].widths.push_back(2.0);
+  }
+  rescue.Predict(t);
+  // Its rear at 50 - (2.25 + k): met when 10 + k + 2.3 >= 47.75 - k, step 18.
+  EXPECT_EQ(rescue.PathHit(x, y), 18);
 }
 
 // The way's states (Points every tick from ego): each step's centre, and whether any is NaN.
@@ -288,10 +352,34 @@ TEST_F(RescueOnAnEmptyRoad, NoSearchForAGoalOutOfReachOrPassed) {
   behind.s_lo = 0;
   behind.s_hi = 40;
   EXPECT_FALSE(rescue_.Next(ego, {behind}, true).has_value());
+  // In lane 0, 2.25 m across from the ego's centre in lane 1 at its nearest, closing in 0.25 s:
+  // too little time for a swerve that far (LateralReach).
+  EXPECT_FALSE(rescue_.Next(ego, {Lane0Goal(0.0, 0.25)}, true).has_value());
   EXPECT_EQ(rescue_.searches(), 0);
   // Without goal_only a way that lasts is enough (the hit case).
   EXPECT_TRUE(rescue_.Next(ego, {far}).has_value());
   EXPECT_EQ(rescue_.searches(), 1);
+}
+
+TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayToItFirst) {
+  // The window closes at 1.5 s (15 steps): a way to the goal first, with 40 / 16 = 2 times the
+  // states a step, then (none needed here) one that lasts.
+  const KsState ego = Ego(50, kLane1, 20);
+  ASSERT_TRUE(rescue_.Next(ego, {Lane0Goal(1.0, 1.5)}).has_value());
+  EXPECT_EQ(rescue_.searches(), 1);
+  std::vector<double> x, y;
+  rescue_.Points(ego, &x, &y);
+  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  EXPECT_LE(static_cast<int>(x.size()) / ticks, 16);  // it ends where it meets the region
+  ASSERT_FALSE(y.empty());
+  EXPECT_GE(y.back(), -3.0);
+  EXPECT_LE(y.back(), -0.5);
+  // A window open past the horizon: a way that lasts the whole 4 s, as without a goal.
+  Rescue open{*road_, VehicleParams(), kDt};
+  open.Predict(t_);
+  ASSERT_TRUE(open.Next(ego, {Lane0Goal(1.0, 10.0, 60.5)}).has_value());
+  open.Points(ego, &x, &y);
+  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
 }
 
 }  // namespace

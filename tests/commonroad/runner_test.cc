@@ -488,6 +488,24 @@ TEST(RunnerTest, PassesACarGivenAsASetBasedPrediction) {
   }
 }
 
+// The shared set-based scene (its cars' occupancies grow with the prediction's uncertainty) asks
+// for a lane change into the left lane within 0.9-1.0 s: the rescue's way to the goal, pruned
+// by what the vehicle can reach across the road and checked against each step's occupancy.
+TEST(RunnerTest, TheSharedSetBasedSceneIsSolvedWithItsOccupancies) {
+  const std::string path =
+      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
+  auto sc = LoadScenario(path);
+  ASSERT_TRUE(sc.ok()) << sc.message();
+  RunOptions o;
+  o.timing = false;
+  const std::vector<ProblemRun> runs = RunScenario(*sc, Config(), o).problems;
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_TRUE(runs[0].verdict.solved) << runs[0].verdict.Summary();
+  EXPECT_TRUE(std::any_of(runs[0].cycles.begin(), runs[0].cycles.end(),
+                          [](const RunCycle& c) { return c.rescued; }));
+}
+
 TEST(RunnerTest, EverySharedFileRunsAndItsTrajectoriesAreKsTrajectories) {
   const std::filesystem::path dir = std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad";
   if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;

@@ -97,9 +97,16 @@ class Rescue {
   // meets a goal region of `goals`, the telemetry's) is found: the rest of the last way while
   // it is still clear to its end and at least half the horizon long, else a new search's.
   // nullopt when none does (the planner's path is driven then: its least harm knows the goals).
-  // goal_only: only a way that meets a goal region (the planner's path misses a goal).
+  // goal_only: only a way that meets a goal region (the planner's path misses a goal). When
+  // every goal window closes within the horizon (GoalSteps), a way to a goal is searched for
+  // first in either case, up to that step, with steps / GoalSteps times the states a step.
   std::optional<KsInput> Next(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
                               bool goal_only = false);
+
+  // The most (m) a state at s may move across the road toward +d (toward 1) or -d (-1) within
+  // `time` s, with the vehicle's limits: an upper bound (its steering turned toward it at the
+  // largest rate).
+  double LateralReach(double s, const KsState& state, int toward, double time) const;
 
   // The way's centre points every plan::kTickSeconds from `ego` (the first one tick on): the
   // path sent in its place.
@@ -169,15 +176,20 @@ class Rescue {
   // goal_only: none unless it meets a goal region.
   void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states,
               bool goal_only = false);
+  // Whether a state at (s, d) in the road's frame, t s from now, may still meet a goal region
+  // within the horizon: one whose window is open at t or later, not passed, whose start lies
+  // within reach at the vehicle's full acceleration before its window closes, and whose band
+  // across the road lies within LateralReach.
+  bool MayMeetGoal(double s, double d, const KsState& state, double t,
+                   const std::vector<cost::GoalRegion>& goals) const;
   // The distance (s, d) of a state (speed v, heading) at t s from the nearest goal region whose
   // window holds t (0 inside it with its speed and heading, 1e-3 inside without), +inf when
   // none does.
-  // Whether a state at s (m along the road) with speed v (m/s), t s from now, may still meet a
-  // goal region within the horizon: one whose window is open at t or later, not passed, and
-  // whose start lies within reach at the vehicle's full acceleration before its window closes.
-  bool MayMeetGoal(double s, double v, double t, const std::vector<cost::GoalRegion>& goals) const;
   double GoalDistance(double s, double d, double v, double orientation, double t,
                       const std::vector<cost::GoalRegion>& goals) const;
+  // The step (1..steps - 1) by which every window of `goals` has closed; 0 when none are given
+  // or one stays open to the horizon or beyond.
+  int GoalSteps(const std::vector<cost::GoalRegion>& goals) const;
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;

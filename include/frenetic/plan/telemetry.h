@@ -32,6 +32,9 @@ struct CarFuture {
   double start = 0;  // s, >= 0
   double length = 0, width = 0;  // m: the footprint of a car to come (0: the default car's)
   std::vector<double> x, y, v, heading;  // m, m, m/s, rad (counter-clockwise from +x)
+  // m: the footprint at each sample where it changes along the future (a set-based prediction's
+  // occupancy grows with its uncertainty), else empty (the row's, or length and width above).
+  std::vector<double> lengths, widths;
 };
 
 struct Telemetry {
