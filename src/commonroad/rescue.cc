@@ -303,7 +303,7 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
     Drop();
     const int goal_steps = GoalSteps(goals);
     const auto search = [&](bool to_goal) {
-      const int scale = to_goal ? std::max(1, options_.steps / std::max(goal_steps, 1)) : 1;
+      const int scale = to_goal && goal_steps > 0 ? std::max(1, options_.steps / goal_steps) : 1;
       Search(ego, goals, options_.max_states * scale, to_goal);
       // None at the usual size: once more with more states a step (a narrow way through).
       if (way_.empty() && options_.retry_states > options_.max_states) {
