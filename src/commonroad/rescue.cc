@@ -352,8 +352,12 @@ bool Rescue::MayMeetGoal(double s, double d, const KsState& state, double t,
   for (const cost::GoalRegion& g : goals) {
     const double t_last = std::min(g.t_hi + kWindowSlack * dt_, horizon);
     if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
-    const double time = t_last - t;
+    double time = t_last - t;
     if (s + v * time + 0.5 * vehicle_.a_max * time * time < g.s_lo) continue;
+    // Past the region's end the way cannot meet it: the latest it gets there is braking at the
+    // vehicle's limit from now (never, when it stops short).
+    const double ahead = g.s_hi - s, a = vehicle_.a_max;
+    if (v * v > 2 * a * ahead) time = std::min(time, (v - std::sqrt(v * v - 2 * a * ahead)) / a);
     // Across: the band's nearest edge at s (its slope over the reach added as slack) within
     // the most the vehicle can move toward it in the time left.
     const double slack = std::abs(g.d_slope) * (v * time + 0.5 * vehicle_.a_max * time * time);
