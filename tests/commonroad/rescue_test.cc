@@ -355,6 +355,11 @@ TEST_F(RescueOnAnEmptyRoad, NoSearchForAGoalOutOfReachOrPassed) {
   // In lane 0, 2.25 m across from the ego's centre in lane 1 at its nearest, closing in 0.25 s:
   // too little time for a swerve that far (LateralReach).
   EXPECT_FALSE(rescue_.Next(ego, {Lane0Goal(0.0, 0.25)}, true).has_value());
+  // Open for 10 s, but ending 3 m ahead in lane 0: even braking at the limit the ego passes its
+  // end within 0.16 s, too soon to get across.
+  cost::GoalRegion ending = Lane0Goal(0.0, 10.0, 53);
+  ending.s_lo = 40;
+  EXPECT_FALSE(rescue_.Next(ego, {ending}, true).has_value());
   EXPECT_EQ(rescue_.searches(), 0);
   // Without goal_only a way that lasts is enough (the hit case).
   EXPECT_TRUE(rescue_.Next(ego, {far}).has_value());
