@@ -321,6 +321,8 @@ int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals) const {
   if (goals.empty()) return 0;
   double last = 0;
   for (const cost::GoalRegion& g : goals) last = std::max(last, g.t_hi + kWindowSlack * dt_);
+  // Compared before the conversion: a window without an end (+inf) or NaN stays 0.
+  if (!(last < options_.steps * dt_)) return 0;
   const int steps = static_cast<int>(std::ceil(last / dt_ - 1e-9));
   return steps >= 1 && steps < options_.steps ? steps : 0;
 }
