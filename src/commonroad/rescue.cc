@@ -350,19 +350,21 @@ double Rescue::GoalDistance(double s, double d, double v, double orientation, do
 bool Rescue::MayMeetGoal(double s, double d, const KsState& state, double t,
                          const std::vector<cost::GoalRegion>& goals) const {
   const double horizon = options_.steps * dt_;
-  const double v = state.velocity;
+  const double v = state.velocity, a = vehicle_.a_max;
+  // The farthest along the road within `time` s, at full acceleration.
+  const auto reach = [v, a](double time) { return v * time + 0.5 * a * time * time; };
   for (const cost::GoalRegion& g : goals) {
     const double t_last = std::min(g.t_hi + kWindowSlack * dt_, horizon);
     if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
     double time = t_last - t;
-    if (s + v * time + 0.5 * vehicle_.a_max * time * time < g.s_lo) continue;
+    if (s + reach(time) < g.s_lo) continue;
     // Past the region's end the way cannot meet it: the latest it gets there is braking at the
     // vehicle's limit from now (never, when it stops short).
-    const double ahead = g.s_hi - s, a = vehicle_.a_max;
+    const double ahead = g.s_hi - s;
     if (v * v > 2 * a * ahead) time = std::min(time, (v - std::sqrt(v * v - 2 * a * ahead)) / a);
     // Across: the band's nearest edge at s (its slope over the reach added as slack) within
     // the most the vehicle can move toward it in the time left.
-    const double slack = std::abs(g.d_slope) * (v * time + 0.5 * vehicle_.a_max * time * time);
+    const double slack = std::abs(g.d_slope) * reach(time);
     const double d_off = g.d_slope * (s - g.s_ref);
     const double below = g.d_lo + d_off - slack - d, above = d - (g.d_hi + d_off + slack);
     if (below <= 0 && above <= 0) return true;
@@ -376,10 +378,9 @@ double Rescue::LateralReach(double s, const KsState& state, int toward, double t
   // An upper bound of the KS model's displacement across the road toward +d (toward 1) or -d
   // (-1) in `time` s, of its centre: the rear axle's (the KS model's point, which moves along
   // the heading) and the centre's turn about it. The steering turned toward it at the largest
-  // rate from the present angle
-  // (the curvature tan(delta) / l growing at most at rate / (l cos^2 of the largest angle
-  // reachable), up to the steering limit and the friction circle at the lowest speed
-  // reachable), the heading's rate at the speed that makes it largest, the road's own curvature
+  // rate from the present angle (the curvature tan(delta) / l growing at most at rate / (l cos^2
+  // of the largest angle reachable), up to the steering limit and the friction circle at the
+  // lowest speed reachable), the heading's rate at the speed that makes it largest, the road's own curvature
   // over the reach added against the vehicle, the displacement at the highest speed reachable
   // (the lowest while heading away). Small steps, each taken at its largest rate.
   const VehicleParams& p = vehicle_;

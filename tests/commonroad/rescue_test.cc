@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
@@ -40,6 +41,14 @@ plan::SensorCar Row(int id, double x, double y, double v) {
   return c;
 }
 
+// A telemetry with the ego at x and these cars (no futures, no goals).
+plan::Telemetry Scene(double x, std::vector<plan::SensorCar> cars = {}) {
+  plan::Telemetry t;
+  t.x = x;
+  t.sensor_fusion = std::move(cars);
+  return t;
+}
+
 KsState Ego(double x, double y, double v) {
   KsState s;
   s.x = x;
@@ -61,9 +70,7 @@ void Straight(double x0, double y, double v, int n, std::vector<double>* x, std:
 TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   const auto road = TwoLanes();
   Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 10;
-  t.sensor_fusion = {Row(1, 60, kLane0, 0.0)};
+  const plan::Telemetry t = Scene(10, {Row(1, 60, kLane0, 0.0)});
   rescue.Predict(t);
   std::vector<double> x, y;
   Straight(10, kLane0, 20, 250, &x, &y);
@@ -80,8 +87,7 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
 TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
   const auto road = TwoLanes();  // edges at y 0 and -7
   Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 10;
+  const plan::Telemetry t = Scene(10);
   rescue.Predict(t);
   // Along lane 0, then drifting left at 1 m/s from x = 30 (step 10): the box (1.8 m wide, the
   // margin 0.05 m more) crosses y = 0 when its centre passes y = -0.95, 0.8 s later (step 18).
@@ -142,9 +148,7 @@ TEST(RescueTest, APredictedCarWhoseFootprintGrowsIsCheckedAtEachSamplesSize) {
   Rescue rescue(*road, VehicleParams(), kDt);
   // A car standing 40 m ahead in the ego's lane, known by its future (a set-based prediction's
   // bounding boxes): 4.5 m long now, 2 m longer every step.
-  plan::Telemetry t;
-  t.x = 10;
-  t.sensor_fusion = {Row(1, 50, kLane0, 0.0)};
+  plan::Telemetry t = Scene(10, {Row(1, 50, kLane0, 0.0)});
   plan::CarFuture f;
   f.id = 1;
   for (int k = 0; k <= 40; ++k) {
@@ -189,9 +193,7 @@ std::vector<KsState> StepsOf(const Rescue& rescue, const KsState& ego) {
 TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   const auto road = TwoLanes();
   Rescue rescue(*road, VehicleParams(), kDt);
-  plan::Telemetry t;
-  t.x = 50;
-  t.sensor_fusion = {Row(1, 20, kLane0, 40.0)};  // 30 m behind, 20 m/s faster
+  plan::Telemetry t = Scene(50, {Row(1, 20, kLane0, 40.0)});  // 30 m behind, 20 m/s faster
   rescue.Predict(t);
   std::vector<double> x, y;
   Straight(50, kLane0, 20, 250, &x, &y);
@@ -226,13 +228,10 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
 // A rescue on the two lanes with no car at all: every way lasts, the goals decide.
 class RescueOnAnEmptyRoad : public ::testing::Test {
  protected:
-  RescueOnAnEmptyRoad() {
-    t_.x = 50;
-    rescue_.Predict(t_);
-  }
+  RescueOnAnEmptyRoad() { rescue_.Predict(t_); }
   std::shared_ptr<const map::Road> road_ = TwoLanes();
   Rescue rescue_{*road_, VehicleParams(), kDt};
-  plan::Telemetry t_;
+  plan::Telemetry t_ = Scene(50);
 };
 
 TEST_F(RescueOnAnEmptyRoad, TheWayEndsInTheGoalRegionsLane) {
@@ -256,10 +255,8 @@ TEST_F(RescueOnAnEmptyRoad, TheWayEndsInTheGoalRegionsLane) {
 
 TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   const auto road = TwoLanes();
-  plan::Telemetry t;
-  t.x = 50;
   // 2 m wide cars in both lanes: 1.5 m between them, 0.75 m to each edge; the ego is 1.61 m.
-  t.sensor_fusion = {Row(1, 20, kLane0, 40.0), Row(2, 20, kLane1, 40.0)};
+  const plan::Telemetry t = Scene(50, {Row(1, 20, kLane0, 40.0), Row(2, 20, kLane1, 40.0)});
   // The searches one Next makes with a retry of that many states a step (0: none), and the
   // states they checked; none finds a way.
   const auto searches = [&](int retry_states, std::int64_t* checked) {
@@ -379,6 +376,16 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   ASSERT_FALSE(y.empty());
   EXPECT_GE(y.back(), -3.0);
   EXPECT_LE(y.back(), -0.5);
+  // A closing goal no way can meet (lane 0 from s 60 to 72 within 1.0-1.5 s, where a car
+  // stands at x 70, and the ego at 20 m/s is past s 64 by 1 s): the goal searches come first
+  // and find nothing, then a way that lasts is searched for and driven.
+  Rescue blocked{*road_, VehicleParams(), kDt};
+  const plan::Telemetry with_car = Scene(50, {Row(1, 70, kLane0, 0.0)});
+  blocked.Predict(with_car);
+  ASSERT_TRUE(blocked.Next(ego, {Lane0Goal(1.0, 1.5, 72)}).has_value());
+  EXPECT_GE(blocked.searches(), 2);
+  blocked.Points(ego, &x, &y);
+  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
   // A window open past the horizon: a way that lasts the whole 4 s, as without a goal.
   Rescue open{*road_, VehicleParams(), kDt};
   open.Predict(t_);
