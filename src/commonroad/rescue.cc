@@ -14,9 +14,10 @@ namespace {
 
 constexpr double kTick = plan::kTickSeconds;
 // Grid cells: position, speed, heading, steering angle; the strata of the spread (position,
-// speed; the 1e3 cells leave of heading and steering only their sign).
+// speed, speed across the search's start heading; the 1e3 cell leaves of the steering only its
+// sign). See Rescue::Stratum.
 constexpr double kCells[5] = {0.25, 0.25, 0.25, 0.01, 0.005};
-constexpr double kStrata[5] = {2.0, 2.0, 1.0, 1e3, 1e3};
+constexpr double kStrata[5] = {2.0, 2.0, 1.0, 1.0, 1e3};
 // The runner insets goal windows from the verdict's whole steps by up to half a step at each end
 // (a window of one step becomes an instant between two): a step within this many steps of a
 // window's inset ends is one of its whole steps, and one outside the window is a step or more
@@ -512,10 +513,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
     // Checked round-robin over the strata until max_states are valid.
     reach::SpreadOrder(
         next_,
-        [](const Node& n) {
-          const KsState& q = n.state;
-          return reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kStrata);
-        },
+        [h0 = ego.orientation](const Node& n) { return Stratum(n.state, h0); },
         spread_, rank_);
     std::vector<Node>& layer = layers_[k];
     const std::size_t cap = static_cast<std::size_t>(max_states);
@@ -557,6 +555,11 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
     way_[k - 1] = node.input;
     i = node.parent;
   }
+}
+
+std::uint64_t Rescue::Stratum(const KsState& q, double heading0) {
+  return reach::CellOf(q.x, q.y, q.velocity, q.velocity * std::sin(q.orientation - heading0),
+                       q.steering_angle, kStrata);
 }
 
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {

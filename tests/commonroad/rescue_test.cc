@@ -113,6 +113,32 @@ TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
   EXPECT_EQ(rescue.PathHit(x, y, {g}), left);
 }
 
+TEST(RescueTest, TheSearchsStrataKeepATurnOutOfTheLaneApartFromGoingStraight) {
+  // At 30 m/s a heading 0.05 rad off the start's moves 1.5 m/s across: another stratum than
+  // going straight at the same place and speed (the heading's sign alone made them one), on
+  // either side, and turned back toward the start heading from either side too.
+  KsState straight;
+  straight.x = 100.5;
+  straight.y = 0.5;
+  straight.velocity = 30;
+  straight.orientation = 0.3;
+  KsState out = straight;
+  out.orientation = 0.35;
+  KsState other = straight;
+  other.orientation = 0.25;
+  const double h0 = 0.3;
+  EXPECT_NE(Rescue::Stratum(out, h0), Rescue::Stratum(straight, h0));
+  EXPECT_NE(Rescue::Stratum(other, h0), Rescue::Stratum(straight, h0));
+  // The same turn at 2 m/s moves 0.1 m/s across: one stratum with going straight.
+  straight.velocity = out.velocity = 2;
+  EXPECT_EQ(Rescue::Stratum(out, h0), Rescue::Stratum(straight, h0));
+  // Measured from the start's heading, not the frame's x axis: on a road heading 0.3 rad, a
+  // state along it is not turning, one along the x axis is.
+  straight.velocity = out.velocity = 30;
+  out.orientation = 0.0;
+  EXPECT_NE(Rescue::Stratum(out, h0), Rescue::Stratum(straight, h0));
+}
+
 TEST(RescueTest, LateralReachBoundsTheVehiclesHardestSwerve) {
   const auto road = TwoLanes();
   const VehicleParams vp;
