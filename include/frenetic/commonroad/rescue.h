@@ -104,12 +104,12 @@ class Rescue {
                               bool goal_only = false);
 
   // The stratum of a search's state (its spread keeps states of every stratum, round-robin):
-  // cells of 2 m x 2 m, 1 m/s of speed and 1 m/s of speed across the search's start heading
+  // cells of 2 m x 2 m, 1 m/s of speed and 0.5 m/s of speed across the search's start heading
   // `heading0` (v sin(heading - heading0)), and the steering's sign. The speed across keeps a
   // state turning out of its lane apart from one going straight at the same place and speed (an
   // escape across lanes from a car closing from behind); at low speed the same turn moves little
-  // across and shares its stratum. Was the heading's sign alone: derived highD problems
-  // 348 -> 362 solved of 384 with recorded predictions, 286 -> 290 constant-velocity.
+  // across and shares its stratum. Was the heading's sign alone; see docs/commonroad.md ("The
+  // rescue's strata") for what each cell size solved.
   static std::uint64_t Stratum(const KsState& q, double heading0);
 
   // The most (m) a state at s may move across the road toward +d (toward 1) or -d (-1) within
