@@ -429,9 +429,9 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_option("--rescue-retry", args->rescue_retry,
                   "States a step (count) of a second rescue search when the first (150 a step) "
                   "finds no way (the ego would otherwise drive into a predicted car, or miss the "
-                  "goal); 0 = none. A narrow way through a box-in may need thousands: on the "
-                  "shared highD files 2000 solved one problem more than 300 and its search took "
-                  "0.4 s in one cycle. Default: 300 (twice the first)")
+                  "goal); 0 = none. A narrow way through a box-in may need thousands; each "
+                  "costs time in the cycle it runs (2000 states a step: up to 0.4 s). Default: "
+                  "300 (twice the first)")
       ->check(CLI::Range(0, 100000));
   sub->add_flag("--way-through", args->way_through,
                 "For each problem left unsolved (not infeasible at start), search whether any way "

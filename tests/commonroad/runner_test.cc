@@ -547,5 +547,36 @@ TEST(RunnerTest, EverySharedFileRunsAndItsTrajectoriesAreKsTrajectories) {
   EXPECT_EQ(solved + infeasible, problems) << unsolved;
 }
 
+// The shared highD files (fast recorded traffic, cars closing from behind at twice their stated
+// speed): every problem that has a solution is solved with recorded predictions. The last one
+// (`ALower26-1_26451`) needed the rescue's strata by the speed across (Rescue::Stratum).
+TEST(RunnerTest, EverySharedHighDProblemWithASolutionIsSolved) {
+  const std::filesystem::path dir =
+      std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad" / "highD";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
+  RunOptions o;
+  o.timing = false;
+  const plan::PlannerConfig config = Config();
+  int problems = 0, solved = 0, infeasible = 0;
+  std::string unsolved;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() < 7 || name.compare(name.size() - 7, 7, ".cr.xml") != 0) continue;
+    auto sc = LoadScenario(entry.path().string());
+    ASSERT_TRUE(sc.ok()) << sc.message();
+    for (const ProblemRun& p : RunScenario(*sc, config, o).problems) {
+      ++problems;
+      solved += p.verdict.solved;
+      infeasible += p.verdict.infeasible_at_start.has_value();
+      if (!p.verdict.solved && !p.verdict.infeasible_at_start) {
+        unsolved += " " + sc->benchmark_id + ": " + p.verdict.Summary();
+      }
+    }
+  }
+  EXPECT_GE(problems, 30);
+  EXPECT_LE(infeasible, 3);
+  EXPECT_EQ(solved + infeasible, problems) << unsolved;
+}
+
 }  // namespace
 }  // namespace frenetic::commonroad
