@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <numbers>
 #include <set>
@@ -506,45 +507,70 @@ TEST(RunnerTest, TheSharedSetBasedSceneIsSolvedWithItsOccupancies) {
                           [](const RunCycle& c) { return c.rescued; }));
 }
 
-TEST(RunnerTest, EverySharedFileRunsAndItsTrajectoriesAreKsTrajectories) {
-  const std::filesystem::path dir = std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad";
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
+// The problems of the scenario files in `dir` whose names end with `suffix`, each run closed-loop
+// with recorded predictions (no timing) and given to on_problem (when set): how many there were,
+// were solved and were infeasible at start, and the others' verdicts.
+struct SharedTally {
+  int problems = 0, solved = 0, infeasible = 0;
+  std::string unsolved;
+};
+SharedTally RunSharedDir(
+    const std::filesystem::path& dir, const std::string& suffix,
+    const std::function<void(const std::filesystem::path&, const ProblemRun&)>& on_problem = {}) {
   RunOptions o;
   o.timing = false;
   const plan::PlannerConfig config = Config();
-  int problems = 0, solved = 0, infeasible = 0;
-  std::string unsolved;
+  SharedTally t;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    if (entry.path().extension() != ".xml") continue;
+    const std::string name = entry.path().filename().string();
+    if (name.size() < suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+      continue;
+    }
     auto sc = LoadScenario(entry.path().string());
-    ASSERT_TRUE(sc.ok()) << sc.message();
+    if (!sc.ok()) {
+      ADD_FAILURE() << sc.message();
+      continue;
+    }
     for (const ProblemRun& p : RunScenario(*sc, config, o).problems) {
-      ++problems;
-      solved += p.verdict.solved;
-      if (p.verdict.infeasible_at_start) {
-        // No solution exists (ZAM_Ramp's ego starts with its rear past the road's closed
-        // start); nothing was planned.
-        ++infeasible;
-        EXPECT_TRUE(p.cycles.empty()) << entry.path();
-        continue;
+      ++t.problems;
+      t.solved += p.verdict.solved;
+      t.infeasible += p.verdict.infeasible_at_start.has_value();
+      if (!p.verdict.solved && !p.verdict.infeasible_at_start) {
+        t.unsolved += " " + sc->benchmark_id + ": " + p.verdict.Summary();
       }
-      if (!p.verdict.solved) unsolved += " " + sc->benchmark_id + ": " + p.verdict.Summary();
-      ASSERT_TRUE(p.road.ok()) << p.road.message();
-      // Whatever the outcome, the runner's own part holds: a trajectory from the initial state,
-      // step by step, that the KS model and the vehicle's limits allow.
-      for (const FailureKind k : {FailureKind::kTrajectory, FailureKind::kStart,
-                                  FailureKind::kDynamics, FailureKind::kSteeringRate,
-                                  FailureKind::kSteeringAngle, FailureKind::kAcceleration,
-                                  FailureKind::kFrictionCircle, FailureKind::kVelocity}) {
-        EXPECT_EQ(p.verdict.Find(k), nullptr) << entry.path() << ": " << p.verdict.Summary();
-      }
+      if (on_problem) on_problem(entry.path(), p);
     }
   }
-  EXPECT_GE(problems, 13);
+  return t;
+}
+
+TEST(RunnerTest, EverySharedFileRunsAndItsTrajectoriesAreKsTrajectories) {
+  const std::filesystem::path dir = std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
+  const SharedTally t =
+      RunSharedDir(dir, ".xml", [](const std::filesystem::path& path, const ProblemRun& p) {
+        if (p.verdict.infeasible_at_start) {
+          // No solution exists (ZAM_Ramp's ego starts with its rear past the road's closed
+          // start); nothing was planned.
+          EXPECT_TRUE(p.cycles.empty()) << path;
+          return;
+        }
+        ASSERT_TRUE(p.road.ok()) << p.road.message();
+        // Whatever the outcome, the runner's own part holds: a trajectory from the initial
+        // state, step by step, that the KS model and the vehicle's limits allow.
+        for (const FailureKind k : {FailureKind::kTrajectory, FailureKind::kStart,
+                                    FailureKind::kDynamics, FailureKind::kSteeringRate,
+                                    FailureKind::kSteeringAngle, FailureKind::kAcceleration,
+                                    FailureKind::kFrictionCircle, FailureKind::kVelocity}) {
+          EXPECT_EQ(p.verdict.Find(k), nullptr) << path << ": " << p.verdict.Summary();
+        }
+      });
+  EXPECT_GE(t.problems, 13);
   // Every example that has a solution is solved (recorded predictions, the benchmark's
   // convention).
-  EXPECT_LE(infeasible, 1);
-  EXPECT_EQ(solved + infeasible, problems) << unsolved;
+  EXPECT_LE(t.infeasible, 1);
+  EXPECT_EQ(t.solved + t.infeasible, t.problems) << t.unsolved;
 }
 
 // The shared highD files (fast recorded traffic, cars closing from behind at twice their stated
@@ -554,28 +580,10 @@ TEST(RunnerTest, EverySharedHighDProblemWithASolutionIsSolved) {
   const std::filesystem::path dir =
       std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad" / "highD";
   if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
-  RunOptions o;
-  o.timing = false;
-  const plan::PlannerConfig config = Config();
-  int problems = 0, solved = 0, infeasible = 0;
-  std::string unsolved;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() < 7 || name.compare(name.size() - 7, 7, ".cr.xml") != 0) continue;
-    auto sc = LoadScenario(entry.path().string());
-    ASSERT_TRUE(sc.ok()) << sc.message();
-    for (const ProblemRun& p : RunScenario(*sc, config, o).problems) {
-      ++problems;
-      solved += p.verdict.solved;
-      infeasible += p.verdict.infeasible_at_start.has_value();
-      if (!p.verdict.solved && !p.verdict.infeasible_at_start) {
-        unsolved += " " + sc->benchmark_id + ": " + p.verdict.Summary();
-      }
-    }
-  }
-  EXPECT_GE(problems, 30);
-  EXPECT_LE(infeasible, 3);
-  EXPECT_EQ(solved + infeasible, problems) << unsolved;
+  const SharedTally t = RunSharedDir(dir, ".cr.xml");
+  EXPECT_GE(t.problems, 30);
+  EXPECT_LE(t.infeasible, 3);
+  EXPECT_EQ(t.solved + t.infeasible, t.problems) << t.unsolved;
 }
 
 }  // namespace
