@@ -381,9 +381,9 @@ double Rescue::LateralReach(double s, const KsState& state, int toward, double t
   // the heading) and the centre's turn about it. The steering turned toward it at the largest
   // rate from the present angle (the curvature tan(delta) / l growing at most at rate / (l cos^2
   // of the largest angle reachable), up to the steering limit and the friction circle at the
-  // lowest speed reachable), the heading's rate at the speed that makes it largest, the road's own curvature
-  // over the reach added against the vehicle, the displacement at the highest speed reachable
-  // (the lowest while heading away). Small steps, each taken at its largest rate.
+  // lowest speed reachable), the heading's rate at the speed that makes it largest, the road's
+  // own curvature over the reach added against the vehicle, the displacement at the highest
+  // speed reachable (the lowest while heading away). Small steps, each taken at its largest rate.
   const VehicleParams& p = vehicle_;
   const double l = p.Wheelbase();
   const double a = p.a_max;
@@ -453,7 +453,9 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   for (std::vector<Node>& layer : layers_) layer.clear();
   KsState start = ego;
   start.time_step = 0;
-  layers_[0].push_back({start, fe0.s, fe0.d, -1, {}});
+  layers_[0].push_back({start, fe0.s, fe0.d, -1, {}, 0.0});
+  // Stratum's speed across the start heading, from each child's sine and cosine of its heading.
+  const double cos_h0 = std::cos(ego.orientation), sin_h0 = std::sin(ego.orientation);
   int depth = 0, met = -1;
   for (int k = 1; k <= options_.steps; ++k) {
     next_.clear();
@@ -506,14 +508,17 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
           q.y = ry + h / 6 * (s.velocity * s0 + 4 * vm * sm + v1 * s1) + p.b * s1;
           const std::uint64_t cell =
               reach::CellOf(q.x, q.y, q.velocity, q.orientation, q.steering_angle, kCells);
-          if (seen_.Insert(cell)) next_.push_back({cell, Node{q, now[i].s, now[i].d, i, {r, a}}});
+          if (seen_.Insert(cell)) {
+            const double across = SpeedAcross(v1, c1, s1, cos_h0, sin_h0);
+            next_.push_back({cell, Node{q, now[i].s, now[i].d, i, {r, a}, across}});
+          }
         }
       }
     }
     // Checked round-robin over the strata until max_states are valid.
     reach::SpreadOrder(
         next_,
-        [h0 = ego.orientation](const Node& n) { return Stratum(n.state, h0); },
+        [](const Node& n) { return StratumAcross(n.state, n.across); },
         spread_, rank_);
     std::vector<Node>& layer = layers_[k];
     const std::size_t cap = static_cast<std::size_t>(max_states);
@@ -558,8 +563,13 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
 }
 
 std::uint64_t Rescue::Stratum(const KsState& q, double heading0) {
-  return reach::CellOf(q.x, q.y, q.velocity, q.velocity * std::sin(q.orientation - heading0),
-                       q.steering_angle, kStrata);
+  return StratumAcross(q, SpeedAcross(q.velocity, std::cos(q.orientation),
+                                      std::sin(q.orientation), std::cos(heading0),
+                                      std::sin(heading0)));
+}
+
+std::uint64_t Rescue::StratumAcross(const KsState& q, double across) {
+  return reach::CellOf(q.x, q.y, q.velocity, across, q.steering_angle, kStrata);
 }
 
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {

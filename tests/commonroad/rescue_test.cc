@@ -114,9 +114,9 @@ TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
 }
 
 TEST(RescueTest, TheSearchsStrataKeepATurnOutOfTheLaneApartFromGoingStraight) {
-  // At 30 m/s a heading 0.05 rad off the start's moves 1.5 m/s across: another stratum than
-  // going straight at the same place and speed (the heading's sign alone made them one), on
-  // either side, and turned back toward the start heading from either side too.
+  // At 30 m/s a heading 0.05 rad off the start's, to either side, moves 1.5 m/s across:
+  // another stratum than going straight at the same place and speed (the heading's sign alone
+  // made them one).
   KsState straight;
   straight.x = 100.5;
   straight.y = 0.5;

@@ -522,11 +522,7 @@ SharedTally RunSharedDir(
   const plan::PlannerConfig config = Config();
   SharedTally t;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() < suffix.size() ||
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
-      continue;
-    }
+    if (!entry.path().filename().string().ends_with(suffix)) continue;
     auto sc = LoadScenario(entry.path().string());
     if (!sc.ok()) {
       ADD_FAILURE() << sc.message();

@@ -151,11 +151,19 @@ class Rescue {
     double x = 0, y = 0, along = 0, rel = 0;
     double half_length = 0, half_width = 0, radius = 0;
   };
+  // Stratum with the speed across given: the search has its children's sines and cosines at
+  // hand (v sin(heading - heading0) = v (sin heading cos heading0 - cos heading sin heading0)).
+  static std::uint64_t StratumAcross(const KsState& q, double across);
+  static double SpeedAcross(double v, double cos_heading, double sin_heading, double cos_h0,
+                            double sin_h0) {
+    return v * (sin_heading * cos_h0 - cos_heading * sin_h0);
+  }
   struct Node {
     KsState state;
     double s, d;  // in the road's frame (s: the Frenet hint of its children)
     int parent;  // index in the step before
     KsInput input;
+    double across;  // m/s: the speed across the search's start heading (Stratum)
   };
   // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
   // s along the road (from the hint s_hint).
