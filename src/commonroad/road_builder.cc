@@ -355,6 +355,13 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
           lane.left.insert(lane.left.begin(), lane.left.front());
           lane.right.insert(lane.right.begin(), lane.right.front());
         }
+        // Its end is a lane drop when its last lanelet leads nowhere or only into the road
+        // (not an exit: a successor off the road).
+        if (!other_way) {
+          const std::vector<int> next = net.Successors(net.Index(ids.back()));
+          lane.drops = std::all_of(next.begin(), next.end(),
+                                   [&](int k) { return placed.count(k) > 0; });
+        }
         if (kOpenEnd > 0 && (other_way ? last_piece.predecessors : last_piece.successors).empty()) {
           lane.s.push_back(lane.s.back() + kOpenEnd);
           lane.left.push_back(lane.left.back());
@@ -417,6 +424,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     map::LaneProfile kept;
     kept.speed_limit = l.speed_limit;
     kept.oncoming = l.oncoming;
+    kept.drops = l.drops;
     for (size_t k = best_from; k < best_from + best_len; ++k) {
       kept.s.push_back(l.s[k]);
       kept.left.push_back(l.left[k]);

@@ -117,6 +117,10 @@ bool Road::Oncoming(int lane) const {
   return lane >= 0 && lane < num_lanes() && lanes_[lane].oncoming;
 }
 
+bool Road::Drops(int lane) const {
+  return lane >= 0 && lane < num_lanes() && lanes_[lane].drops;
+}
+
 Road::Span Road::EdgesAt(double s) const {
   Span out{kNaN, kNaN, false};
   for (int l = 0; l < num_lanes(); ++l) {

@@ -98,6 +98,7 @@ constexpr Default kDefaults[] = {
     {"prediction.lateral_threshold", 0.7, 0.2, 3, false},
     {"prediction.lane_change_ghosts", 1, 0, 1, false},
     {"prediction.followers_react", 1, 0, 1, false},
+    {"prediction.merge_time", 3, 0, 8, false},
     {"refine.enabled", 1, 0, 1, false},
     {"refine.max_iterations", 40, 1, 500, true},
     {"refine.budget_ms", 3, 0.1, 50, true},

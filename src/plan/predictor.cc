@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <utility>
 
@@ -161,6 +162,8 @@ class TrafficPredictor : public Predictor {
     ghost_seen_.reserve(options_.max_cars);
     ghost_seen_next_.reserve(options_.max_cars);
     memory_.reserve(options_.max_cars);
+    road_end_ = -std::numeric_limits<double>::infinity();
+    for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
     const std::size_t n = static_cast<std::size_t>(options_.max_cars) * kMaxFutureSamples;
     for (auto* v : {&fut_s_, &fut_d_, &fut_v_, &fut_vd_}) v->assign(n, 0.0);
     fut_n_.assign(options_.max_cars, 0);
@@ -215,6 +218,7 @@ class TrafficPredictor : public Predictor {
       car.width = row.width > 0 && std::isfinite(row.width) ? row.width : options_.car_width;
       const int slot = static_cast<int>(cars_.size());
       car.recorded = LoadFuture(row.id, futures, slot, f.s, ego_s);
+      if (!car.recorded && car.d_target == car.d) PredictMerge(f.s, car);
       cars_.push_back(car);
       slot_.push_back(car.recorded ? slot : -1);
     }
@@ -494,6 +498,35 @@ class TrafficPredictor : public Predictor {
     return p;
   }
 
+  // PredictorOptions::merge_time: a car at line coordinate s whose lane ends ahead, before the
+  // road does, moves into the neighbouring lane that goes on (the nearer one when both do):
+  // car.d_target, v_d and lat_delay set for Predict's lateral move.
+  void PredictMerge(double s, TrackedCar& car) const {
+    if (road_->uniform() || !(options_.merge_time > 0) || !(car.v_s > 0.5)) return;
+    const int lane = road_->LaneOf(s, car.d);
+    if (lane < 0) return;
+    const double end = road_->LaneEnd(lane);
+    // A lane drop, not a lane that leaves the road, nor the road's own end.
+    if (!road_->Drops(lane) || !(end < road_end_ - kMergeSlack)) return;
+    const double t_end = std::max(end - s - 0.5 * car.length, 0.0) / car.v_s;
+    if (!(t_end <= options_.future_horizon)) return;
+    // The neighbour that exists where the lane ends and goes on past it.
+    const double at = end - kMergeSlack;
+    double target = NAN;
+    for (const int n : {lane - 1, lane + 1}) {
+      const map::Road::Span span = road_->LaneAt(n, at);
+      if (!span.exists || !(road_->LaneEnd(n) > end + kMergeSlack)) continue;
+      if (std::isnan(target) || std::abs(span.centre() - car.d) < std::abs(target - car.d)) {
+        target = span.centre();
+      }
+    }
+    if (std::isnan(target)) return;
+    const double move = std::max(std::min(options_.merge_time, t_end), 0.1);
+    car.d_target = target;
+    car.v_d = (target - car.d) / move;
+    car.lat_delay = t_end - std::min(options_.merge_time, t_end);
+  }
+
   // The centre of the next lane in the direction of a lateral move faster than the threshold,
   // or d itself (no move predicted, or a move away from that centre: wander). s: the car's line
   // coordinate.
@@ -518,6 +551,9 @@ class TrafficPredictor : public Predictor {
 
   std::shared_ptr<const map::Road> road_;
   std::shared_ptr<const map::ReferenceLine> line_;
+  double road_end_ = 0;  // the farthest lane end (a lane ending before it is a lane drop)
+  // m: a lane ending this close to the road's end ends with it; a neighbour must go on this far.
+  static constexpr double kMergeSlack = 5.0;
   PredictorOptions options_;
   bool manoeuvres_;
   std::vector<TrackedCar> cars_;

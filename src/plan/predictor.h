@@ -68,6 +68,13 @@ struct PredictorOptions {
   // ego: a car alongside or just ahead may move in).
   bool lane_change_ghosts = false;
   double ghost_lateral_speed = 1.6;  // m/s across, about a lane in 2.5 s
+  // Both predictors, on a road that is not uniform: a car (not recorded, not moving across
+  // already) whose lane ends before the road does (a lane drop, a zipper merge, an on-ramp's
+  // acceleration lane) and that reaches the end within future_horizon at its speed moves into
+  // the neighbouring lane that goes on, over the last merge_time s before the end (all of the
+  // time left when less), its move ending at that lane's centre there. 0: none (the car is
+  // predicted on along its lane's d, through the end).
+  double merge_time = 0;  // s
 };
 
 class Predictor {
@@ -95,7 +102,7 @@ class Predictor {
   virtual void Reset() = 0;
 };
 
-// Constant speed along the lane, constant d.
+// Constant speed along the lane, constant d (but for a lane drop's merge, merge_time).
 std::unique_ptr<Predictor> MakeConstantVelocityPredictor(std::shared_ptr<const map::Road> road,
                                                          const PredictorOptions& options);
 // Constant velocity, except a braking car keeps braking for up to brake_horizon and a car moving

@@ -117,6 +117,8 @@ TEST(RoadBuilderTest, ALaneDropKeepsTheReferenceOnTheLaneThatGoesOn) {
   EXPECT_NEAR(b.road->LaneEnd(0), 600, 1.0);
   EXPECT_GT(b.road->LaneEnd(0), 290);
   EXPECT_NEAR(b.map_end, 300, 1.0);  // where the run-on starts
+  // Its traffic has to move over before the end (the predictions' merge).
+  EXPECT_TRUE(b.road->Drops(1));
   // The left lane's centre is y = 1.75 in XY everywhere (the line itself).
   for (double s : {20.0, 120.0, 160.0, 250.0}) {
     const map::Road::Span a = b.road->LaneAt(0, s);
@@ -209,6 +211,8 @@ TEST(RoadBuilderTest, TheHalfOfAZipperMergeOffTheReferenceTapersOffItsLane) {
     EXPECT_GT(right.width(), 0.5) << x;
     EXPECT_LT(right.width(), 3.5) << x;
   }
+  // Its end is a lane drop: 27 leads into 24, the lane the reference goes on along.
+  EXPECT_TRUE(b.road->Drops(1));
 }
 
 TEST(RoadBuilderTest, GoalByRectangleRoutesIntoItsLane) {
@@ -254,6 +258,8 @@ TEST(RoadBuilderTest, AnExitThatSplitsOffIsFollowedAndTheOtherHalfIsNoNeighbour)
   // The left lane ends at the fork (its own way on leads elsewhere); the right one goes on
   // along the ramp, 3.5 m wide about the line.
   EXPECT_NEAR(b.road->LaneEnd(0), 200, 1.0);
+  // That end is no lane drop: its traffic goes on along 3, off this road, not into the ramp.
+  EXPECT_FALSE(b.road->Drops(0));
   for (double s : {100.0, 250.0, 350.0}) {
     const map::Road::Span r = b.road->LaneAt(1, s);
     ASSERT_TRUE(r.exists) << s;

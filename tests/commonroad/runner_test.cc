@@ -472,6 +472,33 @@ TEST(RunnerTest, ConstantVelocityPredictionsStillAvoidACutIn) {
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
 }
 
+TEST(RunnerTest, ConstantVelocityPredictionsSeeTheOtherHalfOfAZipperMergeMergeIn) {
+  // The ego in the left half of a zipper merge (its lane goes on, behind a car 20 m ahead that
+  // follows it), a car alongside in the right half, all at 12 m/s; that car drives on straight
+  // into the merged lane as its own lane ends. The ego sees only the present: without the merge
+  // predicted, the car seems to drive on beside it, and the ego runs into it at the merge.
+  for (const double beside : {-2.0, 0.0, 2.0}) {
+    ScenarioXml xml;
+    AddZipperMerge(xml);
+    std::vector<StateXml> car, leader;
+    for (int k = 0; k <= 85; ++k) {
+      car.push_back({k, {-100 + beside + 1.2 * k, 5.25}, 0.0, 12});
+      const double x = -80 + 1.2 * k;  // 28 moves 3.5 m right from x = -20 to 0
+      leader.push_back({k, {x, 8.75 - 3.5 * std::clamp((x + 20) / 20, 0.0, 1.0)}, 0.0, 12});
+    }
+    xml.DynamicObstacle(4, 4.8, 2, car)
+        .DynamicObstacle(5, 4.8, 2, leader)
+        .Problem(1, {-100, 8.75}, 0, 12, {GoalLaneletXml(24, 84, 85)});
+    const ProblemRun p = RunOne(xml, PredictionMode::kConstantVelocity);
+    EXPECT_TRUE(p.verdict.solved) << beside << ": " << p.verdict.Summary();
+    plan::PlannerConfig no_merge = Config();
+    ASSERT_TRUE(no_merge.Set("prediction.merge_time", 0).ok());
+    const ProblemRun blind = RunOne(xml, PredictionMode::kConstantVelocity, &no_merge);
+    EXPECT_NE(blind.verdict.Find(FailureKind::kCollision), nullptr)
+        << beside << ": " << blind.verdict.Summary();
+  }
+}
+
 TEST(RunnerTest, PassesACarGivenAsASetBasedPrediction) {
   // A slow car 50 m ahead in the ego's lane, predicted as regions that grow along the lane; the
   // goal is the left lane. The verdict checks the ego against the regions.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "frenetic/map/reference_line.h"
+#include "frenetic/map/road.h"
 #include "plan/search/stages_testing.h"
 
 namespace frenetic::plan {
@@ -85,6 +86,53 @@ TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
   cv->Observe(row(19.4, -2.0), 280, 0.1);
   EXPECT_NEAR(cv->Predict(0, 3.0).v, 19.4, 0.05);
   EXPECT_NEAR(cv->Predict(0, 3.0).d, 9.0, 0.05);
+}
+
+// A lane drop (a zipper merge, an on-ramp's acceleration lane): a car in the lane that ends
+// moves into the lane beside over the last merge_time s before the end, in both predictors; not
+// when the end is no drop (a lane leaving the road), nor when the car reaches it past the
+// horizon, nor with merge_time 0.
+TEST(PredictorTest, ACarWhoseLaneDropsMergesBeforeTheEnd) {
+  const std::vector<map::ReferenceLine::Point> pts = {{0, 0}, {400, 0}};
+  auto line = map::ReferenceLine::FitOpen(pts, map::ReferenceLine::Options(), "straight");
+  ASSERT_TRUE(line.ok()) << line.message();
+  auto road_with = [&](bool drops) {
+    map::LaneProfile left{{0, 400}, {0, 0}, {3.5, 3.5}};
+    map::LaneProfile right{{0, 150}, {3.5, 3.5}, {7, 7}};
+    right.drops = drops;
+    auto road = map::Road::Make(*line, {left, right}, "drop");
+    EXPECT_TRUE(road.ok()) << road.message();
+    return *road;
+  };
+  PredictorOptions o;
+  o.merge_time = 3.0;
+  o.future_horizon = 8.0;
+  // d is right of the line: y = -d. Car 1 in the right lane at s 100, 10 m/s: its front reaches
+  // the end (s 150) after (50 - 2.4) / 10 = 4.76 s. Car 2 there at 5 m/s: after 29.5 s.
+  const std::vector<SensorCar> rows = {{1, 100, -5.25, 10, 0, 0, 0, 4.8, 1.8},
+                                       {2, 20, -5.25, 5, 0, 0, 0, 4.8, 1.8},
+                                       {3, 120, -1.75, 10, 0, 0, 0, 4.8, 1.8}};
+  for (const bool manoeuvres : {false, true}) {
+    SCOPED_TRACE(manoeuvres ? "manoeuvres" : "constant velocity");
+    auto pred = manoeuvres ? MakeManoeuvrePredictor(road_with(true), o)
+                           : MakeConstantVelocityPredictor(road_with(true), o);
+    pred->Observe(rows, 0, 0.0);
+    ASSERT_EQ(pred->cars().size(), 3u);
+    EXPECT_NEAR(pred->Predict(0, 1.0).d, 5.25, 1e-6);       // not yet
+    EXPECT_NEAR(pred->Predict(0, 1.76 + 1.5).d, 3.5, 0.01);  // half way over
+    EXPECT_NEAR(pred->Predict(0, 1.76 + 1.5).v_d, -3.5 / 3.0, 1e-6);
+    EXPECT_NEAR(pred->Predict(0, 4.8).d, 1.75, 1e-6);  // in the lane that goes on
+    EXPECT_NEAR(pred->Predict(0, 4.8).s, 148, 0.01);    // at its speed all along
+    EXPECT_NEAR(pred->Predict(1, 6.0).d, 5.25, 1e-6);   // the end is past the horizon
+    EXPECT_NEAR(pred->Predict(2, 4.8).d, 1.75, 1e-6);   // the lane that goes on
+  }
+  auto no_drop = MakeConstantVelocityPredictor(road_with(false), o);
+  no_drop->Observe(rows, 0, 0.0);
+  EXPECT_NEAR(no_drop->Predict(0, 4.8).d, 5.25, 1e-6);
+  o.merge_time = 0;
+  auto off = MakeConstantVelocityPredictor(road_with(true), o);
+  off->Observe(rows, 0, 0.0);
+  EXPECT_NEAR(off->Predict(0, 4.8).d, 5.25, 1e-6);
 }
 
 // Lane-change ghosts (udacity-sim.md §8.5): a car braking behind a leader, faster than 15 mph,

@@ -28,6 +28,11 @@ struct LaneProfile {
   // closed end, past which the stations run on for the planner's horizons only); +inf: none.
   // A lane's own end before the road's end (a lane drop) is a wall anyway.
   double wall = std::numeric_limits<double>::infinity();
+  // The lane's end, where it comes before the road's, is a lane drop: its traffic has to move
+  // into a lane beside before it (a lanelet ending with no successor, a zipper's half leading
+  // into the other), not a lane that leaves the road there (an exit's lanes, seen from its
+  // ramp). Traffic predictions use it.
+  bool drops = false;
 };
 
 class Road {
@@ -71,6 +76,7 @@ class Road {
   double SpeedLimit(int lane) const;  // m/s, +inf when none
   double Wall(int lane) const;        // LaneProfile::wall (NaN outside the lanes)
   bool Oncoming(int lane) const;      // LaneProfile::oncoming (false outside the lanes)
+  bool Drops(int lane) const;         // LaneProfile::drops (false outside the lanes)
   // The road's edges at s: the leftmost existing lane's left border and the rightmost's right
   // border (exists false when no lane exists there).
   Span EdgesAt(double s) const;
