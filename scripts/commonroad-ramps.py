@@ -14,7 +14,10 @@ and one of four junctions:
   exitb     a deceleration lane 6 (x 120-220, adjacent right of 4) goes on as the ramp 7; the
             goal is 7, the ego starts in the left lane;
   entry     an acceleration lane 5 (x 0-200, adjacent right of 1) ends at x = 200; the ego starts
-            on it, the goal is lanelet 4.
+            on it, the goal is lanelet 4;
+  entrymain the same road, the ego starts in the right lane, the goal is lanelet 4, and cars on
+            the acceleration lane (with traffic) move into the right lane over the 3 s before
+            its end (an exiD entry seen from the motorway).
 Traffic (seed > 0): cars at 22-30 m/s in both lanes, 30-70 m apart, each at constant speed
 along its lane (none within 12 m of the ego's start in its lane); seed 0: none.
 
@@ -63,6 +66,7 @@ def motorway(succ1=(4,), succ2=(3,), ar1=None, ar4=None, fork=200):
 
 
 OPENS = 0  # the goal window's first step (--opens)
+KINDS = ['exit', 'straight', 'exitleft', 'exitcurve', 'exitb', 'entry', 'entrymain']
 
 
 def goal_lanelet(i):
@@ -112,17 +116,32 @@ def road(kind):
         out.append(lanelet(7, range(220, 421, 10), lambda x: off(x) - W, lambda x: off(x) - 2 * W,
                            pred=(6,)))
         return out, goal_lanelet(7), W / 2
-    if kind == 'entry':
+    if kind in ('entry', 'entrymain'):
         x0 = range(0, 201, 10)
         return ([lanelet(5, x0, lambda x: -W, lambda x: -2 * W, al=1)] + motorway(ar1=5),
-                goal_lanelet(4), -1.5 * W)
+                goal_lanelet(4), -1.5 * W if kind == 'entry' else -W / 2)
     raise ValueError(kind)
 
 
-def state(x, y, v, k):
-    return (f'<position><point><x>{x:.3f}</x><y>{y}</y></point></position><orientation><exact>0'
-            f'</exact></orientation><time><exact>{k}</exact></time><velocity><exact>{v:.3f}'
+def state(x, y, v, k, h=0.0):
+    return (f'<position><point><x>{x:.3f}</x><y>{y:.4f}</y></point></position><orientation><exact>'
+            f'{h:.5f}</exact></orientation><time><exact>{k}</exact></time><velocity><exact>{v:.3f}'
             '</exact></velocity>')
+
+
+def car_xml(i, xs, ys, v):
+    """A car of 4.5 x 1.8 m at the points xs, ys (one per step), at speed v."""
+    def heading(k):
+        k1 = min(k + 1, len(xs) - 1)
+        k0 = k1 - 1
+        return math.atan2(ys[k1] - ys[k0], xs[k1] - xs[k0])
+    trajectory = ''.join(f'<state>{state(xs[k], ys[k], v, k, heading(k))}</state>'
+                         for k in range(1, len(xs)))
+    return (f'<dynamicObstacle id="{i}"><type>car</type><shape><rectangle>'
+            '<length>4.5</length><width>1.8</width></rectangle></shape><initialState>'
+            f'{state(xs[0], ys[0], v, 0, heading(0))}<yawRate><exact>0</exact></yawRate><slipAngle>'
+            f'<exact>0</exact></slipAngle></initialState><trajectory>{trajectory}'
+            '</trajectory></dynamicObstacle>\n')
 
 
 def scenario(kind, speed, seed):
@@ -144,6 +163,18 @@ def scenario(kind, speed, seed):
                         f'<exact>0</exact></slipAngle></initialState><trajectory>{trajectory}'
                         '</trajectory></dynamicObstacle>\n')
                 x += rng.uniform(30, 70)
+        if kind == 'entrymain':
+            # Cars on the acceleration lane, each moving into the right lane over the 3 s before
+            # its end (x = 200), at constant speed.
+            x = rng.uniform(-60, 0)
+            while x < 150:
+                v = rng.uniform(18, 28)
+                xs = [x + v * 0.1 * k for k in range(150)]
+                start = 200 - 3 * v - 2.25
+                ys = [-1.5 * W + W * min(max((px - start) / (3 * v), 0.0), 1.0) for px in xs]
+                if abs(x - 20) > 12:
+                    cars.append(car_xml(100 + len(cars), xs, ys, v))
+                x += rng.uniform(30, 70)
     problem = (f'<planningProblem id="1"><initialState>{state(20, y0, speed, 0)}<yawRate><exact>0'
                '</exact></yawRate><slipAngle><exact>0</exact></slipAngle></initialState>'
                f'{goal}</planningProblem>')
@@ -163,11 +194,14 @@ def main():
     ap.add_argument('--opens', type=int, default=0,
                     help="the goal window's first step (0.1 s steps; default: 0). A window that "
                          "opens late makes the ego wait in a goal at the map's end")
+    ap.add_argument('--kinds', nargs='+', default=KINDS[:-1], choices=KINDS,
+                    help='the junctions to write (default: all but entrymain, the set of '
+                         'docs/commonroad.md)')
     args = ap.parse_args()
     global OPENS
     OPENS = args.opens
     os.makedirs(args.out_dir, exist_ok=True)
-    for kind in ('exit', 'straight', 'exitleft', 'exitcurve', 'exitb', 'entry'):
+    for kind in args.kinds:
         for speed in args.speeds:
             for seed in args.seeds:
                 path = os.path.join(args.out_dir, f'{kind}_v{int(speed)}_{seed}.xml')
