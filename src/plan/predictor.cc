@@ -521,10 +521,11 @@ class TrafficPredictor : public Predictor {
       }
     }
     if (std::isnan(target)) return;
-    const double move = std::max(std::min(options_.merge_time, t_end), 0.1);
+    // A car at the end already (or nearly) still takes kMinMergeTime to move over, not a jump.
+    const double move = std::max(std::min(options_.merge_time, t_end), kMinMergeTime);
     car.d_target = target;
     car.v_d = (target - car.d) / move;
-    car.lat_delay = t_end - std::min(options_.merge_time, t_end);
+    car.lat_delay = std::max(t_end - options_.merge_time, 0.0);
   }
 
   // The centre of the next lane in the direction of a lateral move faster than the threshold,
@@ -554,6 +555,7 @@ class TrafficPredictor : public Predictor {
   double road_end_ = 0;  // the farthest lane end (a lane ending before it is a lane drop)
   // m: a lane ending this close to the road's end ends with it; a neighbour must go on this far.
   static constexpr double kMergeSlack = 5.0;
+  static constexpr double kMinMergeTime = 1.0;  // s: the quickest move over predicted
   PredictorOptions options_;
   bool manoeuvres_;
   std::vector<TrackedCar> cars_;

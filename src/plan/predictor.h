@@ -72,7 +72,8 @@ struct PredictorOptions {
   // already) whose lane ends before the road does (a lane drop, a zipper merge, an on-ramp's
   // acceleration lane) and that reaches the end within future_horizon at its speed moves into
   // the neighbouring lane that goes on, over the last merge_time s before the end (all of the
-  // time left when less), its move ending at that lane's centre there. 0: none (the car is
+  // time left when less, but at least 1 s: a car at the end moves over, it does not jump), its
+  // move ending at that lane's centre. 0: none (the car is
   // predicted on along its lane's d, through the end).
   double merge_time = 0;  // s
 };

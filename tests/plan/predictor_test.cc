@@ -111,13 +111,14 @@ TEST(PredictorTest, ACarWhoseLaneDropsMergesBeforeTheEnd) {
   // the end (s 150) after (50 - 2.4) / 10 = 4.76 s. Car 2 there at 5 m/s: after 29.5 s.
   const std::vector<SensorCar> rows = {{1, 100, -5.25, 10, 0, 0, 0, 4.8, 1.8},
                                        {2, 20, -5.25, 5, 0, 0, 0, 4.8, 1.8},
-                                       {3, 120, -1.75, 10, 0, 0, 0, 4.8, 1.8}};
+                                       {3, 120, -1.75, 10, 0, 0, 0, 4.8, 1.8},
+                                       {4, 149, -5.25, 10, 0, 0, 0, 4.8, 1.8}};
   for (const bool manoeuvres : {false, true}) {
     SCOPED_TRACE(manoeuvres ? "manoeuvres" : "constant velocity");
     auto pred = manoeuvres ? MakeManoeuvrePredictor(road_with(true), o)
                            : MakeConstantVelocityPredictor(road_with(true), o);
     pred->Observe(rows, 0, 0.0);
-    ASSERT_EQ(pred->cars().size(), 3u);
+    ASSERT_EQ(pred->cars().size(), 4u);
     EXPECT_NEAR(pred->Predict(0, 1.0).d, 5.25, 1e-6);       // not yet
     EXPECT_NEAR(pred->Predict(0, 1.76 + 1.5).d, 3.5, 0.01);  // half way over
     EXPECT_NEAR(pred->Predict(0, 1.76 + 1.5).v_d, -3.5 / 3.0, 1e-6);
@@ -125,6 +126,9 @@ TEST(PredictorTest, ACarWhoseLaneDropsMergesBeforeTheEnd) {
     EXPECT_NEAR(pred->Predict(0, 4.8).s, 148, 0.01);    // at its speed all along
     EXPECT_NEAR(pred->Predict(1, 6.0).d, 5.25, 1e-6);   // the end is past the horizon
     EXPECT_NEAR(pred->Predict(2, 4.8).d, 1.75, 1e-6);   // the lane that goes on
+    // A car at the end already moves over in 1 s, not at once.
+    EXPECT_NEAR(pred->Predict(3, 0.5).d, 3.5, 1e-6);
+    EXPECT_NEAR(pred->Predict(3, 1.0).d, 1.75, 1e-6);
   }
   auto no_drop = MakeConstantVelocityPredictor(road_with(false), o);
   no_drop->Observe(rows, 0, 0.0);
