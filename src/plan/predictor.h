@@ -25,7 +25,7 @@ struct TrackedCar {
   int id = 0;
   double s = 0, d = 0, v_s = 0;
   double a_s = 0;        // m/s^2 along the lane, from the previous reading (0 when unknown)
-  double v_d = 0;        // m/s across the lane, right positive
+  double v_d = 0;        // m/s across the lane, right positive (a predicted merge's, if any)
   double d_target = 0;   // m: where a lateral move is predicted to end (= d when none)
   bool ghost = false;    // a lane change the car may start (PredictorOptions::lane_change_ghosts)
   double lat_delay = 0;  // s before a predicted lateral move starts
