@@ -154,14 +154,8 @@ def scenario(kind, speed, seed):
             while x < 250:
                 v = rng.uniform(22, 30)
                 if abs(x - 20) > 12 or abs(lane_y - y0) > 1:
-                    trajectory = ''.join(f'<state>{state(x + v * 0.1 * k, lane_y, v, k)}</state>'
-                                         for k in range(1, 150))
-                    cars.append(
-                        f'<dynamicObstacle id="{100 + len(cars)}"><type>car</type><shape><rectangle>'
-                        '<length>4.5</length><width>1.8</width></rectangle></shape><initialState>'
-                        f'{state(x, lane_y, v, 0)}<yawRate><exact>0</exact></yawRate><slipAngle>'
-                        f'<exact>0</exact></slipAngle></initialState><trajectory>{trajectory}'
-                        '</trajectory></dynamicObstacle>\n')
+                    cars.append(car_xml(100 + len(cars), [x + v * 0.1 * k for k in range(150)],
+                                        [lane_y] * 150, v))
                 x += rng.uniform(30, 70)
         if kind == 'entrymain':
             # Cars on the acceleration lane, each moving into the right lane over the 3 s before

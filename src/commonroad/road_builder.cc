@@ -454,6 +454,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
   for (const GoalState& g : problem.goals) time_only = time_only && !g.HasPosition();
   for (map::LaneProfile& l : lanes) {
     if (l.s.back() > last - kMapEndSlack) {
+      l.drops = false;  // the map's end, not a lane's
       if (time_only) l.wall = l.s.back();
       l.s.push_back(l.s.back() + kMapRunOn);
       l.left.push_back(l.left.back());

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <utility>
 
@@ -162,8 +161,7 @@ class TrafficPredictor : public Predictor {
     ghost_seen_.reserve(options_.max_cars);
     ghost_seen_next_.reserve(options_.max_cars);
     memory_.reserve(options_.max_cars);
-    road_end_ = -std::numeric_limits<double>::infinity();
-    for (int l = 0; l < road_->num_lanes(); ++l) road_end_ = std::max(road_end_, road_->LaneEnd(l));
+    if (!road_->uniform() && options_.merge_time > 0) FindMerges();
     const std::size_t n = static_cast<std::size_t>(options_.max_cars) * kMaxFutureSamples;
     for (auto* v : {&fut_s_, &fut_d_, &fut_v_, &fut_vd_}) v->assign(n, 0.0);
     fut_n_.assign(options_.max_cars, 0);
@@ -498,27 +496,40 @@ class TrafficPredictor : public Predictor {
     return p;
   }
 
-  // PredictorOptions::merge_time: a car at line coordinate s whose lane ends ahead, before the
-  // road does, moves into the neighbouring lane that goes on (the nearer one when both do):
-  // car.d_target, v_d and lat_delay set for Predict's lateral move.
+  // Per lane, once: where a lane drop (map::Road::Drops) ends, and the centres there of its
+  // neighbours that go on past the end (NaN: none). The road does not change.
+  struct Merge {
+    double end = NAN;
+    double to[2] = {NAN, NAN};  // the left and the right neighbour's centre
+  };
+  void FindMerges() {
+    merges_.assign(road_->num_lanes(), Merge{});
+    for (int l = 0; l < road_->num_lanes(); ++l) {
+      if (!road_->Drops(l)) continue;
+      Merge& m = merges_[l];
+      m.end = road_->LaneEnd(l);
+      for (int side = 0; side < 2; ++side) {
+        const int n = side == 0 ? l - 1 : l + 1;
+        const map::Road::Span span = road_->LaneAt(n, m.end - kMergeSlack);
+        if (span.exists && road_->LaneEnd(n) > m.end + kMergeSlack) m.to[side] = span.centre();
+      }
+    }
+  }
+
+  // PredictorOptions::merge_time: a car at line coordinate s whose lane drops ahead moves into
+  // the neighbouring lane that goes on (the nearer one when both do): car.d_target, v_d and
+  // lat_delay set for Predict's lateral move.
   void PredictMerge(double s, TrackedCar& car) const {
-    if (road_->uniform() || !(options_.merge_time > 0) || !(car.v_s > 0.5)) return;
+    if (merges_.empty() || !(car.v_s > 0.5)) return;
     const int lane = road_->LaneOf(s, car.d);
     if (lane < 0) return;
-    const double end = road_->LaneEnd(lane);
-    // A lane drop, not a lane that leaves the road, nor the road's own end.
-    if (!road_->Drops(lane) || !(end < road_end_ - kMergeSlack)) return;
-    const double t_end = std::max(end - s - 0.5 * car.length, 0.0) / car.v_s;
+    const Merge& m = merges_[lane];
+    if (std::isnan(m.end)) return;
+    const double t_end = std::max(m.end - s - 0.5 * car.length, 0.0) / car.v_s;
     if (!(t_end <= options_.future_horizon)) return;
-    // The neighbour that exists where the lane ends and goes on past it.
-    const double at = end - kMergeSlack;
-    double target = NAN;
-    for (const int n : {lane - 1, lane + 1}) {
-      const map::Road::Span span = road_->LaneAt(n, at);
-      if (!span.exists || !(road_->LaneEnd(n) > end + kMergeSlack)) continue;
-      if (std::isnan(target) || std::abs(span.centre() - car.d) < std::abs(target - car.d)) {
-        target = span.centre();
-      }
+    double target = m.to[0];
+    if (std::isnan(target) || std::abs(m.to[1] - car.d) < std::abs(target - car.d)) {
+      target = m.to[1];
     }
     if (std::isnan(target)) return;
     // A car at the end already (or nearly) still takes kMinMergeTime to move over, not a jump.
@@ -552,9 +563,10 @@ class TrafficPredictor : public Predictor {
 
   std::shared_ptr<const map::Road> road_;
   std::shared_ptr<const map::ReferenceLine> line_;
-  double road_end_ = 0;  // the farthest lane end (a lane ending before it is a lane drop)
-  // m: a lane ending this close to the road's end ends with it; a neighbour must go on this far.
+  // m: a merge's neighbour must go on this far past the drop's end (and is read this far
+  // before it).
   static constexpr double kMergeSlack = 5.0;
+  std::vector<Merge> merges_;  // per lane (empty: no merges predicted)
   static constexpr double kMinMergeTime = 1.0;  // s: the quickest move over predicted
   PredictorOptions options_;
   bool manoeuvres_;

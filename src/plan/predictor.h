@@ -69,12 +69,12 @@ struct PredictorOptions {
   bool lane_change_ghosts = false;
   double ghost_lateral_speed = 1.6;  // m/s across, about a lane in 2.5 s
   // Both predictors, on a road that is not uniform: a car (not recorded, not moving across
-  // already) whose lane ends before the road does (a lane drop, a zipper merge, an on-ramp's
+  // already) whose lane drops (map::Road::Drops: a lane drop, a zipper merge, an on-ramp's
   // acceleration lane) and that reaches the end within future_horizon at its speed moves into
   // the neighbouring lane that goes on, over the last merge_time s before the end (all of the
   // time left when less, but at least 1 s: a car at the end moves over, it does not jump), its
-  // move ending at that lane's centre. 0: none (the car is
-  // predicted on along its lane's d, through the end).
+  // move ending at that lane's centre. 0: none (the car is predicted on along its lane's d,
+  // through the end).
   double merge_time = 0;  // s
 };
 

@@ -117,8 +117,10 @@ TEST(RoadBuilderTest, ALaneDropKeepsTheReferenceOnTheLaneThatGoesOn) {
   EXPECT_NEAR(b.road->LaneEnd(0), 600, 1.0);
   EXPECT_GT(b.road->LaneEnd(0), 290);
   EXPECT_NEAR(b.map_end, 300, 1.0);  // where the run-on starts
-  // Its traffic has to move over before the end (the predictions' merge).
+  // Its traffic has to move over before the end (the predictions' merge); the left lane's
+  // end is the map's, no drop.
   EXPECT_TRUE(b.road->Drops(1));
+  EXPECT_FALSE(b.road->Drops(0));
   // The left lane's centre is y = 1.75 in XY everywhere (the line itself).
   for (double s : {20.0, 120.0, 160.0, 250.0}) {
     const map::Road::Span a = b.road->LaneAt(0, s);

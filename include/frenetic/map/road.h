@@ -28,10 +28,10 @@ struct LaneProfile {
   // closed end, past which the stations run on for the planner's horizons only); +inf: none.
   // A lane's own end before the road's end (a lane drop) is a wall anyway.
   double wall = std::numeric_limits<double>::infinity();
-  // The lane's end, where it comes before the road's, is a lane drop: its traffic has to move
-  // into a lane beside before it (a lanelet ending with no successor, a zipper's half leading
-  // into the other), not a lane that leaves the road there (an exit's lanes, seen from its
-  // ramp). Traffic predictions use it.
+  // The lane's end is a lane drop: its traffic has to move into a lane beside before it (a
+  // lanelet ending with no successor before the map's end, a zipper's half leading into the
+  // other), not a lane that leaves the road there (an exit's lanes, seen from its ramp), nor
+  // the map's end. Traffic predictions use it.
   bool drops = false;
 };
 
