@@ -121,6 +121,20 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
       kmin = std::min(kmin, k);
     }
   }
+  {
+    // The speed prefilter's share: on a path at offset d the XY speed is at least
+    // s' (1 - kappa d) (its part along the line), so at least s' (1 - K |d|max) with K the
+    // largest |kappa| read above (a quarter more and 1e-3 1/m for the curvature between the
+    // 2 m reads) and |d|max the farthest a candidate may go across (the road's outer lane
+    // borders or the start, and 1 m of overshoot). None on a road that bends so tightly that
+    // the share would be under a half.
+    const double k = 1.25 * std::max(kmax, -kmin) + 1e-3;
+    const double d = std::max({std::abs(ws.road_left), std::abs(ws.road_right),
+                               Finite(start.d) ? std::abs(start.d) : 1e9}) + 1.0;
+    const double share = 1.0 - k * d;
+    ws.speed_share = Finite(share) && share >= 0.5 ? share : 0.0;
+    ws.speed_reach = reach;
+  }
   if (cfg.check.curve_prefilter) {
     // Each bin's largest |kappa|, from its two ends and its middle (the line's curvature
     // changes over tens of metres).

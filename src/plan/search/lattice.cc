@@ -66,7 +66,26 @@ void Lattice::AddLon(const LonTraj& l) {
   l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
                 &ws_.lon_sdd[i * n]);
   ws_.lon_near_have[i] = 0;  // its masks: when first needed (Scorer::InputFor)
-  if (cfg_.check.curve_prefilter && TooFastForTheCurve(i)) ws_.lon.pop_back();
+  if (cfg_.check.curve_prefilter && TooFastForTheCurve(i)) {
+    ws_.lon.pop_back();
+    return;
+  }
+  ws_.lon.back().too_fast = TooFastForTheVehicle(i);
+}
+
+bool Lattice::TooFastForTheVehicle(int i) const {
+  if (!(ws_.speed_share > 0)) return false;
+  // A sample's s' and the XY speed of the tick ending there (the mean over its 0.02 s) differ
+  // by the tick's acceleration times 0.01 s or so: the slack (1.1 m/s at the Udacity track's
+  // top speed, 2.5 m/s at a KS vehicle's) covers 100 m/s^2 and more.
+  const double limit = (1 + kSpeedSlack) * cfg_.limits.max_speed;
+  const int n = ws_.n_samples;
+  for (int k = 1; k < n && k * cfg_.score.dt <= cfg_.check.horizon + 1e-9; ++k) {
+    // Past the stretch whose curvature was read, the share says nothing.
+    if (!(ws_.lon_s[i * n + k] - ws_.start.s <= ws_.speed_reach)) return false;
+    if (ws_.lon_sd[i * n + k] * ws_.speed_share > limit) return true;
+  }
+  return false;
 }
 
 bool Lattice::TooFastForTheCurve(int i) const {
@@ -589,7 +608,7 @@ void Lattice::Generate() {
   for (int i = 0; i < static_cast<int>(ws_.lon.size()); ++i) {
     for (int j = 0; j < static_cast<int>(ws_.lat.size()); ++j) {
       if (ws_.lon[i].lane >= 0 && ws_.lon[i].lane != ws_.lat[j].lane) continue;
-      if (ws_.lat[j].swerve() && !ws_.SwerveEndsInside(i, j)) continue;
+      if (ws_.lat[j].swerve() ? !ws_.SwerveEndsInside(i, j) : ws_.lon[i].too_fast) continue;
       ws_.cand_lon.push_back(i);
       ws_.cand_lat.push_back(j);
     }

@@ -24,6 +24,9 @@ struct LonTraj {
   double param = 0;
   int lead = -1;  // following: the leader's index in the predictor's cars of this cycle
   double jerk2 = 0;
+  // Faster along s than the vehicle's top speed allows within the check horizon (Lattice::
+  // TooFastForTheVehicle): paired with no lane move, whose checks reach that far.
+  bool too_fast = false;
 };
 
 // What a lateral move of the bundle is.
@@ -86,6 +89,15 @@ class Lattice {
   // candidate of it (the XY check would reject them all).
   bool TooFastForTheCurve(int i) const;
   static constexpr double kCurveSlack = 0.15;
+  // Whether lon bundle i's s' at a scoring sample within the check horizon, times
+  // Workspace::speed_share, is kSpeedSlack over limits.max_speed: its XY speed is then over the
+  // limit whatever the lateral move, and the XY check rejects every candidate of it whose checks
+  // reach that sample (all but a swerve's, which end at its goal region). Following or merging
+  // behind a car of recorded traffic faster than the ego can drive (highD's move at twice their
+  // stated speed) made a fifth of a highD box-in's candidates such ones, and four fifths of its
+  // XY limit checks.
+  bool TooFastForTheVehicle(int i) const;
+  static constexpr double kSpeedSlack = 0.05;
 
   const Settings& cfg_;
   const Predictor& predictor_;

@@ -110,6 +110,10 @@ struct Workspace {
   // (Settings::curve_prefilter; filled only with it).
   double kappa_s0 = 0;
   std::vector<double> abs_kappa;
+  // The lattice's speed prefilter (Lattice::TooFastForTheVehicle): the share of s' that is at
+  // least the XY speed anywhere within the road up to speed_reach m along s from the start (0:
+  // none is known), from the line's largest |kappa| there.
+  double speed_share = 0, speed_reach = 0;
   double max_abs_d = 0;
   cost::CostContext ctx;
   // The goals of this cycle (Telemetry::goals), times relative to the start state.

@@ -96,6 +96,44 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
   EXPECT_GT(near_limit, 0) << "the bound kept some within its slack";
 }
 
+TEST(SearchLatticeTest, NoLaneMovePairsWithATrajectoryFasterThanTheVehicle) {
+  REQUIRE_UDACITY_MAP();
+  // Following a leader at 29 m/s (the top speed is 22.1 m/s): those longitudinal trajectories
+  // end faster than the vehicle drives. They are marked, no lane move pairs with them, and the
+  // XY check would have rejected every such pair; the others keep their pairs.
+  Stages st(GridOnly());
+  PrepareCentred(st, 20, 0, {{kS + 30, 6.0, 29.0}});
+  ASSERT_GT(st.ws.speed_share, 0.5);
+  ASSERT_LT(st.ws.speed_share, 1.0) << "the bend's curvature and the road's width count";
+  st.lattice.Generate();
+  const Workspace& ws = st.ws;
+  std::vector<int> pairs(ws.lon.size(), 0);
+  for (size_t c = 0; c < ws.cand_lon.size(); ++c) ++pairs[ws.cand_lon[c]];
+  int too_fast = 0;
+  for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
+    const LonTraj& l = ws.lon[i];
+    if (!l.too_fast) {
+      EXPECT_GT(pairs[i], 0) << "lon " << i;
+      continue;
+    }
+    ++too_fast;
+    EXPECT_EQ(pairs[i], 0) << "lon " << i;
+    EXPECT_EQ(l.kind, cost::LonKind::kFollowing) << "lon " << i;
+    for (int j = 0; j < static_cast<int>(ws.lat.size()); ++j) {
+      if (l.lane >= 0 && l.lane != ws.lat[j].lane) continue;
+      st.ws.FillTicksForLimits({l.traj, ws.lat[j].traj});
+      Reject why = Reject::kCount;
+      EXPECT_GT(st.limits.Violation(&why, true), 0) << "lon " << i << " lat " << j;
+    }
+  }
+  EXPECT_GT(too_fast, 0);
+  // A leader at the ego's pace: none is.
+  Stages slow(GridOnly());
+  PrepareCentred(slow, 20, 0, {{kS + 30, 6.0, 20.0}});
+  slow.lattice.Generate();
+  for (const LonTraj& l : slow.ws.lon) EXPECT_FALSE(l.too_fast);
+}
+
 TEST(SearchLatticeTest, FreeRoadCentredInTheMiddleLane) {
   REQUIRE_UDACITY_MAP();
   Stages st(GridOnly());
@@ -202,8 +240,14 @@ TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
     ++following_pairs;
     EXPECT_EQ(ws.lat[ws.cand_lat[i]].lane, 1) << "following is bound to the leader's lane";
   }
-  // Only the own lane's single move pairs with them.
-  EXPECT_EQ(following_pairs, c.grid.durations * c.grid.follow_gaps);
+  // Only the own lane's single move pairs with them, but for those faster than the vehicle
+  // drives on the way (the shortest close 40 m less the gap in a second or two, from 20 m/s:
+  // they overshoot the top speed).
+  int too_fast = 0;
+  for (const LonTraj& l : ws.lon) too_fast += l.kind == cost::LonKind::kFollowing && l.too_fast;
+  EXPECT_GT(too_fast, 0);
+  EXPECT_LT(too_fast, c.grid.follow_gaps * c.grid.durations / 2);
+  EXPECT_EQ(following_pairs, c.grid.durations * c.grid.follow_gaps - too_fast);
   // (No constant-acceleration run: the leader is within 100 m.)
   EXPECT_EQ(ws.cand_lon.size(), 87u * ws.lat.size() + following_pairs);
   for (const LonTraj& l : ws.lon) {
