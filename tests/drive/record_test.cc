@@ -71,7 +71,9 @@ std::string Record(const std::shared_ptr<const World>& world, const std::string&
   }
   auto scenario = LoadScenario("dense");
   EXPECT_TRUE(scenario.ok()) << scenario.message();
-  auto report = RunEpisode(world, *scenario, 4, EpisodeLimits{0, 0, 12, 60}, *planner, options);
+  // Seed 5: dense traffic whose candidates run into cars in most exchanges (the rejection
+  // traces below need some).
+  auto report = RunEpisode(world, *scenario, 5, EpisodeLimits{0, 0, 12, 60}, *planner, options);
   EXPECT_TRUE(report.ok()) << report.message();
   EXPECT_TRUE((*writer)->status().ok());
   writer->reset();
@@ -137,9 +139,7 @@ TEST(Record, AReplicaTracesTheCandidatesThePlannerWouldHave) {
   for (const auto& row : Lines(replayed)) {
     if (row["type"] != "exchange") continue;
     with_candidates += !row["plan"]["candidates"].empty();
-    int rejected = 0;
-    for (const auto& [why, count] : row["plan"]["rejections"].items()) rejected += count.get<int>();
-    with_rejections += rejected > 0;
+    with_rejections += row["plan"]["rejections"]["collision"].get<int>() > 0;
   }
   EXPECT_GT(with_candidates, 10);
   EXPECT_GT(with_rejections, 0);

@@ -125,12 +125,24 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     // The speed prefilter's share: on a path at offset d the XY speed is at least
     // s' (1 - kappa d) (its part along the line), so at least s' (1 - K |d|max) with K the
     // largest |kappa| read above (a quarter more and 1e-3 1/m for the curvature between the
-    // 2 m reads) and |d|max the farthest a candidate may go across (the road's outer lane
-    // borders or the start, and 1 m of overshoot). None on a road that bends so tightly that
-    // the share would be under a half.
+    // 2 m reads) and |d|max the farthest across that a candidate passing the limit checks may
+    // be: past what its off-road check accepts (on a uniform road limits.d_min / d_max, on
+    // another the edge table's widest edges anywhere ahead: a lane that widens, an oncoming lane
+    // passed on) by the chords' reading of d (within 1.5 m), or the start's d, or the road's
+    // outer lane borders at the start. None on a road that bends so tightly that the share
+    // would be under a half.
     const double k = 1.25 * std::max(kmax, -kmin) + 1e-3;
-    const double d = std::max({std::abs(ws.road_left), std::abs(ws.road_right),
-                               Finite(start.d) ? std::abs(start.d) : 1e9}) + 1.0;
+    double d = std::max({std::abs(ws.road_left), std::abs(ws.road_right),
+                         Finite(start.d) ? std::abs(start.d) : 1e9});
+    if (cfg.road.uniform) {
+      d = std::max({d, std::abs(cfg.limits.d_min), std::abs(cfg.limits.d_max)});
+    } else {
+      for (std::size_t b = 0; b < ws.edge_lo.size(); ++b) {
+        if (Finite(ws.edge_lo[b])) d = std::max(d, std::abs(ws.edge_lo[b]));
+        if (Finite(ws.edge_hi[b])) d = std::max(d, std::abs(ws.edge_hi[b]));
+      }
+    }
+    d += 1.5;
     const double share = 1.0 - k * d;
     ws.speed_share = Finite(share) && share >= 0.5 ? share : 0.0;
     ws.speed_reach = reach;

@@ -124,6 +124,15 @@ TEST(SearchLatticeTest, NoLaneMovePairsWithATrajectoryFasterThanTheVehicle) {
       st.ws.FillTicksForLimits({l.traj, ws.lat[j].traj});
       Reject why = Reject::kCount;
       EXPECT_GT(st.limits.Violation(&why, true), 0) << "lon " << i << " lat " << j;
+      // Over the speed limit itself, in XY (ticks 0.02 s apart), not only another limit.
+      double top = 0;
+      map::CartesianPose prev = st.line->ToCartesian(ws.tk_s[1], ws.tk_d[1]);
+      for (int t = 2; t <= ws.n_ticks; ++t) {
+        const map::CartesianPose p = st.line->ToCartesian(ws.tk_s[t], ws.tk_d[t]);
+        top = std::max(top, std::hypot(p.x - prev.x, p.y - prev.y) / kTickSeconds);
+        prev = p;
+      }
+      EXPECT_GT(top, st.cfg.limits.max_speed) << "lon " << i << " lat " << j;
     }
   }
   EXPECT_GT(too_fast, 0);
@@ -244,10 +253,20 @@ TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
   // drives on the way (the shortest close 40 m less the gap in a second or two, from 20 m/s:
   // they overshoot the top speed).
   int too_fast = 0;
-  for (const LonTraj& l : ws.lon) too_fast += l.kind == cost::LonKind::kFollowing && l.too_fast;
+  for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
+    const LonTraj& l = ws.lon[i];
+    if (l.kind != cost::LonKind::kFollowing || !l.too_fast) continue;
+    ++too_fast;
+    // Faster than the top speed along s within the check horizon (the share is at most 1).
+    double top = 0;
+    for (int k = 1; k < ws.n_samples && k * c.score.dt <= c.check.horizon + 1e-9; ++k) {
+      top = std::max(top, ws.lon_sd[i * ws.n_samples + k]);
+    }
+    EXPECT_GT(top, c.limits.max_speed) << "lon " << i << " T " << l.traj.duration;
+  }
   EXPECT_GT(too_fast, 0);
   EXPECT_LT(too_fast, c.grid.follow_gaps * c.grid.durations / 2);
-  EXPECT_EQ(following_pairs, c.grid.durations * c.grid.follow_gaps - too_fast);
+  EXPECT_EQ(following_pairs + too_fast, c.grid.durations * c.grid.follow_gaps);
   // (No constant-acceleration run: the leader is within 100 m.)
   EXPECT_EQ(ws.cand_lon.size(), 87u * ws.lat.size() + following_pairs);
   for (const LonTraj& l : ws.lon) {
