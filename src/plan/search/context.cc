@@ -65,11 +65,14 @@ void RoadLanes(const Settings& cfg, const map::Road& road, Workspace& ws) {
   ws.edge_s0 = s0 - Workspace::kEdgeBehind;
   const int bins = static_cast<int>(ws.edge_lo.size());
   map::Road::Span prev = road.EdgesAt(ws.edge_s0);
+  ws.edge_widest = 0;
   for (int b = 0; b < bins; ++b) {
     const map::Road::Span next = road.EdgesAt(ws.edge_s0 + (b + 1) * Workspace::kEdgeBin);
     const bool both = prev.exists && next.exists;
     ws.edge_lo[b] = both ? std::max(prev.left, next.left) : NAN;
     ws.edge_hi[b] = both ? std::min(prev.right, next.right) : NAN;
+    if (Finite(ws.edge_lo[b])) ws.edge_widest = std::max(ws.edge_widest, std::abs(ws.edge_lo[b]));
+    if (Finite(ws.edge_hi[b])) ws.edge_widest = std::max(ws.edge_widest, std::abs(ws.edge_hi[b]));
     prev = next;
   }
 }
@@ -134,14 +137,8 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     const double k = 1.25 * std::max(kmax, -kmin) + 1e-3;
     double d = std::max({std::abs(ws.road_left), std::abs(ws.road_right),
                          Finite(start.d) ? std::abs(start.d) : 1e9});
-    if (cfg.road.uniform) {
-      d = std::max({d, std::abs(cfg.limits.d_min), std::abs(cfg.limits.d_max)});
-    } else {
-      for (std::size_t b = 0; b < ws.edge_lo.size(); ++b) {
-        if (Finite(ws.edge_lo[b])) d = std::max(d, std::abs(ws.edge_lo[b]));
-        if (Finite(ws.edge_hi[b])) d = std::max(d, std::abs(ws.edge_hi[b]));
-      }
-    }
+    d = cfg.road.uniform ? std::max({d, std::abs(cfg.limits.d_min), std::abs(cfg.limits.d_max)})
+                         : std::max(d, ws.edge_widest);
     d += 1.5;
     const double share = 1.0 - k * d;
     ws.speed_share = Finite(share) && share >= 0.5 ? share : 0.0;

@@ -105,6 +105,7 @@ struct Workspace {
   static constexpr double kEdgeBin = 2.0, kEdgeBehind = 10.0, kEdgeAhead = 20.0;  // m
   double edge_s0 = 0;
   std::vector<double> edge_lo, edge_hi;
+  double edge_widest = 0;  // m: the largest |edge| of the table where a lane exists
   // The line's largest |kappa| (1/m) over each kEdgeBin m from kappa_s0 (the edges' reach),
   // and the largest |d| of a lane border at the start (m): the lattice's curve prefilter
   // (Settings::curve_prefilter; filled only with it).
