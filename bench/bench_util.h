@@ -57,6 +57,10 @@ struct Scene {
   // vehicle.
   std::vector<commonroad::KsState> ego;
   std::vector<std::vector<double>> path_x, path_y;
+  // CommonRoad scenes, per message: whether the planner's least-harm choice was on
+  // (commonroad::CycleInput::least_harm; the replay sets it), and whether no candidate passed
+  // (status fallback_used: with a way held, the rescue drove it, Rescue::Continue).
+  std::vector<char> least_harm, fallback;
   double dt = 0;
   commonroad::VehicleParams vehicle;
 };
@@ -222,11 +226,14 @@ class Replay {
 
   // Prepares the next measured message (not part of the measurement: may do the cold cycle).
   void Prepare() {
+    const bool commonroad = next_ < static_cast<int>(scene_->least_harm.size());
+    if (commonroad) planner_->set_least_harm(scene_->least_harm[next_] != 0);
     if (next_ == 0) {
       planner_->Reset();
       Remember(planner_->Plan(scene_->messages[0]));
       next_ = 1;
     }
+    if (commonroad) planner_->set_least_harm(scene_->least_harm[next_] != 0);
     const plan::Telemetry& rec = scene_->messages[next_];
     const std::size_t n_prev = rec.previous_path_x.size();
     const std::size_t consumed =

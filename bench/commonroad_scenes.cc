@@ -53,11 +53,13 @@ StatusOr<Scene> Capture(const std::string& path) {
     scene.t.push_back(in.step * scenario->dt);
     scene.messages.push_back(in.telemetry);
     scene.ego.push_back(in.ego);
+    scene.least_harm.push_back(in.least_harm ? 1 : 0);
   };
   options.on_plan = [&](const commonroad::CycleInput& in, const plan::PlanResult& result) {
     if (in.problem.id != problem) return;
     scene.path_x.push_back(result.x);
     scene.path_y.push_back(result.y);
+    scene.fallback.push_back(result.status == plan::PlanStatus::kFallbackUsed ? 1 : 0);
   };
   scene.dt = scenario->dt;
   scene.vehicle = *vehicle;

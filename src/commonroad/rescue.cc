@@ -101,6 +101,11 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
 RescueStep Rescue::Step(const plan::Telemetry& t, const std::vector<double>& x,
                         const std::vector<double>& y, const KsState& ego) {
   Predict(t);
+  return Check(t, x, y, ego);
+}
+
+RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
+                         const std::vector<double>& y, const KsState& ego) {
   RescueStep r;
   const PathCheck path = Walk(x, y, t.goals);
   r.hit = path.hit;
@@ -273,13 +278,30 @@ int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
   return Walk(x, y, goals).hit;
 }
 
-int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals) {
+bool Rescue::Holds(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
+  const int rest = static_cast<int>(way_.size()) - 1;  // after the step driven since
+  return goal_way_ && rest >= 1 && Lasts(ego, &goals, 1) == rest;
+}
+
+RescueStep Rescue::Continue(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
+  RescueStep r;
+  if (!Holds(ego, goals)) {
+    Drop();
+    return r;
+  }
+  r.why = RescueStep::Why::kNoPath;
+  way_.erase(way_.begin());  // the step driven since
+  r.input = way_.front();
+  return r;
+}
+
+int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals, int from) {
   KsState s = ego;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
-  const int n = std::min(static_cast<int>(way_.size()), options_.steps);
+  const int n = std::min(static_cast<int>(way_.size()) - from, options_.steps);
   map::FrenetPoint at{};
   for (int k = 1; k <= n; ++k) {
-    s = SimulateKs(s, way_[k - 1], dt_, vehicle_, 1);
+    s = SimulateKs(s, way_[from + k - 1], dt_, vehicle_, 1);
     if (!Clear(s, k, s_hint, &at)) return k - 1;
     s_hint = at.s;
   }

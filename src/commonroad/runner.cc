@@ -293,9 +293,22 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       const bool tracing = spdlog::should_log(spdlog::level::trace);
       plan::CycleTrace trace;
       if (tracing) (*planner)->set_trace(&trace, 200);
-      const CycleInput input{problem, k, built->road, problem_config, t, ego};
+      // A way the rescue holds stands in for the planner's least harm (Rescue::Holds): the
+      // planner then skips that choice when no candidate passes. Its time counts.
+      bool way_holds = false;
+      double r_ms = 0;
+      if (rescue) {
+        const auto p0 = std::chrono::steady_clock::now();
+        rescue->Predict(t);
+        way_holds = rescue->Holds(ego, t.goals);
+        r_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0)
+                   .count();
+      }
+      const double holds_ms = r_ms;
+      const CycleInput input{problem, k, built->road, problem_config, t, ego, !way_holds};
       if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
+      (*planner)->set_least_harm(!way_holds);
       const plan::PlanResult& res = (*planner)->Plan(t);
       if (options.on_plan) options.on_plan(input, res);
       if (tracing) {
@@ -321,12 +334,17 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       std::optional<KsInput> rescue_input;
       if (rescue) {
         const auto r0 = std::chrono::steady_clock::now();
-        const RescueStep step = rescue->Step(t, res.x, res.y, ego);
-        const double r_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
-                .count();
+        const RescueStep step = way_holds && res.status == plan::PlanStatus::kFallbackUsed
+                                    ? rescue->Continue(ego, t.goals)
+                                    : rescue->Check(t, res.x, res.y, ego);
+        r_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
+                    .count();
         rescue_input = step.input;
-        if (step.why == RescueStep::Why::kHit) {
+        if (step.why == RescueStep::Why::kNoPath) {
+          spdlog::debug("{} #{} step {}: no candidate passes; the rescue's way stands in "
+                        "({:.3f} ms)",
+                        sc.benchmark_id, problem.id, k, r_ms);
+        } else if (step.why == RescueStep::Why::kHit) {
           spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue "
                         "({:.3f} ms) {}",
                         sc.benchmark_id, problem.id, k, step.hit, r_ms,
@@ -339,6 +357,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         }
       }
       const double ms =
+          holds_ms +
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       RunCycle cyc;
       cyc.step = k;

@@ -3,7 +3,8 @@
 // of it and on the road, the way into a goal region's lane, and no way when the cars of both
 // lanes close in side by side; when a planner's path misses a goal that is closing, a way to it
 // (kept while it still meets it), and no search for a goal out of reach, along the road or
-// across it; a bound of the swerve across the road; a predicted car whose footprint grows.
+// across it; a bound of the swerve across the road; a predicted car whose footprint grows; a
+// way to a goal held and driven on when the planner sends no path that passes.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -418,6 +419,59 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   ASSERT_TRUE(open.Next(ego, {Lane0Goal(1.0, 10.0, 60.5)}).has_value());
   open.Points(ego, &x, &y);
   EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
+}
+
+TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNextInput) {
+  std::vector<cost::GoalRegion> goals = {Lane0Goal(1.5, 2.0)};
+  const KsState ego = Ego(50, kLane1, 20);
+  const std::optional<KsInput> u = rescue_.Next(ego, goals, true);
+  ASSERT_TRUE(u.has_value());
+  std::vector<double> x0, y0;
+  rescue_.Points(ego, &x0, &y0);
+  // A step on, the window a step nearer: the rest of the way still meets the goal.
+  KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  for (cost::GoalRegion& g : goals) {
+    g.t_lo -= kDt;
+    g.t_hi -= kDt;
+  }
+  rescue_.Predict(t_);
+  EXPECT_TRUE(rescue_.Holds(next, goals));
+  const RescueStep step = rescue_.Continue(next, goals);
+  EXPECT_EQ(step.why, RescueStep::Why::kNoPath);
+  ASSERT_TRUE(step.input.has_value());
+  EXPECT_EQ(rescue_.searches(), 1);  // no new search
+  // It is the same way, a step on: its points from the new state are the first ones' rest.
+  std::vector<double> x1, y1;
+  rescue_.Points(next, &x1, &y1);
+  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  ASSERT_EQ(x1.size() + ticks, x0.size());
+  for (std::size_t i = 0; i < x1.size(); ++i) {
+    EXPECT_NEAR(x1[i], x0[i + ticks], 1e-3) << i;  // one step of 0.1 s against 5 ticks
+    EXPECT_NEAR(y1[i], y0[i + ticks], 1e-3) << i;
+  }
+  // A goal whose window now closes before the way gets there: it no longer holds, and Continue
+  // drives nothing and forgets the way.
+  next = SimulateKs(next, *step.input, kDt, VehicleParams());
+  goals = {Lane0Goal(0.1, 0.2, 62)};
+  EXPECT_FALSE(rescue_.Holds(next, goals));
+  const RescueStep none = rescue_.Continue(next, goals);
+  EXPECT_EQ(none.why, RescueStep::Why::kNone);
+  EXPECT_FALSE(none.input.has_value());
+  std::vector<double> x2, y2;
+  rescue_.Points(next, &x2, &y2);
+  EXPECT_TRUE(x2.empty());
+}
+
+TEST_F(RescueOnAnEmptyRoad, AWayThatOnlyLastsDoesNotHold) {
+  // No goal to meet: the way found lasts the horizon, and stands in for a planner's path only
+  // when that path hits something (Check), never for its least harm.
+  const KsState ego = Ego(50, kLane1, 20);
+  const std::optional<KsInput> u = rescue_.Next(ego, {});
+  ASSERT_TRUE(u.has_value());
+  const KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  rescue_.Predict(t_);
+  EXPECT_FALSE(rescue_.Holds(next, {}));
+  EXPECT_FALSE(rescue_.Continue(next, {}).input.has_value());
 }
 
 }  // namespace

@@ -153,6 +153,38 @@ TEST(SearchPlannerTest, BrakesWithinLimitsForACutIn) {
   EXPECT_LT(m.max_jerk, 10.0);
 }
 
+// Boxed in (a car at walking pace a few metres ahead in every lane): no candidate passes. By
+// default the least harmful feasible candidate is taken (a winner with its lane); with the
+// least-harm choice off (a caller with a way of its own) the cheap fallback path goes out at
+// once, with no winner, still a whole path of finite points.
+TEST(SearchPlannerTest, WithTheLeastHarmOffANoPassCycleSendsTheFallbackPath) {
+  REQUIRE_MAP(line);
+  PlannerConfig config = Config();
+  config.PinDeadlines();
+  for (const bool on : {true, false}) {
+    auto made = MakePlanner("search", config, line);
+    ASSERT_TRUE(made.ok()) << made.message();
+    auto planner = std::move(made.value());
+    planner->set_least_harm(on);
+    Loop loop(line, planner.get(), 1500, 6.0, 20.0, 7);
+    loop.cars.push_back({0, 1508, 2.0, 2.0});
+    loop.cars.push_back({1, 1508, 6.0, 2.0});
+    loop.cars.push_back({2, 1508, 10.0, 2.0});
+    const PlanResult& r = planner->Plan(loop.Make());
+    EXPECT_EQ(r.status, PlanStatus::kFallbackUsed) << "least harm " << on;
+    if (on) {
+      EXPECT_GE(r.summary.winner_lane, 0);
+    } else {
+      EXPECT_EQ(r.summary.winner_lane, -1);
+    }
+    EXPECT_GE(r.x.size(), 50u) << "least harm " << on;
+    ASSERT_EQ(r.x.size(), r.y.size());
+    for (std::size_t i = 0; i < r.x.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(r.x[i]) && std::isfinite(r.y[i])) << i;
+    }
+  }
+}
+
 TEST(SearchPlannerTest, SplicesSmoothlyAtSpeedOnTheWholeLoop) {
   REQUIRE_MAP(line);
   auto planner = Make("search", line);

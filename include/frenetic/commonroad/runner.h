@@ -58,6 +58,9 @@ struct CycleInput {
   const plan::PlannerConfig& config;  // the problem's (its speed limit raised: CommonRoadConfig)
   const plan::Telemetry& telemetry;
   const KsState& ego;  // the vehicle's state the telemetry is read from
+  // Whether the planner's least-harm choice is on (plan::Planner::set_least_harm): off while
+  // the rescue holds a way to a goal (Rescue::Holds), which then stands in for it.
+  bool least_harm = true;
 };
 
 struct RunOptions {

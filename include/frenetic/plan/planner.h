@@ -109,6 +109,11 @@ class Planner {
     (void)trace;
     (void)max_candidates;
   }
+  // Whether a cycle in which no candidate passes every check takes the least harmful feasible
+  // one (on, the default) or the cheap fallback path at once, with status kFallbackUsed (off:
+  // a caller that holds a way of its own to drive then, as the CommonRoad runner's rescue
+  // does). Planners without a least-harm choice ignore it.
+  virtual void set_least_harm(bool on) { (void)on; }
 };
 
 class PlannerConfig;  // plan/planner_config.h

@@ -102,6 +102,7 @@ class SearchPlanner : public Planner {
   void set_trace(CycleTrace* trace, int max_candidates) override {
     tracer_.Attach(trace, max_candidates);
   }
+  void set_least_harm(bool on) override { least_harm_on_ = on; }
 
   void Reset() override {
     continuity_.Reset();
@@ -197,7 +198,9 @@ class SearchPlanner : public Planner {
       const bool none_passed_before = ws_.none_passed_last;
       found = selection_.Select(none_passed_before, &sum, &check_cut);
       ws_.none_passed_last = !found && !check_cut;
-      if (!found && !check_cut) least_harm = least_harm_.Choose(&check_cut, none_passed_before);
+      if (!found && !check_cut && least_harm_on_) {
+        least_harm = least_harm_.Choose(&check_cut, none_passed_before);
+      }
       if (check_cut) {
         over_budget = true;
         sum.deadline_stage = PlanSummary::Stage::kCheck;
@@ -323,6 +326,7 @@ class SearchPlanner : public Planner {
 
   std::vector<double> per_term_;   // unweighted term values (EvaluateWinnerCosts)
   double sim_time_ = NAN;          // s, simulated time of the current message (NaN: unknown)
+  bool least_harm_on_ = true;      // set_least_harm
   PlanResult result_;
 };
 
