@@ -107,7 +107,8 @@ struct Workspace {
   std::vector<double> edge_lo, edge_hi;
   double edge_widest = 0;  // m: the largest |edge| of the table where a lane exists
   // The line's largest |kappa| (1/m) over each kEdgeBin m from kappa_s0 (the edges' reach),
-  // and the largest |d| of a lane border at the start (m): the lattice's curve prefilter
+  // and max_abs_d, the farthest across (m) that a candidate passing the limit checks may be
+  // (the speed prefilter's |d|max, BuildContext): the lattice's curve prefilter
   // (Settings::curve_prefilter; filled only with it).
   double kappa_s0 = 0;
   std::vector<double> abs_kappa;

@@ -80,6 +80,12 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
   EXPECT_LT(on.ws.lon.size(), off.ws.lon.size());
   ASSERT_GT(on.ws.lon.size(), 0u);
   const Workspace& ws = on.ws;
+  // The bound's reach across is as wide as a candidate passing the limit checks may go (the
+  // off-road check's d limits on this uniform road, and the chords' 1.5 m), not the lane
+  // borders at the start.
+  EXPECT_GE(ws.max_abs_d, std::max({std::abs(ws.road_left), std::abs(ws.road_right),
+                                    std::abs(on.cfg.limits.d_min),
+                                    std::abs(on.cfg.limits.d_max)}) + 1.5 - 1e-9);
   const int n = ws.n_samples;
   int near_limit = 0;
   for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
