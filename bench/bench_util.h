@@ -226,14 +226,13 @@ class Replay {
 
   // Prepares the next measured message (not part of the measurement: may do the cold cycle).
   void Prepare() {
-    const bool commonroad = next_ < static_cast<int>(scene_->least_harm.size());
-    if (commonroad) planner_->set_least_harm(scene_->least_harm[next_] != 0);
     if (next_ == 0) {
       planner_->Reset();
+      LeastHarmAsRecorded(0);
       Remember(planner_->Plan(scene_->messages[0]));
       next_ = 1;
     }
-    if (commonroad) planner_->set_least_harm(scene_->least_harm[next_] != 0);
+    LeastHarmAsRecorded(next_);
     const plan::Telemetry& rec = scene_->messages[next_];
     const std::size_t n_prev = rec.previous_path_x.size();
     const std::size_t consumed =
@@ -263,6 +262,12 @@ class Replay {
   }
 
  private:
+  // A CommonRoad scene's message i: the least-harm choice as the run had it.
+  void LeastHarmAsRecorded(int i) {
+    if (i < static_cast<int>(scene_->least_harm.size())) {
+      planner_->set_least_harm(scene_->least_harm[i] != 0);
+    }
+  }
   void Remember(const plan::PlanResult& r) {
     last_x_.clear();
     last_y_.clear();

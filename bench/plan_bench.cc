@@ -266,10 +266,7 @@ void RescueCommonRoad(benchmark::State& state, const std::vector<std::string>& p
     auto scene = CommonRoadScene(path);
     if (!scene.ok()) return state.SkipWithError(scene.message().c_str());
     const Scene& sc = **scene;
-    if (sc.ego.empty() || sc.ego.size() != sc.path_x.size() ||
-        sc.fallback.size() != sc.path_x.size()) {
-      continue;  // infeasible at start
-    }
+    if (sc.ego.empty() || sc.ego.size() != sc.path_x.size()) continue;  // infeasible at start
     scenes.push_back(&sc);
   }
   if (scenes.empty()) return state.SkipWithError("no scene with a cycle");
@@ -293,11 +290,9 @@ void RescueCommonRoad(benchmark::State& state, const std::vector<std::string>& p
     // As the runner: a way to a goal that holds stands in for the planner's least harm.
     const plan::Telemetry& m = scene.messages[i];
     rescue->Predict(m);
-    const bool holds = rescue->Holds(scene.ego[i], m.goals);
-    const commonroad::RescueStep r = holds && scene.fallback[i] != 0
-                                         ? rescue->Continue(scene.ego[i], m.goals)
-                                         : rescue->Check(m, scene.path_x[i], scene.path_y[i],
-                                                         scene.ego[i]);
+    rescue->Holds(scene.ego[i], m.goals);
+    const commonroad::RescueStep r =
+        rescue->Answer(m, scene.path_x[i], scene.path_y[i], scene.ego[i], scene.fallback[i] != 0);
     const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
     const double cpu = ThreadCpuSeconds() - cpu0;
     state.PauseTiming();

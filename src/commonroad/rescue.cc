@@ -127,6 +127,7 @@ void Rescue::Predict(const plan::Telemetry& t) {
   // checks reach them (CarsAt): a path's check mostly needs the first 2 s only.
   sources_.clear();
   ready_ = 0;
+  held_ = false;
   const auto add = [this](Source::Kind kind, double length, double width) -> Source& {
     Source& src = sources_.emplace_back();
     src.kind = kind;
@@ -280,19 +281,26 @@ int Rescue::PathHit(const std::vector<double>& x, const std::vector<double>& y,
 
 bool Rescue::Holds(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
   const int rest = static_cast<int>(way_.size()) - 1;  // after the step driven since
-  return goal_way_ && rest >= 1 && Lasts(ego, &goals, 1) == rest;
+  held_ = goal_way_ && rest >= 1 && Lasts(ego, &goals, 1) == rest;
+  return held_;
 }
 
-RescueStep Rescue::Continue(const KsState& ego, const std::vector<cost::GoalRegion>& goals) {
+RescueStep Rescue::Continue() {
   RescueStep r;
-  if (!Holds(ego, goals)) {
+  if (!held_) {
     Drop();
     return r;
   }
+  held_ = false;
   r.why = RescueStep::Why::kNoPath;
   way_.erase(way_.begin());  // the step driven since
   r.input = way_.front();
   return r;
+}
+
+RescueStep Rescue::Answer(const plan::Telemetry& t, const std::vector<double>& x,
+                          const std::vector<double>& y, const KsState& ego, bool none_passed) {
+  return held_ && none_passed ? Continue() : Check(t, x, y, ego);
 }
 
 int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals, int from) {
@@ -314,6 +322,7 @@ int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals
 
 std::optional<KsInput> Rescue::Next(const KsState& ego,
                                     const std::vector<cost::GoalRegion>& goals, bool goal_only) {
+  held_ = false;
   if (!way_.empty()) way_.erase(way_.begin());  // the step driven since
   const int rest = static_cast<int>(way_.size());
   // A way to a goal is kept while it still meets it; another while it lasts long enough.

@@ -296,15 +296,15 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       // A way the rescue holds stands in for the planner's least harm (Rescue::Holds): the
       // planner then skips that choice when no candidate passes. Its time counts.
       bool way_holds = false;
-      double r_ms = 0;
+      double holds_ms = 0;
       if (rescue) {
         const auto p0 = std::chrono::steady_clock::now();
         rescue->Predict(t);
         way_holds = rescue->Holds(ego, t.goals);
-        r_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0)
-                   .count();
+        holds_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0)
+                .count();
       }
-      const double holds_ms = r_ms;
       const CycleInput input{problem, k, built->road, problem_config, t, ego, !way_holds};
       if (options.on_cycle) options.on_cycle(input);
       const auto t0 = std::chrono::steady_clock::now();
@@ -334,11 +334,12 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       std::optional<KsInput> rescue_input;
       if (rescue) {
         const auto r0 = std::chrono::steady_clock::now();
-        const RescueStep step = way_holds && res.status == plan::PlanStatus::kFallbackUsed
-                                    ? rescue->Continue(ego, t.goals)
-                                    : rescue->Check(t, res.x, res.y, ego);
-        r_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
-                    .count();
+        const RescueStep step =
+            rescue->Answer(t, res.x, res.y, ego, res.status == plan::PlanStatus::kFallbackUsed);
+        const double r_ms =
+            holds_ms +
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
+                .count();
         rescue_input = step.input;
         if (step.why == RescueStep::Why::kNoPath) {
           spdlog::debug("{} #{} step {}: no candidate passes; the rescue's way stands in "

@@ -436,7 +436,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNe
   }
   rescue_.Predict(t_);
   EXPECT_TRUE(rescue_.Holds(next, goals));
-  const RescueStep step = rescue_.Continue(next, goals);
+  const RescueStep step = rescue_.Continue();
   EXPECT_EQ(step.why, RescueStep::Why::kNoPath);
   ASSERT_TRUE(step.input.has_value());
   EXPECT_EQ(rescue_.searches(), 1);  // no new search
@@ -454,7 +454,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNe
   next = SimulateKs(next, *step.input, kDt, VehicleParams());
   goals = {Lane0Goal(0.1, 0.2, 62)};
   EXPECT_FALSE(rescue_.Holds(next, goals));
-  const RescueStep none = rescue_.Continue(next, goals);
+  const RescueStep none = rescue_.Continue();
   EXPECT_EQ(none.why, RescueStep::Why::kNone);
   EXPECT_FALSE(none.input.has_value());
   std::vector<double> x2, y2;
@@ -471,7 +471,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayThatOnlyLastsDoesNotHold) {
   const KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
   rescue_.Predict(t_);
   EXPECT_FALSE(rescue_.Holds(next, {}));
-  EXPECT_FALSE(rescue_.Continue(next, {}).input.has_value());
+  EXPECT_FALSE(rescue_.Continue().input.has_value());
 }
 
 }  // namespace

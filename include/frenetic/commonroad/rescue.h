@@ -82,18 +82,25 @@ class Rescue {
   // Step's check alone, on the cars of the last Predict (t: the same telemetry).
   RescueStep Check(const plan::Telemetry& t, const std::vector<double>& x,
                    const std::vector<double>& y, const KsState& ego);
+  // The closed loop's answer to the path the planner sent, after Predict(t) and Holds(ego,
+  // t.goals) this cycle: when the way held and no candidate passed (none_passed: the planner
+  // skipped its least harm), the way driven on (Continue); otherwise Check.
+  RescueStep Answer(const plan::Telemetry& t, const std::vector<double>& x,
+                    const std::vector<double>& y, const KsState& ego, bool none_passed);
 
   // Whether the rest of the way from `ego` (one step driven since it was found or last kept)
   // is a way to a goal region that still meets it, clear to its end: one Next keeps whatever
-  // the planner's path hits or misses. On the cars of the last Predict. The closed loop asks
+  // the planner's path hits or misses. On the cars of the last Predict; the answer is kept
+  // for Continue and Answer until the next Predict or change of the way. The closed loop asks
   // before the planner runs: when it holds, a cycle in which no candidate passes drives the
   // way (Continue) instead of the planner's least harm, which the way stands in for whenever
   // that path hits a car or misses the goal. (A way that only lasts does not hold: a least-harm
   // path toward the goal then still counts. Tried: 2 fewer derived highD problems solved with
   // either prediction; see docs/commonroad.md.)
   bool Holds(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
-  // The way's next input when it Holds (why kNoPath); none (and the way forgotten) otherwise.
-  RescueStep Continue(const KsState& ego, const std::vector<cost::GoalRegion>& goals);
+  // The way's next input (why kNoPath) when the last Holds, since the last Predict, said it
+  // holds; none (and the way forgotten) otherwise.
+  RescueStep Continue();
 
   // The predicted boxes of the telemetry's cars at steps 1..steps from its instant: a car's
   // future where it has one (a car to come appears at its start), else its row carried on at
@@ -147,6 +154,7 @@ class Rescue {
   void Drop() {
     way_.clear();
     goal_way_ = false;
+    held_ = false;
   }
 
   int searches() const { return searches_; }
@@ -242,6 +250,7 @@ class Rescue {
   mutable int ready_ = 0;                       // steps of cars_ laid out
   std::vector<KsInput> way_;
   bool goal_way_ = false;  // way_ ends in a goal region
+  bool held_ = false;      // the last Holds' answer, until Predict or the way changes
   std::vector<std::vector<Node>> layers_;
   std::vector<std::pair<std::uint64_t, Node>> next_;
   KeyTable seen_;
