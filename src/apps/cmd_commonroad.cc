@@ -441,9 +441,12 @@ void RegisterCommonRoad(CLI::App& app) {
                 "path's curvature up to what the steering rate allows, within the friction "
                 "circle), kept while the verdict's collision and road checks pass, on a grid "
                 "(0.25 m, 0.25 m/s, 0.01 rad, 0.002 1/m), at most 10000 per step, to the "
-                "traffic's last step. Evidence, not proof: per problem 'found', or the last step "
-                "any state reached (and whether a step was capped); the summary counts both. "
-                "Takes seconds per problem. Default: off");
+                "traffic's last step, then on the road alone until a kept state meets a goal "
+                "state or every goal's window has closed (at most 200 steps in all). Evidence, "
+                "not proof: per problem 'found', or the last step any state reached (and whether "
+                "a step was capped), and the step a state met the goal (a way to the goal: the "
+                "problem has a solution); the summary counts them. Takes seconds per problem. "
+                "Default: off");
   sub->callback([args] { ExitWith(Run(*args)); });
 }
 

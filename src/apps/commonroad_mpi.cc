@@ -125,6 +125,8 @@ json WayThroughWire(const cr::WayThrough& w) {
           {"last_step", w.last_step},
           {"survived_to", w.survived_to},
           {"exhaustive", w.exhaustive},
+          {"goal_step", w.goal_step},
+          {"goal_searched_to", w.goal_searched_to},
           {"checked", w.checked}};
 }
 
@@ -134,6 +136,8 @@ cr::WayThrough WayThroughFrom(const json& j) {
   w.last_step = j.at("last_step").get<int>();
   w.survived_to = j.at("survived_to").get<int>();
   w.exhaustive = j.at("exhaustive").get<bool>();
+  w.goal_step = j.at("goal_step").get<int>();
+  w.goal_searched_to = j.at("goal_searched_to").get<int>();
   w.checked = j.at("checked").get<std::int64_t>();
   return w;
 }

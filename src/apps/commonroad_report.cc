@@ -160,6 +160,11 @@ std::string ProblemText(const FileReport& f, const ProblemReport& p) {
                   w.found ? w.last_step : w.survived_to, w.last_step,
                   w.found || w.exhaustive ? "" : " (capped)");
     text += buf;
+    std::snprintf(buf, sizeof(buf),
+                  w.goal_step >= 0 ? "    way to the goal: found (a state meets it at step %d)\n"
+                                   : "    way to the goal: none found to step %d\n",
+                  w.goal_step >= 0 ? w.goal_step : w.goal_searched_to);
+    text += buf;
   }
   return text;
 }
@@ -203,6 +208,8 @@ json ProblemJson(const ProblemReport& p, double dt) {
                         {"last_step", w.last_step},
                         {"survived_to", w.survived_to},
                         {"exhaustive", w.exhaustive},
+                        {"goal_step", w.goal_step >= 0 ? json(w.goal_step) : json(nullptr)},
+                        {"goal_searched_to", w.goal_searched_to},
                         {"states_checked", w.checked}};
   }
   return j;

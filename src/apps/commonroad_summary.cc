@@ -94,6 +94,7 @@ Summary Summarise(const std::vector<FileReport>& files,
         ++s.way_searched;
         s.way_found += p.way_through->found;
         s.way_none_exhaustive += !p.way_through->found && p.way_through->exhaustive;
+        s.way_to_goal += p.way_through->goal_step >= 0;
       }
       if (p.verdict.solved || p.verdict.infeasible_at_start) continue;
       if (!p.road_error.empty()) ++s.failures["road"];
@@ -207,7 +208,8 @@ json SummaryJson(const Summary& s, const SummarySettings& settings) {
     j["way_through"] = {{"searched", s.way_searched},
                         {"found", s.way_found},
                         {"none_found", s.way_searched - s.way_found},
-                        {"none_found_exhaustive", s.way_none_exhaustive}};
+                        {"none_found_exhaustive", s.way_none_exhaustive},
+                        {"to_the_goal", s.way_to_goal}};
   }
   return j;
 }
@@ -236,8 +238,9 @@ std::string SummaryText(const Summary& s, const SummarySettings& settings) {
   if (s.way_searched > 0) {
     text += Format(
         "way through the traffic (--way-through) of the %d unsolved problems: found for %d, none "
-        "found for %d (%d with no step capped)\n",
-        s.way_searched, s.way_found, s.way_searched - s.way_found, s.way_none_exhaustive);
+        "found for %d (%d with no step capped); a way to a goal state found for %d\n",
+        s.way_searched, s.way_found, s.way_searched - s.way_found, s.way_none_exhaustive,
+        s.way_to_goal);
   }
   return text;
 }

@@ -66,6 +66,7 @@ struct Summary {
   // --way-through: the unsolved problems searched, and of those the ones with a way found; the
   // ones with none found where no step was capped (WayThrough::exhaustive).
   int way_searched = 0, way_found = 0, way_none_exhaustive = 0;
+  int way_to_goal = 0;  // of those searched, the ones where a state met a goal (goal_step)
 };
 
 // `solution_files`: scenario id -> path of each loaded solution file (gives the unpaired ones).

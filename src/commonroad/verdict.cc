@@ -170,7 +170,16 @@ std::string GoalMissDetail(std::span<const GoalState> goals, std::span<const KsS
 }  // namespace
 
 bool MeetsGoal(const Scenario& scenario, const GoalState& goal, const KsState& state) {
-  return EvaluateGoal(goal, state, GoalLaneletPolygons(scenario, {&goal, 1})).All();
+  return GoalTest(scenario, {&goal, 1}).MeetsAny(state);
+}
+
+GoalTest::GoalTest(const Scenario& scenario, std::span<const GoalState> goals)
+    : goals_(goals.begin(), goals.end()), polygons_(GoalLaneletPolygons(scenario, goals)) {}
+
+bool GoalTest::MeetsAny(const KsState& state) const {
+  return std::any_of(goals_.begin(), goals_.end(), [&](const GoalState& g) {
+    return EvaluateGoal(g, state, polygons_).All();
+  });
 }
 
 VerdictChecker::VerdictChecker(const Scenario& scenario, const VehicleParams& vehicle,

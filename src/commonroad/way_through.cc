@@ -41,23 +41,47 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
                           : std::clamp(traffic_end - first, 0, options.max_steps);
   r.last_step = first + horizon;
   r.survived_to = first;
+  // Past the traffic, on until a goal's window has closed (a goal without one: max_steps).
+  int goal_end = INT_MIN;
+  for (const GoalState& g : problem.goals) goal_end = std::max(goal_end, g.time ? g.time->end : INT_MAX);
+  const int goal_horizon =
+      goal_end == INT_MIN ? 0 : static_cast<int>(std::clamp<long>(
+                                    static_cast<long>(goal_end) - first, 0, options.max_steps));
+  const GoalTest goal(scenario, problem.goals);
   const double dt = scenario.dt;
-  const auto valid = [&](const Point& p, int step) {
-    ++r.checked;
+  const auto state = [](const Point& p, int step) {
     KsState s;
     s.time_step = step;
     s.x = p.x;
     s.y = p.y;
     s.velocity = p.v;
     s.orientation = p.heading;
+    return s;
+  };
+  const auto valid = [&](const Point& p, int step) {
+    ++r.checked;
+    const KsState s = state(p, step);
     return !checker.CollisionAt(s) && !checker.OffRoadAt(s);
+  };
+  // Whether a kept state at `step` meets a goal (recorded once).
+  const auto meets_goal = [&](const std::vector<Point>& kept, int step) {
+    r.goal_searched_to = step;
+    if (r.goal_step >= 0) return;
+    for (const Point& p : kept) {
+      if (goal.MeetsAny(state(p, step))) {
+        r.goal_step = step;
+        return;
+      }
+    }
   };
   const double wheelbase = vehicle.Wheelbase();
   std::vector<Point> now{{problem.initial.position.x, problem.initial.position.y,
                           std::clamp(problem.initial.velocity.value_or(0.0), 0.0, vehicle.v_max),
                           problem.initial.orientation.value_or(0.0),
                           std::tan(problem.initial.steering_angle.value_or(0.0)) / wheelbase}};
+  r.goal_searched_to = first;
   if (!valid(now[0], first)) return r;
+  meets_goal(now, first);
   // The path's curvature within the steering angle's limit, and its change in a step within
   // what the steering rate allows (d tan(delta) / dt = delta' / cos^2 delta >= delta').
   const double max_curvature =
@@ -74,7 +98,9 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   KeyTable seen;
   reach::SpreadScratch spread;
   std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
-  for (int k = 1; k <= horizon; ++k) {
+  const int steps = std::max(horizon, goal_horizon);
+  for (int k = 1; k <= steps; ++k) {
+    if (k > horizon && r.goal_step >= 0) break;  // through the traffic, and a goal met
     const int step = first + k;
     next.clear();
     seen.Clear();
@@ -110,10 +136,12 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
       if (valid(q, step)) now.push_back(q);
     }
     if (now.empty()) return r;
-    if (visited < n) r.exhaustive = false;
-    r.survived_to = step;
+    if (visited < n && k <= horizon) r.exhaustive = false;
+    meets_goal(now, step);
+    if (k <= horizon) r.survived_to = step;
+    if (k == horizon) r.found = true;
   }
-  r.found = true;
+  if (horizon == 0) r.found = true;
   return r;
 }
 

@@ -351,7 +351,8 @@ TEST_F(CommonRoadCliTest, HelpListsEveryOptionWithItsDefault) {
 
 // --way-through searches the unsolved problems only (not the solved, not the infeasible at
 // start): the far goal's road has no traffic, so a way through it is found, to the search's
-// default 10 steps; the summary counts it. Without the flag there is no such field.
+// default 10 steps, and none to its goal; the summary counts both. Without the flag there is
+// no such field.
 TEST_F(CommonRoadCliTest, WayThroughIsSearchedForTheUnsolvedOnly) {
   const std::string paths = Set() + " " + (dir_ / "blocked" / "b_blocked.xml").string();
   CommandResult r = RunFrenetic("commonroad " + paths + " --json --no-timing --way-through");
@@ -369,6 +370,9 @@ TEST_F(CommonRoadCliTest, WayThroughIsSearchedForTheUnsolvedOnly) {
       EXPECT_EQ(w.at("last_step"), 10);
       EXPECT_EQ(w.at("survived_to"), 10);
       EXPECT_GT(w.at("states_checked").get<int>(), 10);
+      // Then on the road alone to the goal's window's close (step 30): out of reach.
+      EXPECT_TRUE(w.at("goal_step").is_null()) << w.dump();
+      EXPECT_EQ(w.at("goal_searched_to"), 30);
     }
   }
   EXPECT_EQ(searched, 1);
@@ -376,9 +380,12 @@ TEST_F(CommonRoadCliTest, WayThroughIsSearchedForTheUnsolvedOnly) {
   EXPECT_EQ(sum.at("searched"), 1);
   EXPECT_EQ(sum.at("found"), 1);
   EXPECT_EQ(sum.at("none_found"), 0);
+  EXPECT_EQ(sum.at("to_the_goal"), 0);
   CommandResult text = RunFrenetic("commonroad " + paths + " --no-timing --way-through");
   EXPECT_THAT(text.out, HasSubstr("    way through: found (to step 10, the traffic's last)\n"));
+  EXPECT_THAT(text.out, HasSubstr("    way to the goal: none found to step 30\n"));
   EXPECT_THAT(text.out, HasSubstr("of the 1 unsolved problems: found for 1, none found for 0"));
+  EXPECT_THAT(text.out, HasSubstr("a way to a goal state found for 0\n"));
   CommandResult plain = RunFrenetic("commonroad " + paths + " --json --no-timing");
   EXPECT_THAT(plain.out, Not(HasSubstr("way_through")));
 }

@@ -81,7 +81,7 @@ FileReport Awkward() {
   r.distance_ratio = 1.9535585655180756;
   r.verdict = "failed: start, dynamics";
   p.reference = r;
-  p.way_through = commonroad::WayThrough{false, 75, 7, true, 12506};
+  p.way_through = commonroad::WayThrough{false, 75, 7, true, 12506, 64, 80};
   f.problems.push_back(p);
   ProblemReport plain;  // defaults: no goal, no reference
   plain.problem_id = 2;
@@ -130,6 +130,8 @@ TEST(CommonRoadMpiTest, ReportsReadBackExactly) {
   EXPECT_EQ(q.way_through->survived_to, 7);
   EXPECT_EQ(q.way_through->checked, 12506);
   EXPECT_TRUE(q.way_through->exhaustive);
+  EXPECT_EQ(q.way_through->goal_step, 64);
+  EXPECT_EQ(q.way_through->goal_searched_to, 80);
   EXPECT_FALSE(b.problems[1].way_through.has_value());
   EXPECT_FALSE(b.problems[1].verdict.goal_step.has_value());
   // What the output is made of reads the same.

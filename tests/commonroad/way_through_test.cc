@@ -15,6 +15,7 @@ namespace frenetic::commonroad {
 namespace {
 
 using testing::AddStraightRoad;
+using testing::GoalRectangleXml;
 using testing::GoalTimeOnlyXml;
 using testing::ScenarioXml;
 using testing::StateXml;
@@ -120,6 +121,48 @@ TEST(WayThroughTest, TheRoadsEndIsAWallToo) {
     if (!w.found) {
       EXPECT_LT(w.survived_to, 20) << road;
     }
+  }
+}
+
+TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
+  WayThroughOptions few = Small();
+  few.max_states = 500;  // enough here, and quick under the sanitizers
+  // A goal of time only (steps 10-30): the first step of its window, while the car from behind
+  // is still being escaped.
+  {
+    const WayThrough w = Search(Parse(CarFromBehind()), few);
+    EXPECT_EQ(w.goal_step, 10);
+  }
+  // A region 170-190 m along the right lane within steps 40-60, past the traffic's last step
+  // (30): from x = 50 at 20 m/s it is reached at step 60 holding that speed, sooner by speeding
+  // up. The search goes on past the traffic (on the road alone) to find it; `found` and
+  // `survived_to` still speak of the traffic.
+  {
+    ScenarioXml xml;
+    AddStraightRoad(xml, 400)
+        .DynamicObstacle(9, 4.5, 2.0, Car(20, -1.75, 40, 30))
+        .Problem(100, {50, -1.75}, 0, 20,
+                 {GoalRectangleXml({180, -1.75}, 20, 3.0, 0.0, 40, 60)});
+    const WayThrough w = Search(Parse(xml), few);
+    EXPECT_TRUE(w.found);
+    EXPECT_EQ(w.last_step, 30);
+    EXPECT_EQ(w.survived_to, 30);
+    EXPECT_GE(w.goal_step, 40);
+    EXPECT_LE(w.goal_step, 60);
+    EXPECT_EQ(w.goal_searched_to, w.goal_step);
+  }
+  // A region 200-220 m along within steps 10-12: 150 m in 1.2 s is out of the vehicle's reach.
+  // No way to it, though a way through the traffic is found: searched to the traffic's last step.
+  {
+    ScenarioXml xml;
+    AddStraightRoad(xml, 400)
+        .DynamicObstacle(9, 4.5, 2.0, Car(20, -1.75, 40, 30))
+        .Problem(100, {50, -1.75}, 0, 20,
+                 {GoalRectangleXml({210, -1.75}, 20, 3.0, 0.0, 10, 12)});
+    const WayThrough w = Search(Parse(xml), few);
+    EXPECT_TRUE(w.found);
+    EXPECT_EQ(w.goal_step, -1);
+    EXPECT_EQ(w.goal_searched_to, 30);
   }
 }
 

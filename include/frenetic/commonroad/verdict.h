@@ -43,6 +43,7 @@
 // Not checked: collisions between the egos of several planning problems.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -120,6 +121,18 @@ struct VerdictOptions {
 // True when the state meets the goal state (see above); `scenario` resolves lanelet goals (an id
 // it does not know is never met).
 bool MeetsGoal(const Scenario& scenario, const GoalState& goal, const KsState& state);
+
+// MeetsGoal for many states: the goal lanelets' polygons built once. `scenario` must outlive it.
+class GoalTest {
+ public:
+  GoalTest(const Scenario& scenario, std::span<const GoalState> goals);
+  // True when the state meets one of the goal states.
+  bool MeetsAny(const KsState& state) const;
+
+ private:
+  std::vector<GoalState> goals_;
+  std::map<int, std::vector<Vec2>> polygons_;
+};
 
 // Checks trajectories against one scenario; builds the road area once.
 class VerdictChecker {

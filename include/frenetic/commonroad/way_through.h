@@ -12,6 +12,12 @@
 // when more than max_states are valid at a step a spread of them over coarse strata of position
 // and speed is kept (deterministic).
 //
+// The search also tells whether a kept state meets one of the problem's goal states
+// (MeetsGoal): it goes on past the traffic's last step, on the road alone, until one does or
+// every goal's window has closed (at most max_steps). A way to the goal is the stronger
+// evidence: a trajectory that ends in a goal state is a solution (the checker reads it up to
+// its last state).
+//
 // So the model is coarser than KS (five choices of each input a step, the grid, the cap): a way
 // found is strong evidence that the problem has a solution; none found, with `exhaustive` (no
 // step capped), that it has none. Neither is a proof.
@@ -37,15 +43,18 @@ struct WayThroughOptions {
 
 struct WayThrough {
   bool found = false;        // some state lasts from the initial step to last_step
-  int last_step = 0;         // the step searched to: the traffic's last (capped by max_steps)
+  int last_step = 0;         // the traffic's last step (capped by max_steps)
   int survived_to = 0;       // the last step some state reached (last_step when found)
   bool exhaustive = true;    // no step was capped at max_states
   std::int64_t checked = 0;  // states checked for collision and road
+  int goal_step = -1;        // the first step a kept state met a goal state; -1: none did
+  int goal_searched_to = 0;  // the last step searched for one (goal_step when found)
 };
 
 // The search from problem.initial to the last step any dynamic obstacle exists (at most
-// options.max_steps later); `checker` is the scenario's, for `vehicle`. An initial state that
-// already fails gives found false and survived_to the initial step.
+// options.max_steps later), then on until a state meets a goal (above); `checker` is the
+// scenario's, for `vehicle`. An initial state that already fails gives found false and
+// survived_to the initial step.
 WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& problem,
                             const VerdictChecker& checker, const VehicleParams& vehicle,
                             const WayThroughOptions& options = {});
