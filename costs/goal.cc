@@ -196,8 +196,20 @@ class GoalCost : public CostTerm {
     };
     const int k0 = std::max(0, static_cast<int>(std::floor(t0 / dt)));
     const int k1 = std::min(n - 1, static_cast<int>(std::ceil(t1 / dt)));
-    At a = k0 < n ? Sample(in, k0) : At{};
-    for (int k = k0; k < k1 && best > 0; ++k) {  // nothing is below 0: done
+    // The samples' s span against the region's: a region far ahead (or behind) of all of them
+    // bounds every piece's miss and every sample's from below, so when that bound is no better
+    // than the best so far (the window's ends), the pieces can change nothing.
+    bool pieces = k0 < k1 && best > 0;
+    if (pieces && has_s) {
+      double s_min = in.s[k0], s_max = in.s[k0];
+      for (int k = k0 + 1; k <= k1; ++k) {
+        s_min = std::min(s_min, in.s[k]);
+        s_max = std::max(s_max, in.s[k]);
+      }
+      pieces = !(least(s_min, s_max, g.s_lo, g.s_hi, inv_s_) >= best);
+    }
+    At a = pieces ? Sample(in, k0) : At{};
+    for (int k = k0; pieces && k < k1 && best > 0; ++k) {  // nothing is below 0: done
       const At b = Sample(in, k + 1);
       if (k * dt >= t0) best = std::min(best, MissAt(g, a));
       piece(k * dt, (k + 1) * dt, a, b);

@@ -221,5 +221,70 @@ TEST_F(GoalCostTest, PassingBesideARegionStaysAMissAndASlowerCandidateHasLongerT
   EXPECT_EQ(Eval(Beside(5, 80, 90, true)), 0.0);
 }
 
+// The term's meaning, evaluated densely: the least over its window (at most 1 ms apart, both
+// ends included) of the miss of the candidate taken linear between its samples and straight on
+// at its last speed after them.
+double DenseMiss(const Case& c, const GoalRegion& g) {
+  const auto out = [](double x, double lo, double hi) { return std::max({lo - x, 0.0, x - hi}); };
+  const double t_end = (kN - 1) * 0.25, t0 = std::max(g.t_lo, 0.0);
+  const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
+  double best = kInf;
+  const int steps = static_cast<int>(std::ceil((t1 - t0) / 0.001));
+  for (int i = 0; i <= steps; ++i) {
+    const double t = t0 + (t1 - t0) * i / std::max(steps, 1);
+    double s, v;
+    if (t >= t_end) {
+      v = c.s_d[kN - 1];
+      s = c.s[kN - 1] + v * (t - t_end);
+    } else {
+      const int k = static_cast<int>(t / 0.25);
+      const double f = t / 0.25 - k;
+      s = c.s[k] + f * (c.s[k + 1] - c.s[k]);
+      v = c.s_d[k] + f * (c.s_d[k + 1] - c.s_d[k]);
+    }
+    best = std::min(best, out(s, g.s_lo, g.s_hi) / 10.0 + out(v, g.v_lo, g.v_hi) / 5.0);
+  }
+  return best > 0 ? std::min(1.0 + best, 10.0) : 0.0;
+}
+
+TEST_F(GoalCostTest, TheLeastMissIsExactForRegionsNearAndFar) {
+  // Regions behind, among and far past the samples (the samples' span alone then bounds the
+  // miss), windows short and long, speed bounds or none, candidates speeding up and slowing.
+  // One just past the samples' span whose least miss lies inside it, not at a window's end:
+  // slowing at 3 m/s^2 toward [70, 80] with a speed of 15-20 m/s wanted (at 4.6 s: 1 + 2.734;
+  // at 6 s, the window's end, 1 + 3.0).
+  int checked = 0, missed = 0;
+  for (const double a : {-3.0, -2.0, 0.0, 2.0}) {
+    for (const double s_lo : {-40.0, 50.0, 70.0, 150.0, 300.0, 1000.0}) {
+      for (const auto& [t_lo, t_hi] :
+           {std::pair{0.0, 3.0}, {2.0, 8.0}, {0.0, 40.0}, {7.0, 9.0}, {0.0, 6.0}}) {
+        for (const auto& [v_lo, v_hi] :
+             {std::pair{-kInf, kInf}, {25.0, 30.0}, {5.0, 8.0}, {15.0, 20.0}}) {
+          GoalRegion g = Box(s_lo, s_lo + 10, t_lo, t_hi);
+          g.v_lo = v_lo;
+          g.v_hi = v_hi;
+          const Case c(20, {g}, a);
+          const double dense = DenseMiss(c, g);
+          EXPECT_NEAR(Eval(c), dense, 2e-3)
+              << "a " << a << " s " << s_lo << " t [" << t_lo << ", " << t_hi << "] v [" << v_lo
+              << ", " << v_hi << "]";
+          ++checked;
+          missed += dense > 0;
+        }
+      }
+    }
+  }
+  // Both kinds are in the grid: passed through and missed.
+  EXPECT_EQ(checked, 480);
+  EXPECT_GT(missed, 150);
+  EXPECT_LT(missed, 450);
+  {
+    GoalRegion g = Box(70, 80, 0, 6);
+    g.v_lo = 15;
+    g.v_hi = 20;
+    EXPECT_NEAR(Eval(Case(20, {g}, -3)), 1 + 2.734, 0.001);
+  }
+}
+
 }  // namespace
 }  // namespace frenetic::cost
