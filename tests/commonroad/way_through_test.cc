@@ -49,11 +49,12 @@ WayThrough Search(const Scenario& s, const WayThroughOptions& options = Small())
 // The ego in the right lane at x = 50, 20 m/s; a car 30 m behind it in its lane at 40 m/s, there
 // for 3 s: it reaches the ego in about 1.3 s unless the ego leaves the lane. The cars are 2 m
 // wide: no room for the ego (1.61 m) on the line between two of them in the two lanes.
-ScenarioXml CarFromBehind() {
+// `goal`: the problem's goal state (steps 10-30, time only, unless given).
+ScenarioXml CarFromBehind(const std::string& goal = GoalTimeOnlyXml(10, 30)) {
   ScenarioXml xml;
   AddStraightRoad(xml, 400)
       .DynamicObstacle(9, 4.5, 2.0, Car(20, -1.75, 40, 30))
-      .Problem(100, {50, -1.75}, 0, 20, {GoalTimeOnlyXml(10, 30)});
+      .Problem(100, {50, -1.75}, 0, 20, {goal});
   return xml;
 }
 
@@ -138,12 +139,8 @@ TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
   // up. The search goes on past the traffic (on the road alone) to find it; `found` and
   // `survived_to` still speak of the traffic.
   {
-    ScenarioXml xml;
-    AddStraightRoad(xml, 400)
-        .DynamicObstacle(9, 4.5, 2.0, Car(20, -1.75, 40, 30))
-        .Problem(100, {50, -1.75}, 0, 20,
-                 {GoalRectangleXml({180, -1.75}, 20, 3.0, 0.0, 40, 60)});
-    const WayThrough w = Search(Parse(xml), few);
+    const WayThrough w =
+        Search(Parse(CarFromBehind(GoalRectangleXml({180, -1.75}, 20, 3.0, 0.0, 40, 60))), few);
     EXPECT_TRUE(w.found);
     EXPECT_EQ(w.last_step, 30);
     EXPECT_EQ(w.survived_to, 30);
@@ -154,12 +151,8 @@ TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
   // A region 200-220 m along within steps 10-12: 150 m in 1.2 s is out of the vehicle's reach.
   // No way to it, though a way through the traffic is found: searched to the traffic's last step.
   {
-    ScenarioXml xml;
-    AddStraightRoad(xml, 400)
-        .DynamicObstacle(9, 4.5, 2.0, Car(20, -1.75, 40, 30))
-        .Problem(100, {50, -1.75}, 0, 20,
-                 {GoalRectangleXml({210, -1.75}, 20, 3.0, 0.0, 10, 12)});
-    const WayThrough w = Search(Parse(xml), few);
+    const WayThrough w =
+        Search(Parse(CarFromBehind(GoalRectangleXml({210, -1.75}, 20, 3.0, 0.0, 10, 12))), few);
     EXPECT_TRUE(w.found);
     EXPECT_EQ(w.goal_step, -1);
     EXPECT_EQ(w.goal_searched_to, 30);
