@@ -198,9 +198,10 @@ class GoalCost : public CostTerm {
     const int k1 = std::min(n - 1, static_cast<int>(std::ceil(t1 / dt)));
     // The samples' s span against the region's: a region far ahead (or behind) of all of them
     // bounds every piece's miss and every sample's from below, so when that bound is no better
-    // than the best so far (the window's ends), the pieces can change nothing.
+    // than the best so far (the window's ends), the pieces can change nothing. (An empty s
+    // interval, s_lo > s_hi, has no such bound: least() would overstate it.)
     bool pieces = k0 < k1 && best > 0;
-    if (pieces && has_s) {
+    if (pieces && has_s && g.s_lo <= g.s_hi) {
       double s_min = in.s[k0], s_max = in.s[k0];
       for (int k = k0 + 1; k <= k1; ++k) {
         s_min = std::min(s_min, in.s[k]);
@@ -215,6 +216,9 @@ class GoalCost : public CostTerm {
       piece(k * dt, (k + 1) * dt, a, b);
       a = b;
     }
+    // The last sample, where the samples end and the continuation starts: the loop reads each
+    // piece's first end only.
+    if (t0 <= t_end && t1 > t_end && best > 0) best = std::min(best, MissAt(g, Sample(in, n - 1)));
     if (t1 > t_end && best > 0) {  // the continuation: straight on, or across and then straight
       const double ta = std::max(t_end, t0);
       // when its move across ends (none: at once)

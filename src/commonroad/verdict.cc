@@ -177,9 +177,8 @@ GoalTest::GoalTest(const Scenario& scenario, std::span<const GoalState> goals)
     : goals_(goals.begin(), goals.end()), polygons_(GoalLaneletPolygons(scenario, goals)) {}
 
 bool GoalTest::MeetsAny(const KsState& state) const {
-  return std::any_of(goals_.begin(), goals_.end(), [&](const GoalState& g) {
-    return EvaluateGoal(g, state, polygons_).All();
-  });
+  return std::any_of(goals_.begin(), goals_.end(),
+                     [&](const GoalState& g) { return EvaluateGoal(g, state, polygons_).All(); });
 }
 
 VerdictChecker::VerdictChecker(const Scenario& scenario, const VehicleParams& vehicle,
@@ -265,20 +264,16 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
   }
 
   // Goal.
-  const auto polygons = GoalLaneletPolygons(*scenario_, problem.goals);
+  const GoalTest goal(*scenario_, problem.goals);
   for (const KsState& s : traj) {
-    const bool met = std::any_of(problem.goals.begin(), problem.goals.end(),
-                                 [&](const GoalState& g) {
-                                   return EvaluateGoal(g, s, polygons).All();
-                                 });
-    if (met) {
+    if (goal.MeetsAny(s)) {
       verdict.goal_step = s.time_step;
       break;
     }
   }
   if (!verdict.goal_step) {
     fail(FailureKind::kGoal, traj.back().time_step,
-         GoalMissDetail(problem.goals, traj, polygons));
+         GoalMissDetail(problem.goals, traj, goal.polygons()));
   }
 
   // Collision and road, every state from the first to the last.

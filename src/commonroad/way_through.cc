@@ -42,11 +42,14 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   r.last_step = first + horizon;
   r.survived_to = first;
   // Past the traffic, on until a goal's window has closed (a goal without one: max_steps).
-  int goal_end = INT_MIN;
-  for (const GoalState& g : problem.goals) goal_end = std::max(goal_end, g.time ? g.time->end : INT_MAX);
+  std::int64_t goal_end = INT_MIN;
+  for (const GoalState& g : problem.goals) {
+    goal_end = std::max<std::int64_t>(goal_end, g.time ? g.time->end : INT_MAX);
+  }
   const int goal_horizon =
-      goal_end == INT_MIN ? 0 : static_cast<int>(std::clamp<long>(
-                                    static_cast<long>(goal_end) - first, 0, options.max_steps));
+      goal_end == INT_MIN
+          ? 0
+          : static_cast<int>(std::clamp<std::int64_t>(goal_end - first, 0, options.max_steps));
   const GoalTest goal(scenario, problem.goals);
   const double dt = scenario.dt;
   const auto state = [](const Point& p, int step) {
@@ -65,8 +68,8 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   };
   // Whether a kept state at `step` meets a goal (recorded once).
   const auto meets_goal = [&](const std::vector<Point>& kept, int step) {
-    r.goal_searched_to = step;
     if (r.goal_step >= 0) return;
+    r.goal_searched_to = step;
     for (const Point& p : kept) {
       if (goal.MeetsAny(state(p, step))) {
         r.goal_step = step;
@@ -98,6 +101,8 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   KeyTable seen;
   reach::SpreadScratch spread;
   std::vector<std::pair<std::size_t, std::size_t>> rank;  // (rank in its stratum, index)
+  // No step to get through: found.
+  if (horizon == 0) r.found = true;
   const int steps = std::max(horizon, goal_horizon);
   for (int k = 1; k <= steps; ++k) {
     if (k > horizon && r.goal_step >= 0) break;  // through the traffic, and a goal met
@@ -141,7 +146,6 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
     if (k <= horizon) r.survived_to = step;
     if (k == horizon) r.found = true;
   }
-  if (horizon == 0) r.found = true;
   return r;
 }
 

@@ -133,6 +133,8 @@ TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
   {
     const WayThrough w = Search(Parse(CarFromBehind()), few);
     EXPECT_EQ(w.goal_step, 10);
+    EXPECT_EQ(w.goal_searched_to, 10);
+    EXPECT_EQ(w.survived_to, 30);  // the traffic is searched to its end all the same
   }
   // A region 170-190 m along the right lane within steps 40-60, past the traffic's last step
   // (30): from x = 50 at 20 m/s it is reached at step 60 holding that speed, sooner by speeding
@@ -157,6 +159,25 @@ TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
     EXPECT_EQ(w.goal_step, -1);
     EXPECT_EQ(w.goal_searched_to, 30);
   }
+}
+
+TEST(WayThroughTest, WithNoTrafficAfterTheStartTheWayThroughIsFoundAndTheGoalSearchedAlone) {
+  // The only car is there at step 0 alone, far off: nothing to get through. The road ends 32 m
+  // ahead of the ego at 30 m/s (TheRoadsEndIsAWallToo), so every way ends before the goal's
+  // window (steps 30-40) opens: no way to the goal, though `found`.
+  ScenarioXml xml;
+  AddStraightRoad(xml, 82)
+      .DynamicObstacle(9, 4.5, 1.8, Car(0, 1.75, 1, 0))
+      .Problem(100, {50, -1.75}, 0, 30, {GoalTimeOnlyXml(30, 40)});
+  WayThroughOptions few = Small();
+  few.max_states = 500;
+  const WayThrough w = Search(Parse(xml), few);
+  EXPECT_TRUE(w.found);
+  EXPECT_EQ(w.last_step, 0);
+  EXPECT_EQ(w.survived_to, 0);
+  EXPECT_EQ(w.goal_step, -1);
+  EXPECT_GT(w.goal_searched_to, 0);
+  EXPECT_LT(w.goal_searched_to, 30);
 }
 
 TEST(WayThroughTest, CappedStepsAreToldAndTheSearchStaysDeterministic) {

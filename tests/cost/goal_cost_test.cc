@@ -253,21 +253,29 @@ TEST_F(GoalCostTest, TheLeastMissIsExactForRegionsNearAndFar) {
   // One just past the samples' span whose least miss lies inside it, not at a window's end:
   // slowing at 3 m/s^2 toward [70, 80] with a speed of 15-20 m/s wanted (at 4.6 s: 1 + 2.734;
   // at 6 s, the window's end, 1 + 3.0).
+  // A candidate braking at 8 m/s^2 turns back at 2.5 s (its s not monotone); regions open at
+  // one end and an endless window too.
   int checked = 0, missed = 0;
-  for (const double a : {-3.0, -2.0, 0.0, 2.0}) {
-    for (const double s_lo : {-40.0, 50.0, 70.0, 150.0, 300.0, 1000.0}) {
+  for (const double a : {-8.0, -3.0, -2.0, 0.0, 2.0}) {
+    for (const auto& [s_lo, s_hi] : {std::pair{-40.0, -30.0},
+                                     {50.0, 60.0},
+                                     {70.0, 80.0},
+                                     {150.0, 160.0},
+                                     {300.0, 310.0},
+                                     {1000.0, 1010.0},
+                                     {100.0, kInf},
+                                     {-kInf, -10.0}}) {
       for (const auto& [t_lo, t_hi] :
-           {std::pair{0.0, 3.0}, {2.0, 8.0}, {0.0, 40.0}, {7.0, 9.0}, {0.0, 6.0}}) {
+           {std::pair{0.0, 3.0}, {2.0, 8.0}, {0.0, 40.0}, {7.0, 9.0}, {0.0, 6.0}, {1.0, kInf}}) {
         for (const auto& [v_lo, v_hi] :
              {std::pair{-kInf, kInf}, {25.0, 30.0}, {5.0, 8.0}, {15.0, 20.0}}) {
-          GoalRegion g = Box(s_lo, s_lo + 10, t_lo, t_hi);
+          GoalRegion g = Box(s_lo, s_hi, t_lo, t_hi);
           g.v_lo = v_lo;
           g.v_hi = v_hi;
           const Case c(20, {g}, a);
           const double dense = DenseMiss(c, g);
-          EXPECT_NEAR(Eval(c), dense, 2e-3)
-              << "a " << a << " s " << s_lo << " t [" << t_lo << ", " << t_hi << "] v [" << v_lo
-              << ", " << v_hi << "]";
+          EXPECT_NEAR(Eval(c), dense, 2e-3) << "a " << a << " s " << s_lo << " t [" << t_lo << ", "
+                                            << t_hi << "] v [" << v_lo << ", " << v_hi << "]";
           ++checked;
           missed += dense > 0;
         }
@@ -275,15 +283,31 @@ TEST_F(GoalCostTest, TheLeastMissIsExactForRegionsNearAndFar) {
     }
   }
   // Both kinds are in the grid: passed through and missed.
-  EXPECT_EQ(checked, 480);
-  EXPECT_GT(missed, 150);
-  EXPECT_LT(missed, 450);
+  EXPECT_EQ(checked, 960);
+  EXPECT_GT(missed, 300);
+  EXPECT_LT(missed, 900);
   {
     GoalRegion g = Box(70, 80, 0, 6);
     g.v_lo = 15;
     g.v_hi = 20;
     EXPECT_NEAR(Eval(Case(20, {g}, -3)), 1 + 2.734, 0.001);
   }
+}
+
+TEST_F(GoalCostTest, TheLastSampleCountsWhenTheWindowGoesOnPastIt) {
+  // At 0.4 m/s, 10-12.4 m past a region behind it ([-20, -10]), moving across from d = 11 to 5
+  // toward its side (d up to 4): the miss falls until the samples end (6 s) and grows after
+  // them (straight on, farther from the region), so the least lies at the last sample:
+  // 12.4 / 10 + 1 / 1.75, and 1 more for missing.
+  Case c(0.4, {});
+  for (int k = 0; k < kN; ++k) {
+    c.d[k] = 11 - 0.25 * k;
+    c.d_d[k] = -1;
+  }
+  c.goals = {Box(-20, -10, 0, 10)};
+  c.ctx.num_goals = 1;
+  c.ctx.goals = c.goals.data();
+  EXPECT_NEAR(Eval(c), 1 + 1.24 + 1 / 1.75, 1e-9);
 }
 
 }  // namespace

@@ -122,12 +122,15 @@ struct VerdictOptions {
 // it does not know is never met).
 bool MeetsGoal(const Scenario& scenario, const GoalState& goal, const KsState& state);
 
-// MeetsGoal for many states: the goal lanelets' polygons built once. `scenario` must outlive it.
+// MeetsGoal for many states: the goals copied and their lanelets' polygons built once (it keeps
+// no reference to `scenario`).
 class GoalTest {
  public:
   GoalTest(const Scenario& scenario, std::span<const GoalState> goals);
   // True when the state meets one of the goal states.
   bool MeetsAny(const KsState& state) const;
+  // The goal lanelets' polygons, by lanelet id.
+  const std::map<int, std::vector<Vec2>>& polygons() const { return polygons_; }
 
  private:
   std::vector<GoalState> goals_;

@@ -13,10 +13,11 @@
 // and speed is kept (deterministic).
 //
 // The search also tells whether a kept state meets one of the problem's goal states
-// (MeetsGoal): it goes on past the traffic's last step, on the road alone, until one does or
-// every goal's window has closed (at most max_steps). A way to the goal is the stronger
-// evidence: a trajectory that ends in a goal state is a solution (the checker reads it up to
-// its last state).
+// (MeetsGoal): it goes on past the last moving car's step (static obstacles and the road still
+// checked) until one does or every goal's window has closed (at most max_steps). A way to the
+// goal is the stronger evidence: a trajectory that ends in a goal state is a solution (the
+// checker reads it up to its last state). None found is weaker than none through the traffic:
+// past the traffic no step's cap is told (`exhaustive` speaks of the traffic's steps only).
 //
 // So the model is coarser than KS (five choices of each input a step, the grid, the cap): a way
 // found is strong evidence that the problem has a solution; none found, with `exhaustive` (no
@@ -48,7 +49,7 @@ struct WayThrough {
   bool exhaustive = true;    // no step was capped at max_states
   std::int64_t checked = 0;  // states checked for collision and road
   int goal_step = -1;        // the first step a kept state met a goal state; -1: none did
-  int goal_searched_to = 0;  // the last step searched for one (goal_step when found)
+  int goal_searched_to = 0;  // the last step searched for one: goal_step when found
 };
 
 // The search from problem.initial to the last step any dynamic obstacle exists (at most
