@@ -120,11 +120,12 @@ ReferenceReport EvaluateReference(const cr::Scenario& scenario, const cr::Planni
     auto c = cr::EvaluateCost(id, scenario, problem, vehicle, states);
     if (c.ok()) r.costs[id] = c->total;
   }
+  const cr::GoalTest goal(scenario, problem.goals);
   for (const cr::KsState& s : states) {
-    for (const cr::GoalState& g : problem.goals) {
-      if (cr::MeetsGoal(scenario, g, s)) r.goal_step = s.time_step;
+    if (goal.MeetsAny(s)) {
+      r.goal_step = s.time_step;
+      break;
     }
-    if (r.goal_step) break;
   }
   const cr::Verdict verdict = cr::CheckTrajectory(scenario, problem, vehicle, states);
   if (verdict.solved) {

@@ -257,10 +257,9 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       rescue.emplace(road, vp, dt, rescue_options);
     }
     run.stop_reason = "time";
+    const GoalTest goal(sc, problem.goals);
     for (int k = start; k < end; ++k) {
-      bool met = false;
-      for (const GoalState& g : problem.goals) met = met || MeetsGoal(sc, g, ego);
-      if (met) {
+      if (goal.MeetsAny(ego)) {
         run.stop_reason = "goal";
         break;
       }
@@ -408,11 +407,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       run.computation_s += cyc.plan_ms / 1000.0;
       if (run.stop_reason != "time") break;
     }
-    if (run.stop_reason == "time") {
-      bool met = false;
-      for (const GoalState& g : problem.goals) met = met || MeetsGoal(sc, g, ego);
-      if (met) run.stop_reason = "goal";
-    }
+    if (run.stop_reason == "time" && goal.MeetsAny(ego)) run.stop_reason = "goal";
     run.verdict = checker.Check(problem, run.trajectory);
     if (options.on_problem_end) options.on_problem_end(problem, run);
     out.problems.push_back(std::move(run));
