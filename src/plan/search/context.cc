@@ -124,8 +124,6 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
       kmin = std::min(kmin, k);
     }
   }
-  // The farthest across (m, |d|) that a candidate passing the limit checks may be (below).
-  double d_reach = 0;
   {
     // The speed prefilter's share: on a path at offset d the XY speed is at least
     // s' (1 - kappa d) (its part along the line), so at least s' (1 - K |d|max) with K the
@@ -142,7 +140,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     d = cfg.road.uniform ? std::max({d, std::abs(cfg.limits.d_min), std::abs(cfg.limits.d_max)})
                          : std::max(d, ws.edge_widest);
     d += 1.5;
-    d_reach = d;
+    ws.max_abs_d = d;  // the curve prefilter's reach across too
     const double share = 1.0 - k * d;
     ws.speed_share = Finite(share) && share >= 0.5 ? share : 0.0;
     ws.speed_reach = reach;
@@ -160,9 +158,6 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
           Finite(mid) && Finite(next) && Finite(prev) ? std::max({prev, mid, next}) : 0.0;
       prev = next;
     }
-    // The same reach across as the speed prefilter's (not the lane borders at the start: a
-    // lane that widens ahead, a pass on the oncoming lane or an overshoot goes past them).
-    ws.max_abs_d = d_reach;
   }
   for (int l = 0; l < cfg.road.num_lanes; ++l) {
     c.lane_center[l] = ws.lane_center[l];

@@ -106,10 +106,11 @@ struct Workspace {
   double edge_s0 = 0;
   std::vector<double> edge_lo, edge_hi;
   double edge_widest = 0;  // m: the largest |edge| of the table where a lane exists
-  // The line's largest |kappa| (1/m) over each kEdgeBin m from kappa_s0 (the edges' reach),
-  // and max_abs_d, the farthest across (m) that a candidate passing the limit checks may be
-  // (the speed prefilter's |d|max, BuildContext): the lattice's curve prefilter
-  // (Settings::curve_prefilter; filled only with it).
+  // The line's largest |kappa| (1/m) over each kEdgeBin m from kappa_s0 (the edges' reach;
+  // filled only with Settings::curve_prefilter), and max_abs_d, the farthest across (m) that a
+  // candidate passing the limit checks may be (the speed prefilter's |d|max, BuildContext; not
+  // the lane borders at the start: a lane that widens ahead, a pass on the oncoming lane or an
+  // overshoot goes past them): the lattice's curve prefilter.
   double kappa_s0 = 0;
   std::vector<double> abs_kappa;
   // The lattice's speed prefilter (Lattice::TooFastForTheVehicle): the share of s' that is at
