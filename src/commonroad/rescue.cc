@@ -98,12 +98,6 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
   ego_radius_ = std::hypot(half_length_, half_width_);
 }
 
-RescueStep Rescue::Step(const plan::Telemetry& t, const std::vector<double>& x,
-                        const std::vector<double>& y, const KsState& ego) {
-  Predict(t);
-  return Check(t, x, y, ego);
-}
-
 RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
                          const std::vector<double>& y, const KsState& ego) {
   RescueStep r;

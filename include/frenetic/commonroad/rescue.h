@@ -56,7 +56,7 @@ struct RescueOptions {
   double car_width = 2.0;
 };
 
-// What the rescue made of one cycle's path (Rescue::Step).
+// What the rescue made of one cycle's path (Rescue::Check, Rescue::Answer).
 struct RescueStep {
   enum class Why { kNone, kHit, kGoal, kNoPath };
   Why why = Why::kNone;  // kNone: the path is left as it is; kNoPath: the planner sent none
@@ -73,13 +73,10 @@ class Rescue {
   Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
          const RescueOptions& options = {});
 
-  // One cycle of the closed loop: the telemetry's cars predicted (Predict), then the path the
-  // planner sends for it (points every plan::kTickSeconds, the first one tick on) checked: a
-  // way (Next) when it hits a car, else a way to a goal (Next, goal_only) when GoalAtRisk; else
-  // (or when no way to the goal is found) the way is forgotten. `ego`: the vehicle's state.
-  RescueStep Step(const plan::Telemetry& t, const std::vector<double>& x,
-                  const std::vector<double>& y, const KsState& ego);
-  // Step's check alone, on the cars of the last Predict (t: the same telemetry).
+  // The path the planner sends for t (points every plan::kTickSeconds, the first one tick on)
+  // checked on the cars of the last Predict (of the same t): a way (Next) when it hits a car,
+  // else a way to a goal (Next, goal_only) when GoalAtRisk; else (or when no way to the goal is
+  // found) the way is forgotten. `ego`: the vehicle's state.
   RescueStep Check(const plan::Telemetry& t, const std::vector<double>& x,
                    const std::vector<double>& y, const KsState& ego);
   // The closed loop's answer to the path the planner sent, after Predict(t) and Holds(ego,
@@ -106,7 +103,7 @@ class Rescue {
   // future where it has one (a car to come appears at its start), else its row carried on at
   // its velocity (a car with no speed is a square of its longer side: its heading is unknown).
   // The boxes are laid out as the checks reach their steps, from t's futures: t must outlive the
-  // calls up to the next Predict (Step's own telemetry does).
+  // calls up to the next Predict (the closed loop's telemetry of the cycle does).
   void Predict(const plan::Telemetry& t);
 
   // The first step (1..steps) at which a path of points every plan::kTickSeconds (the first one
@@ -144,7 +141,7 @@ class Rescue {
   // path sent in its place.
   void Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const;
 
-  // Whether a path (as PathHit's, one that neither hits a car nor leaves the road: Step asks
+  // Whether a path (as PathHit's, one that neither hits a car nor leaves the road: Check asks
   // only then) meets no goal region of `goals` (in its window, with its speed and heading) while
   // every region's window closes within the path, or the path runs past the region's end.
   bool GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
@@ -192,7 +189,7 @@ class Rescue {
   // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
   // s along the road (from the hint s_hint).
   bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
-  // One walk along a path (PathHit's points and checks) for both of Step's questions: the step
+  // One walk along a path (PathHit's points and checks) for both of Check's questions: the step
   // it hits a car or leaves the road (0: none), and, up to there, whether a point meets a goal
   // region (the road past it is not checked), whether every speed is finite, and the last
   // point's time (s from now) and s.
