@@ -31,6 +31,8 @@ namespace {
 
 double Out(double x, double lo, double hi) { return std::max({lo - x, 0.0, x - hi}); }
 
+constexpr double kRounding = 1e-6;  // m
+
 class GoalCost : public CostTerm {
  public:
   std::vector<CostParamSpec> ParamSpecs() const override {
@@ -89,6 +91,28 @@ class GoalCost : public CostTerm {
     return best > 0 ? std::clamp(miss_ + best, 0.0, cap_) : 0.0;
   }
 
+  // Evaluate's value with each region's miss bounded by its s part alone, over the span of s
+  // the candidate covers (every sample, and the continuation to the window's close): one pass
+  // over the samples, no crossings. Where every region lies far past the candidate's reach (a
+  // goal kilometres on, a window it cannot make at its end speed) it is the value itself, so
+  // the planner's candidates rank by their other terms without evaluating this one for each.
+  double LowerBound(const CostContext& ctx, const CostInput& in) const override {
+    const int n = ctx.num_samples;
+    if (ctx.num_goals <= 0 || ctx.goals == nullptr || n < 1) return 0.0;
+    // First the span of the start, the end and the continuation's close alone (within the
+    // samples' span, so a region it meets bounds nothing: 0 at once, the usual case of a goal
+    // near), then, if none meets it, every sample's.
+    double best = Bound(ctx, in, std::min(in.s[0], in.s[n - 1]), std::max(in.s[0], in.s[n - 1]));
+    if (!(best > 0)) return 0.0;
+    double s_min = in.s[0], s_max = in.s[0];
+    for (int k = 1; k < n; ++k) {
+      s_min = std::min(s_min, in.s[k]);
+      s_max = std::max(s_max, in.s[k]);
+    }
+    best = Bound(ctx, in, s_min, s_max);
+    return best > 0 && std::isfinite(best) ? std::clamp(miss_ + best, 0.0, cap_) : 0.0;
+  }
+
   bool Sampled() const override { return true; }
   bool Expensive() const override { return true; }
 
@@ -137,6 +161,39 @@ class GoalCost : public CostTerm {
     // Out() of an absent part (infinite bounds) is 0.
     return Out(a.s, g.s_lo, g.s_hi) * inv_s_ + Out(Across(g, a), g.d_lo, g.d_hi) * inv_d_ +
            Out(a.v, g.v_lo, g.v_hi) * inv_v_ + Out(a.h, g.h_lo, g.h_hi) * inv_h_;
+  }
+  // LowerBound's least miss over the open regions with the samples' s within [s_min, s_max]:
+  // each region's s part alone, over that span and the continuation to its window's close (0
+  // when a region has no s interval; infinite when no window is left, as Miss).
+  double Bound(const CostContext& ctx, const CostInput& in, double s_min, double s_max) const {
+    const int n = ctx.num_samples;
+    const double t_end = (n - 1) * ctx.dt, s_end = in.s[n - 1], v_end = in.s_d[n - 1];
+    double best = std::numeric_limits<double>::infinity();
+    for (int g = 0; g < std::min(ctx.num_goals, kMaxGoalRegions); ++g) {
+      const GoalRegion& goal = ctx.goals[g];
+      if (!(goal.t_hi >= 0)) continue;  // its window has passed
+      // Miss's window; none left: Miss is infinite.
+      const double t0 = std::max(goal.t_lo, 0.0);
+      const double t1 = std::isfinite(goal.t_hi) ? goal.t_hi : t_end + 60.0;
+      if (!(t1 >= t0)) continue;
+      // An empty s interval (s_lo > s_hi) or none: no bound from s.
+      if (!(goal.s_lo <= goal.s_hi)) return 0.0;
+      double lo = s_min, hi = s_max;
+      if (t1 > t_end) {  // the continuation, straight on at the last speed until t1
+        const double s_far = s_end + v_end * (t1 - t_end);
+        lo = std::min(lo, s_far);
+        hi = std::max(hi, s_far);
+      }
+      // The distance outside the interval, less a micrometre for the rounding of Miss's
+      // interpolated states (a bound never above the value). The side region of a region
+      // crossed turned has the same s interval and costs `approach` more: no lower.
+      double miss = 0.0;
+      if (hi < goal.s_lo) miss = std::max(goal.s_lo - hi - kRounding, 0.0) * inv_s_;
+      if (lo > goal.s_hi) miss = std::max(lo - goal.s_hi - kRounding, 0.0) * inv_s_;
+      best = std::min(best, miss);
+      if (!(best > 0)) return 0.0;
+    }
+    return best;
   }
   // The least miss over the window, at its ends, the samples inside it and the crossings.
   double Miss(const CostContext& ctx, const CostInput& in, const GoalRegion& g) const {

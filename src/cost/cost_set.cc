@@ -64,17 +64,19 @@ double CostSet::Evaluate(const CostContext& ctx, const CostInput& in, double* pe
 
 double CostSet::LowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
                            LaneMemo* memo) const {
-  return BoundSkipping(expensive_, ctx, in, cheap, memo);
+  return BoundSkipping(expensive_, true, ctx, in, cheap, memo);
 }
 
 double CostSet::CoarseLowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
                                  LaneMemo* memo) const {
-  return BoundSkipping(coarse_skip_, ctx, in, cheap, memo);
+  return BoundSkipping(coarse_skip_, false, ctx, in, cheap, memo);
 }
 
-double CostSet::BoundSkipping(const std::vector<char>& skip, const CostContext& ctx,
-                              const CostInput& in, double* cheap, LaneMemo* memo) const {
-  // Evaluate's sum, term for term, with 0 in place of the skipped terms' values.
+double CostSet::BoundSkipping(const std::vector<char>& skip, bool expensive_bounds,
+                              const CostContext& ctx, const CostInput& in, double* cheap,
+                              LaneMemo* memo) const {
+  // Evaluate's sum, term for term, with 0 in place of the skipped terms' values (an Expensive()
+  // term's LowerBound with expensive_bounds).
   double total = 0;
   const int n = size();
   const int lane = in.target_lane;
@@ -82,7 +84,7 @@ double CostSet::BoundSkipping(const std::vector<char>& skip, const CostContext& 
   for (int i = 0; i < n; ++i) {
     double v = 0.0;
     if (skip[i]) {
-      v = 0.0;
+      v = expensive_bounds && expensive_[i] ? terms_[i]->LowerBound(ctx, in) : 0.0;
     } else if (memo_lane && i < LaneMemo::kMaxTerms && lane_only_[i]) {
       if (!memo->known_[i][lane]) {
         memo->value_[i][lane] = terms_[i]->Evaluate(ctx, in);
@@ -100,12 +102,16 @@ double CostSet::BoundSkipping(const std::vector<char>& skip, const CostContext& 
 
 double CostSet::CompleteLowerBound(const CostContext& ctx, const CostInput& in,
                                    double* cheap) const {
-  // LowerBound's sum from the values: the coarse bound's, the Sampled() terms' now, and 0 for
-  // the Expensive() ones (as CoarseLowerBound left them).
+  // LowerBound's sum from the values: the coarse bound's, the Sampled() terms' now, and the
+  // Expensive() ones' LowerBound (CoarseLowerBound left them 0).
   double total = 0;
   const int n = size();
   for (int i = 0; i < n; ++i) {
-    if (coarse_skip_[i] && !expensive_[i]) cheap[i] = terms_[i]->Evaluate(ctx, in);
+    if (expensive_[i]) {
+      cheap[i] = terms_[i]->LowerBound(ctx, in);
+    } else if (coarse_skip_[i]) {
+      cheap[i] = terms_[i]->Evaluate(ctx, in);
+    }
     total += weights_[i] * cheap[i];
   }
   return total;
@@ -122,13 +128,10 @@ double CostSet::EvaluateWithCheap(const CostContext& ctx, const CostInput& in,
   return total;
 }
 
-double CostSet::SumKnown(const double* values, std::uint64_t known) const {
+double CostSet::SumOf(const double* values) const {
   double total = 0;
   const int n = size();
-  for (int i = 0; i < n; ++i) {
-    const bool unknown = expensive_[i] && (i >= 64 || ((known >> i) & 1) == 0);
-    total += weights_[i] * (unknown ? 0.0 : values[i]);
-  }
+  for (int i = 0; i < n; ++i) total += weights_[i] * values[i];
   return total;
 }
 

@@ -186,6 +186,11 @@ TEST_P(CostContractTest, FiniteNonNegativeAndDeterministic) {
     ASSERT_TRUE(std::isfinite(a)) << "case " << i;
     ASSERT_GE(a, 0.0) << "case " << i;
     ASSERT_EQ(a, b) << "case " << i;
+    // The bound an expensive term gives in its place: finite, >= 0, never above its value.
+    const double lower = term->LowerBound(f.ctx, f.in);
+    ASSERT_TRUE(std::isfinite(lower)) << "case " << i;
+    ASSERT_GE(lower, 0.0) << "case " << i;
+    ASSERT_LE(lower, a) << "case " << i;
   }
 }
 
@@ -353,10 +358,10 @@ TEST(CostSetTest, CoarseBoundCompletesToTheLowerBound) {
   }
 }
 
-// CostSet::SumKnown over every registered term: with no expensive term known it is LowerBound,
-// with some of them a bound between LowerBound and Evaluate, with all of them Evaluate, each bit
-// for bit where it is equal.
-TEST(CostSetTest, SumKnownClimbsFromTheLowerBoundToTheCost) {
+// CostSet::SumOf over every registered term: from the bound's values (each expensive term's
+// LowerBound) it is LowerBound, with some expensive terms' values in a bound between LowerBound
+// and Evaluate, with all of them Evaluate, each bit for bit where it is equal.
+TEST(CostSetTest, SumOfClimbsFromTheLowerBoundToTheCost) {
   std::vector<CostTermConfig> terms;
   for (const std::string& name : CostRegistry::Global().Names()) {
     terms.push_back({name, 0.5 + terms.size(), {}});
@@ -374,13 +379,15 @@ TEST(CostSetTest, SumKnownClimbsFromTheLowerBoundToTheCost) {
   int between = 0;
   for (int i = 0; i < 500; ++i) {
     const Fixture f = RandomFixture(rng);
-    std::vector<double> values(n);
+    std::vector<double> values(n), bounds(n);
     const double cost = (*set)->Evaluate(f.ctx, f.in, values.data());
-    const double lower = (*set)->LowerBound(f.ctx, f.in);
+    const double lower = (*set)->LowerBound(f.ctx, f.in, bounds.data());
     if (std::isnan(cost)) continue;
-    ASSERT_EQ((*set)->SumKnown(values.data(), 0), lower) << "case " << i;
-    ASSERT_EQ((*set)->SumKnown(values.data(), ~std::uint64_t{0}), cost) << "case " << i;
-    const double one = (*set)->SumKnown(values.data(), std::uint64_t{1} << expensive.back());
+    ASSERT_EQ((*set)->SumOf(bounds.data()), lower) << "case " << i;
+    ASSERT_EQ((*set)->SumOf(values.data()), cost) << "case " << i;
+    for (int t : expensive) ASSERT_LE(bounds[t], values[t]) << (*set)->name(t) << " case " << i;
+    bounds[expensive.back()] = values[expensive.back()];
+    const double one = (*set)->SumOf(bounds.data());
     ASSERT_LE(lower, one) << "case " << i;
     ASSERT_LE(one, cost) << "case " << i;
     between += lower < one && one < cost;

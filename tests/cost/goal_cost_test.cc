@@ -276,6 +276,7 @@ TEST_F(GoalCostTest, TheLeastMissIsExactForRegionsNearAndFar) {
           const double dense = DenseMiss(c, g);
           EXPECT_NEAR(Eval(c), dense, 2e-3) << "a " << a << " s " << s_lo << " t [" << t_lo << ", "
                                             << t_hi << "] v [" << v_lo << ", " << v_hi << "]";
+          EXPECT_LE(term_->LowerBound(c.ctx, c.in), Eval(c)) << "a " << a << " s " << s_lo;
           ++checked;
           missed += dense > 0;
         }
@@ -292,6 +293,37 @@ TEST_F(GoalCostTest, TheLeastMissIsExactForRegionsNearAndFar) {
     g.v_hi = 20;
     EXPECT_NEAR(Eval(Case(20, {g}, -3)), 1 + 2.734, 0.001);
   }
+}
+
+TEST_F(GoalCostTest, TheBoundIsTheValueWhereTheRegionIsOutOfReach) {
+  // 20 m/s for 6 s, then on at 20 m/s to the window's close at 40 s: 800 m at most, 200 m short
+  // of [1000, 1010] (1 + 20, capped: 10).
+  const Case far(20, {Box(1000, 1010, 0, 40)});
+  EXPECT_EQ(term_->LowerBound(far.ctx, far.in), 10.0);
+  EXPECT_EQ(Eval(far), 10.0);
+  // 90 m short of [890, 900] at 40 s: 1 + 9 (less the micrometre kept for rounding), the
+  // value too.
+  const Case short_of(20, {Box(890, 900, 0, 40)});
+  EXPECT_NEAR(term_->LowerBound(short_of.ctx, short_of.in), 10.0, 1e-6);
+  EXPECT_NEAR(Eval(short_of), 10.0, 1e-9);
+  // Reached, or beside the lane only: no bound from s (0), while the value is the lateral miss.
+  const Case reached(20, {Box(50, 60, 0, 40)});
+  EXPECT_EQ(term_->LowerBound(reached.ctx, reached.in), 0.0);
+  EXPECT_EQ(Eval(reached), 0.0);
+  GoalRegion beside = Box(50, 60, 0, 40);
+  beside.d_lo = 6;
+  beside.d_hi = 10;
+  const Case across(20, {beside});
+  EXPECT_EQ(term_->LowerBound(across.ctx, across.in), 0.0);
+  EXPECT_NEAR(Eval(across), 1 + 4 / 1.75, 1e-9);
+  // Two regions: the nearer one bounds (behind the start by 40 m, window open: 1 + 4).
+  const Case two(20, {Box(1000, 1010, 0, 40), Box(-50, -40, 0, 40)});
+  EXPECT_NEAR(term_->LowerBound(two.ctx, two.in), 5.0, 1e-6);
+  EXPECT_NEAR(Eval(two), 5.0, 1e-9);
+  // A window already closed, or none left: nothing (as the value).
+  const Case closed(20, {Box(1000, 1010, -5, -1)});
+  EXPECT_EQ(term_->LowerBound(closed.ctx, closed.in), 0.0);
+  EXPECT_EQ(Eval(closed), 0.0);
 }
 
 TEST_F(GoalCostTest, TheLastSampleCountsWhenTheWindowGoesOnPastIt) {

@@ -51,23 +51,24 @@ class CostSet {
   // Weighted sum over the terms in config order. When per_term is not null it receives the
   // unweighted value of each term (size() entries). Does not allocate.
   double Evaluate(const CostContext& ctx, const CostInput& in, double* per_term = nullptr) const;
-  // The same weighted sum with every Expensive() term taken as 0: never more than Evaluate(ctx,
+  // The same weighted sum with every Expensive() term taken as its CostTerm::LowerBound (0 for
+  // most): never more than Evaluate(ctx,
   // in) (terms and weights are >= 0, and rounded addition and multiplication are monotone), so a
   // candidate whose bound is above another's exact total cannot rank before it. NaN when a
   // cheap term is NaN (Evaluate is then NaN too). Does not allocate.
   // When cheap is not null it receives the unweighted value of each term that is not
-  // Expensive() (0 for those that are; size() entries).
+  // Expensive() (the LowerBound of those that are; size() entries).
   // With memo (not null), a LaneOnly() term is evaluated once per target lane while the memo
   // is not cleared: the same values.
   double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr,
                     LaneMemo* memo = nullptr) const;
-  // LowerBound's sum with the Sampled() terms taken as 0 too: never more than LowerBound(ctx,
-  // in), by the same argument. cheap (not null) receives the values of the terms it evaluates
+  // LowerBound's sum with the Sampled() terms taken as 0, and the Expensive() ones as 0 in place
+  // of their LowerBound: never more than LowerBound(ctx, in), by the same argument. cheap (not null) receives the values of the terms it evaluates
   // and 0 for the others; memo as LowerBound's. Does not allocate.
   double CoarseLowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
                           LaneMemo* memo = nullptr) const;
   // Completes a CoarseLowerBound of the same input: evaluates the Sampled() terms that are not
-  // Expensive() into cheap and returns LowerBound(ctx, in) from cheap's values, the same sum
+  // Expensive(), and the Expensive() terms' LowerBound, into cheap and returns LowerBound(ctx, in) from cheap's values, the same sum
   // term for term; cheap then holds what LowerBound would have put there. Does not allocate.
   double CompleteLowerBound(const CostContext& ctx, const CostInput& in, double* cheap) const;
   // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
@@ -75,20 +76,22 @@ class CostSet {
   double EvaluateWithCheap(const CostContext& ctx, const CostInput& in, const double* cheap) const;
   // The Expensive() terms' indices, in config order.
   const std::vector<int>& expensive_terms() const { return expensive_terms_; }
-  // Evaluate's sum from each term's unweighted value in values[i], with every Expensive() term
-  // whose bit i in `known` is clear (and every one from index 64 on) taken as 0: never more than
-  // Evaluate of the input the values came from (as LowerBound), and equal to it, bit for bit,
-  // when every Expensive() term is known (the same products, added in the same order).
-  double SumKnown(const double* values, std::uint64_t known) const;
+  // Evaluate's sum from each term's unweighted value in values[i], where an Expensive() term not
+  // evaluated yet may hold a lower bound of its value instead (its LowerBound, as LowerBound and
+  // CompleteLowerBound leave it in cheap): with those bounds and no Expensive() term evaluated it
+  // is LowerBound, bit for bit; with every one evaluated it is Evaluate, bit for bit (the same
+  // products, added in the same order); in between, between the two.
+  double SumOf(const double* values) const;
 
  private:
   CostSet() = default;
   std::vector<std::string> names_;
   std::vector<double> weights_;
   std::vector<std::unique_ptr<CostTerm>> terms_;
-  // LowerBound and CoarseLowerBound: the terms in `skip` are taken as 0.
-  double BoundSkipping(const std::vector<char>& skip, const CostContext& ctx, const CostInput& in,
-                       double* cheap, LaneMemo* memo) const;
+  // LowerBound and CoarseLowerBound: the terms in `skip` are taken as 0, or with
+  // expensive_bounds the Expensive() ones as their LowerBound.
+  double BoundSkipping(const std::vector<char>& skip, bool expensive_bounds, const CostContext& ctx,
+                       const CostInput& in, double* cheap, LaneMemo* memo) const;
   std::vector<char> expensive_, lane_only_;  // each term's Expensive() and LaneOnly()
   std::vector<int> expensive_terms_;         // the indices of the Expensive() ones
   std::vector<char> coarse_skip_;  // Expensive() or Sampled(): what CoarseLowerBound leaves out

@@ -240,6 +240,14 @@ class CostTerm {
   // the term out of a first, cheap lower bound of the total (CostSet::LowerBound) and evaluate it
   // only for the candidates that bound cannot rule out. Changes no value.
   virtual bool Expensive() const { return false; }
+  // For an Expensive() term: a cheap lower bound of Evaluate for the same input (finite, >= 0,
+  // never above Evaluate; NaN only where Evaluate is), which the bounds that leave the term out
+  // (CostSet::LowerBound, SumOf) count in its place. 0 by default. Must not allocate.
+  virtual double LowerBound(const CostContext& ctx, const CostInput& in) const {
+    (void)ctx;
+    (void)in;
+    return 0.0;
+  }
   // Whether Evaluate reads the input sample by sample (its cost grows with num_samples), where
   // the others read a few numbers (durations, the end state, the jerk integrals, the target
   // lane). A planner may then leave such a term out of a coarser first bound too

@@ -29,7 +29,7 @@ Scorer::Scorer(const Settings& cfg, const cost::CostSet& costs, Workspace& ws,
   stage_.assign(cap, 0);
   exp_order_ = costs_.expensive_terms();
   exp_sum_.assign(costs_.size(), 0.0);
-  if (!exp_order_.empty() && (exp_order_.back() >= 64 || exp_order_.size() > 255)) {
+  if (exp_order_.size() > 255) {
     exp_order_.clear();
   }
 }
@@ -148,7 +148,7 @@ void Scorer::Resolve(int c) {
   }
   // The expensive terms Advance has not evaluated yet, then EvaluateWithCheap's sum.
   while (stage_[c] < static_cast<int>(exp_order_.size())) EvaluateNextExpensive(c, in);
-  const double v = costs_.SumKnown(values, ~std::uint64_t{0});
+  const double v = costs_.SumOf(values);
   ws_.cand_cost[c] = Finite(v) ? v : 1e300;
 }
 
@@ -168,9 +168,8 @@ double Scorer::Advance(int c) {
     return ws_.cand_cost[c];
   }
   EvaluateNextExpensive(c, InputFor(ws_.cand_lon[c], ws_.cand_lat[c]));
-  std::uint64_t known = 0;
-  for (int q = 0; q < stage_[c]; ++q) known |= std::uint64_t{1} << exp_order_[q];
-  const double b = costs_.SumKnown(&cheap_[static_cast<std::size_t>(c) * costs_.size()], known);
+  // The terms not evaluated yet count with their lower bounds (Tighten put them in cheap_).
+  const double b = costs_.SumOf(&cheap_[static_cast<std::size_t>(c) * costs_.size()]);
   // Not finite: the exact cost is 1e300 (a term is NaN or infinite); never above it.
   return Finite(b) ? std::min(b, 1e300) : (Resolve(c), ws_.cand_cost[c]);
 }

@@ -153,13 +153,13 @@ class Scorer {
   std::vector<char> resolved_;  // per candidate: ws.cand_cost is exact
   std::vector<char> complete_;  // per candidate: bound_ is the cheap terms' (not the coarse one)
   // Per candidate, the cheap terms' values computed for its bound ([c * terms + t]; the
-  // Sampled() ones once it is complete; the expensive ones as Advance evaluates them):
-  // Resolve() evaluates only the expensive ones still missing.
+  // Sampled() ones once it is complete; the expensive ones' LowerBound then, their values as
+  // Advance evaluates them): Resolve() evaluates only the expensive ones still missing.
   std::vector<double> cheap_;
   // Advance: per candidate, how many of the expensive terms (in exp_order_) are in cheap_; the
   // order, and the weighted values of each term evaluated this cycle (exp_sum_, by term index),
-  // which order the next cycle's. Off (empty order: Resolve evaluates them all at once) when a
-  // term's index is beyond SumKnown's 64 bits.
+  // which order the next cycle's. Off (empty order: Resolve evaluates them all at once) when
+  // there are more than stage_ counts.
   std::vector<std::uint8_t> stage_;
   std::vector<int> exp_order_;
   std::vector<double> exp_sum_;
