@@ -52,8 +52,8 @@ class CostSet {
   // unweighted value of each term (size() entries). Does not allocate.
   double Evaluate(const CostContext& ctx, const CostInput& in, double* per_term = nullptr) const;
   // The same weighted sum with every Expensive() term taken as its CostTerm::LowerBound (0 for
-  // most): never more than Evaluate(ctx,
-  // in) (terms and weights are >= 0, and rounded addition and multiplication are monotone), so a
+  // most): never more than Evaluate(ctx, in) (terms and weights are >= 0, the bounds are not
+  // above the values, and rounded addition and multiplication are monotone), so a
   // candidate whose bound is above another's exact total cannot rank before it. NaN when a
   // cheap term is NaN (Evaluate is then NaN too). Does not allocate.
   // When cheap is not null it receives the unweighted value of each term that is not
@@ -63,13 +63,15 @@ class CostSet {
   double LowerBound(const CostContext& ctx, const CostInput& in, double* cheap = nullptr,
                     LaneMemo* memo = nullptr) const;
   // LowerBound's sum with the Sampled() terms taken as 0, and the Expensive() ones as 0 in place
-  // of their LowerBound: never more than LowerBound(ctx, in), by the same argument. cheap (not null) receives the values of the terms it evaluates
-  // and 0 for the others; memo as LowerBound's. Does not allocate.
+  // of their LowerBound: never more than LowerBound(ctx, in), by the same argument. cheap (not
+  // null) receives the values of the terms it evaluates and 0 for the others; memo as
+  // LowerBound's. Does not allocate.
   double CoarseLowerBound(const CostContext& ctx, const CostInput& in, double* cheap,
                           LaneMemo* memo = nullptr) const;
   // Completes a CoarseLowerBound of the same input: evaluates the Sampled() terms that are not
-  // Expensive(), and the Expensive() terms' LowerBound, into cheap and returns LowerBound(ctx, in) from cheap's values, the same sum
-  // term for term; cheap then holds what LowerBound would have put there. Does not allocate.
+  // Expensive(), and the Expensive() terms' LowerBound, into cheap and returns LowerBound(ctx,
+  // in) from cheap's values, the same sum term for term; cheap then holds what LowerBound would
+  // have put there. Does not allocate.
   double CompleteLowerBound(const CostContext& ctx, const CostInput& in, double* cheap) const;
   // Evaluate(ctx, in) from the cheap terms' values LowerBound kept for the same input: only the
   // Expensive() terms are evaluated; the same sum, term for term. Does not allocate.
