@@ -33,6 +33,7 @@
 #include "frenetic/commonroad/solution.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/tune/cluster.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -295,7 +296,7 @@ int Print(const Args& a, const Setup& setup, const std::vector<FileReport>& resu
     json scenarios = json::array();
     for (const FileReport& f : results) scenarios.push_back(FileJson(f));
     const json out = {{"scenarios", scenarios}, {"summary", SummaryJson(summary, settings)}};
-    std::printf("%s\n", out.dump().c_str());
+    std::printf("%s\n", JsonText(out).c_str());
   } else {
     for (const FileReport& f : results) std::printf("%s", FileText(f).c_str());
     std::printf("%s", SummaryText(summary, settings).c_str());

@@ -23,6 +23,7 @@
 #include "frenetic/sim/scenario.h"
 #include "frenetic/sim/world.h"
 #include "frenetic/units.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -145,7 +146,7 @@ int Drive(const DriveArgs& a) {
     }
     auto report = DriveOverNetwork(*world, *scenario, seed, limits, connect);
     if (!report.ok()) return Fail(report.message());
-    std::printf("%s", a.json ? (report->ToJson().dump() + "\n").c_str() : report->ToText().c_str());
+    std::printf("%s", a.json ? (JsonText(report->ToJson()) + "\n").c_str() : report->ToText().c_str());
     return 0;
   }
 
@@ -181,7 +182,7 @@ int Drive(const DriveArgs& a) {
         sim::RunEpisodes(*world, *scenario, seed, a.episodes, a.jobs, limits, factory, options);
     if (!agg.ok()) return Fail(agg.message());
     if (a.json) {
-      std::printf("%s\n", agg->ToJson().dump().c_str());
+      std::printf("%s\n", JsonText(agg->ToJson()).c_str());
     } else {
       std::printf("%s", agg->ToText().c_str());
     }
@@ -221,7 +222,7 @@ int Drive(const DriveArgs& a) {
   auto report = sim::RunEpisode(*world, *scenario, seed, limits, **probe, options);
   if (!report.ok()) return Fail(report.message());
   if (a.json) {
-    std::printf("%s\n", report->ToJson().dump().c_str());
+    std::printf("%s\n", JsonText(report->ToJson()).c_str());
   } else {
     std::printf("%s", report->ToText().c_str());
   }

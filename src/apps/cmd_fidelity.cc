@@ -20,6 +20,7 @@
 #include "frenetic/eval/fidelity.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/world.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -186,7 +187,7 @@ int RunFidelity(const FidelityArgs& args) {
           {{"check", q.check}, {"quirk", q.name}, {"count", q.count}, {"note", q.note}});
     }
     j["wall_seconds"] = seconds;
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", JsonText(j, 2).c_str());
     return ok ? 0 : 1;
   }
 

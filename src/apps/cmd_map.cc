@@ -14,6 +14,7 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/map/track_generator.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -90,7 +91,7 @@ int RunMapCheck(const MapCheckArgs& args) {
         {"max_kappa_step_per_m", max_dkappa_step},
         {"fit_seconds", fit_seconds},
     };
-    std::printf("%s\n", j.dump().c_str());
+    std::printf("%s\n", JsonText(j).c_str());
     return 0;
   }
   std::printf("map                      %s\n", path.c_str());

@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "frenetic/record/reader.h"
 #include "frenetic/report/page.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -39,7 +40,7 @@ std::string Verdict(const record::RunData& run) {
   if (!f.is_object() || !f.contains("solved") || !f["solved"].is_boolean()) return "";
   if (f["solved"].get<bool>()) {
     return "; solved, goal at step " +
-           (f.contains("goal_step") ? f["goal_step"].dump() : std::string("?"));
+           (f.contains("goal_step") ? JsonText(f["goal_step"]) : std::string("?"));
   }
   std::string out = "; NOT solved:";
   if (f.contains("failures") && f["failures"].is_array()) {
@@ -47,7 +48,7 @@ std::string Verdict(const record::RunData& run) {
       if (!e.is_object()) continue;
       const bool named = e.contains("kind") && e["kind"].is_string();
       out += " " + (named ? e["kind"].get<std::string>() : std::string("?")) + " at step " +
-             (e.contains("step") ? e["step"].dump() : std::string("?"));
+             (e.contains("step") ? JsonText(e["step"]) : std::string("?"));
     }
   }
   return out;
@@ -84,7 +85,7 @@ int RunReport(const ReportArgs& args) {
                           {"incidents", run->incidents.size()},
                           {"footer", run->has_footer},
                           {"sim_seconds", std::round((run->t.back() - run->t.front()) * 1000) / 1000}};
-    std::printf("%s\n", out.dump().c_str());
+    std::printf("%s\n", JsonText(out).c_str());
   } else {
     std::printf("wrote %s (%.1f MB): %d exchanges over %.1f s, %zu cycles with candidates, "
                 "%zu incidents, %d lines skipped%s%s\n",

@@ -14,6 +14,7 @@
 #include "frenetic/tune/cluster.h"
 #include "frenetic/tune/suite.h"
 #include "frenetic/tune/tuner.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -122,7 +123,7 @@ int RunTune(const TuneArgs& args) {
     j["wall_s"] = wall_s;
     j["output"] = args.output;
     j["tuned_config"] = result->tuned_yaml;
-    std::printf("%s\n", j.dump().c_str());
+    std::printf("%s\n", JsonText(j).c_str());
   } else {
     std::printf("%s", result->ToTable().c_str());
     std::printf("wall time %.1f s on %d rank(s)\n", wall_s, cluster.size());

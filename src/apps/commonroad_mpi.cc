@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frenetic/json_text.h"
+
 namespace frenetic::apps::commonroad_cli {
 
 using nlohmann::json;
@@ -217,7 +219,7 @@ FileReport FileFrom(const json& j) {
 std::string Serialise(const std::vector<FileReport>& reports, const std::vector<int>& indices) {
   json out = json::array();
   for (int i : indices) out.push_back({{"index", i}, {"report", FileWire(reports.at(i))}});
-  return out.dump();
+  return JsonText(out);
 }
 
 Status Deserialise(std::string_view text, std::vector<FileReport>* reports) {

@@ -17,6 +17,7 @@
 #include "frenetic/record/schema.h"
 #include "frenetic/record/writer.h"
 #include "frenetic/units.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -191,7 +192,7 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
               {key::kCarWidth, vp.width},
               {key::kRoad, RoadJson(road)},
               {key::kGoals, GoalsJson(scenario_, in.problem)}};
-    writer_->WriteText(h.dump());
+    writer_->WriteText(JsonText(h));
     auto planner = plan::MakePlanner("search", in.config, in.road);
     if (!planner.ok()) {
       spdlog::warn("record {}: no planner to trace the candidates ({}); they are left out", path_,
@@ -248,7 +249,7 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
         {key::kPlan, record::PlanJson(status, summary, summary.ms_total, scale, candidates)},
         {key::kMetrics, {{"speed_mph", Round(speed * units::kMpsToMph, 4)}, {"lane", lane}}},
         {key::kIncidents, json::array()}};
-    *line += e.dump();
+    *line += JsonText(e);
   });
   if (index_ % kDrainLines == 0) {
     if (const Status st = writer_->status(); !st.ok()) {
@@ -303,7 +304,7 @@ void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun&
         {"p99", Round(Percentile(ms, 0.99), 4)},
         {"max", Round(ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end()), 4)}}},
       {"plan_fallbacks", fallbacks}};
-  writer_->WriteText(json({{key::kType, key::kFooter}, {key::kReport, report}}).dump(),
+  writer_->WriteText(JsonText(json({{key::kType, key::kFooter}, {key::kReport, report}})),
                      /*last=*/true);
   const Status st = writer_->status();
   writer_.reset();

@@ -28,6 +28,48 @@ std::string Quote(std::string_view text) {
 
 }  // namespace
 
+std::string Printable(std::string_view text) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  const auto cont = [&](std::size_t i, unsigned lo = 0x80, unsigned hi = 0xBF) {
+    return i < text.size() && byte(i) >= lo && byte(i) <= hi;
+  };
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned c = byte(i);
+    // The length of a well-formed UTF-8 sequence starting at i (RFC 3629: no overlong forms,
+    // no surrogates, nothing above U+10FFFF), 0 when there is none.
+    std::size_t n = 0;
+    if (c >= 0x20 && c < 0x7F) {
+      n = 1;
+    } else if (c >= 0xC2 && c <= 0xDF) {
+      n = cont(i + 1) ? 2 : 0;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      const bool second = c == 0xE0 ? cont(i + 1, 0xA0) : c == 0xED ? cont(i + 1, 0x80, 0x9F)
+                                                                     : cont(i + 1);
+      n = second && cont(i + 2) ? 3 : 0;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      const bool second = c == 0xF0 ? cont(i + 1, 0x90) : c == 0xF4 ? cont(i + 1, 0x80, 0x8F)
+                                                                     : cont(i + 1);
+      n = second && cont(i + 2) && cont(i + 3) ? 4 : 0;
+    }
+    if (n > 0) {
+      out.append(text.substr(i, n));
+      i += n;
+    } else if (c == '\n' || c == '\r' || c == '\t') {
+      out += ' ';
+      ++i;
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 0xF];
+      ++i;
+    }
+  }
+  return out;
+}
+
 StatusOr<std::string> ReadXmlFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return Status::Error(path + ": not a file");
@@ -109,8 +151,7 @@ std::string XmlSource::Path(const pugi::xml_node& node) const {
 Status XmlSource::Error(const pugi::xml_node& node, std::string_view message) const {
   std::string text = source_ + ":" + std::to_string(Line(node)) + ": " + Path(node) + ": ";
   text += message;
-  std::replace(text.begin(), text.end(), '\n', ' ');
-  return Status::Error(std::move(text));
+  return Status::Error(Printable(text));
 }
 
 Status XmlSource::Child(const pugi::xml_node& node, const char* name, pugi::xml_node* out) const {

@@ -17,6 +17,11 @@ namespace frenetic::commonroad {
 // error (the scenario and the solution loaders).
 StatusOr<std::string> ReadXmlFile(const std::string& path);
 
+// `text` fit for a one-line message in a terminal, a log or JSON: its well-formed UTF-8 as it
+// is, a newline, carriage return or tab as a space, and every other control character or byte
+// that is not well-formed UTF-8 as \xNN (a mangled file may hold any bytes).
+std::string Printable(std::string_view text);
+
 // The XML text and its name. Every Status it returns is one line:
 //   "<source>:<line>: <path>: <message>"
 // where <path> names the element and its ancestors below the root, with their ids, e.g.

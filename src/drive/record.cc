@@ -10,6 +10,7 @@
 #include "frenetic/record/schema.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/protocol.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::sim {
 namespace {
@@ -100,18 +101,18 @@ void FormatExchange(int index, double t, const std::string& telemetry_json,
   // type, the cycle and the time.
   *line += '{';
   AppendKey(key::kType, line);
-  *line += nlohmann::json(key::kExchange).dump();
+  *line += JsonText(nlohmann::json(key::kExchange));
   *line += ',';
   AppendKey(key::kCycle, line);
   *line += std::to_string(index);
   *line += ',';
   AppendKey(key::kTime, line);
-  *line += nlohmann::json(t).dump();
+  *line += JsonText(nlohmann::json(t));
   *line += ',';
   AppendKey(key::kTelemetry, line);
   *line += telemetry_json.empty() ? "null" : telemetry_json;
   *line += ",";
-  *line += rest.dump().substr(1);
+  *line += JsonText(rest).substr(1);
 }
 
 }  // namespace
@@ -192,7 +193,7 @@ void RecordWriter::WriteHeader(const Simulator& sim, const std::string& planner_
                       {key::kCarLength, sc.car_length},
                       {key::kCarWidth, sc.car_width}};
   if (!connect_url.empty()) h[key::kConnect] = connect_url;
-  writer_->WriteText(h.dump());
+  writer_->WriteText(JsonText(h));
 }
 
 void RecordWriter::WriteExchange(int index, double t, const std::string& telemetry_json,
@@ -242,7 +243,7 @@ void RecordWriter::WriteRemoteExchange(int index, double t, const std::string& t
 void RecordWriter::WriteFooter(const DriveReport& report) {
   nlohmann::json f = {{key::kType, key::kFooter}, {key::kReport, report.ToJson()}};
   if (!timing_) f[key::kReport]["plan_ms"] = {{"p50", 0}, {"p99", 0}, {"max", 0}};
-  writer_->WriteText(f.dump(), /*last=*/true);
+  writer_->WriteText(JsonText(f), /*last=*/true);
 }
 
 }  // namespace frenetic::sim

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "frenetic/check.h"
+#include "frenetic/json_text.h"
 #include "report/assets.h"
 
 namespace frenetic::report {
@@ -36,7 +37,7 @@ class JsonOut {
   }
   JsonOut& Key(std::string_view key) {
     Sep();
-    out_ += nlohmann::json(std::string(key)).dump();
+    out_ += JsonText(nlohmann::json(std::string(key)));
     out_ += ':';
     fresh_ = true;
     return *this;
@@ -54,7 +55,7 @@ class JsonOut {
   }
   JsonOut& String(std::string_view s) {
     Sep();
-    out_ += nlohmann::json(std::string(s)).dump();
+    out_ += JsonText(nlohmann::json(std::string(s)));
     return *this;
   }
   JsonOut& Json(std::string_view raw) {  // an already serialised JSON value

@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "frenetic/tune/tuner.h"
+#include "frenetic/json_text.h"
 
 namespace frenetic::tune {
 namespace {
@@ -205,7 +206,7 @@ class Search {
                         {"values", values},     {"params", params},
                         {"objective", m.objective}, {"components", m.ToJson()}};
     if (x != nullptr) j["x"] = *x;
-    *log_ << j.dump() << "\n";
+    *log_ << JsonText(j) << "\n";
     log_->flush();  // a kill loses at most the line being written
   }
 

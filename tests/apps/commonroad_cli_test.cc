@@ -312,6 +312,40 @@ TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {
   EXPECT_EQ(doc.at("summary").at("unreadable_files"), 1);
 }
 
+// Bytes that are not text, in a value the reader rejects and in a benchmark id it accepts (both
+// reach the output): the run goes on, and --json writes valid JSON (nlohmann's dump throws on
+// invalid UTF-8: this aborted the command).
+TEST_F(CommonRoadCliTest, BytesThatAreNotTextNeverAbortTheOutput) {
+  const fs::path dir = dir_ / "bytes";
+  fs::create_directories(dir);
+  std::string broken = SolvableXml();
+  const std::size_t at = broken.find("<x>");
+  ASSERT_NE(at, std::string::npos);
+  broken.insert(at + 3, "\xff\x01");
+  std::ofstream(dir / "a_broken.xml", std::ios::binary) << broken;
+  std::string named = SolvableXml();
+  const std::size_t id = named.find("ZAM_Reach");
+  ASSERT_NE(id, std::string::npos);
+  named.replace(id, 9, "ZAM_R\xe9" "ach");  // Latin-1, not UTF-8
+  std::ofstream(dir / "b_named.xml", std::ios::binary) << named;
+
+  CommandResult j = RunFrenetic("commonroad " + dir.string() + " --json --no-timing");
+  EXPECT_EQ(j.exit_code, 1) << j.out;  // one file unreadable
+  const json doc = json::parse(j.out, nullptr, false);
+  ASSERT_FALSE(doc.is_discarded()) << j.out;
+  ASSERT_EQ(doc.at("scenarios").size(), 2u);
+  EXPECT_THAT(doc.at("scenarios")[0].at("error").get<std::string>(),
+              HasSubstr("'\\xff\\x01"));
+  const json& run = doc.at("scenarios")[1];
+  EXPECT_EQ(run.at("benchmark_id").get<std::string>(), "ZAM_R\xef\xbf\xbd" "ach-1_1_T-1");
+  EXPECT_TRUE(run.at("problems")[0].at("solved").get<bool>());
+
+  CommandResult t = RunFrenetic("commonroad " + dir.string() + " --no-timing 2>&1");
+  EXPECT_EQ(t.exit_code, 1) << t.out;
+  EXPECT_THAT(t.out, HasSubstr("'\\xff\\x01"));
+  EXPECT_THAT(t.out, HasSubstr("solved 1 / 1 problems feasible at start"));
+}
+
 TEST_F(CommonRoadCliTest, BadArgumentsFailWithOneLine) {
   struct Case {
     std::string args, needle;

@@ -1,5 +1,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -442,6 +443,12 @@ std::vector<MalformedCase> MalformedCases() {
        "<exact>99999999999", "planningProblem 1/initialState/time/exact", "not an integer"},
       {"SyntaxError", Replace(valid, "</rightBound>", "</rightBond>"), "</rightBond>",
        "XML syntax error", "mismatch"},
+      // Bytes that are not text in a value: escaped, so the line stays one line of valid UTF-8
+      // (JSON output and terminals); well-formed UTF-8 is kept as it is.
+      {"BytesThatAreNotText", Replace(valid, "<x>10</x>", "<x>1\xff\x01\xc3\n0</x>"),
+       "<x>1\xff", "lanelet 1/leftBound/point/x", "'1\\xff\\x01\\xc3 0' is not a finite number"},
+      {"WellFormedUtf8", Replace(valid, "<x>10</x>", "<x>1\xc3\xa9</x>"), "<x>1\xc3",
+       "lanelet 1/leftBound/point/x", "'1\xc3\xa9' is not a finite number"},
   };
 }
 
@@ -453,6 +460,7 @@ TEST_P(MalformedTest, GivesOneLineNamingTheElementAndItsLine) {
   ASSERT_FALSE(s.ok()) << c.name;
   const std::string& m = s.message();
   EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  EXPECT_NO_THROW((void)nlohmann::json(m).dump()) << "not UTF-8: " << m;
   const int line = LineOf(c.xml, c.at);
   ASSERT_GT(line, 0) << c.at;
   EXPECT_THAT(m, StartsWith("bad.xml:" + std::to_string(line) + ": ")) << m;
@@ -502,8 +510,9 @@ void FuzzOne(const std::string& text, const std::string& what) {
     }
     return;
   }
-  // "fuzz.xml:<line>: <something>", one line.
+  // "fuzz.xml:<line>: <something>", one line of valid UTF-8.
   const std::string& m = s.message();
+  EXPECT_NO_THROW((void)nlohmann::json(m).dump()) << what << ": not UTF-8: " << m;
   const std::string_view prefix = "fuzz.xml:";
   bool form = m.compare(0, prefix.size(), prefix) == 0 && m.find('\n') == std::string::npos;
   size_t i = prefix.size();
@@ -538,7 +547,7 @@ void Fuzz(const std::string& base, int truncations, int mutations, uint32_t seed
           text.insert(at, "x");
           break;
       }
-      if (text.empty()) text = "<";
+      if (text.empty()) text.assign(1, '<');
     }
     FuzzOne(text, "mutation " + std::to_string(i));
   }
