@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang in build-fuzz and runs the wire-protocol fuzzer.
-#   scripts/fuzz.sh [SECONDS]     run for SECONDS (default 60); exit 0 when nothing was found
+# Builds the libFuzzer targets with clang in build-fuzz and runs them one after the other: the
+# wire-protocol fuzzer, then the CommonRoad readers' (scenario and solution files).
+#   scripts/fuzz.sh [SECONDS]     run each for SECONDS (default 60); exit 0 when nothing was found
 #   FRENETIC_FUZZ_SEED=N          libFuzzer seed (default 1, so CI runs are repeatable)
 # Needs clang and libclang-rt-14-dev. Findings (crash-*, leak-*, timeout-*) land in build-fuzz/.
 set -euo pipefail
@@ -19,7 +20,7 @@ if [ ! -f "$BUILD/CMakeCache.txt" ]; then
     -DFRENETIC_BUILD_FUZZERS=ON -DFRENETIC_BUILD_TESTS=OFF -DFRENETIC_BUILD_BENCHMARKS=OFF \
     -DFRENETIC_WITH_MPI=OFF >/dev/null
 fi
-cmake --build "$BUILD" -j "$JOBS" --target frame_parser_fuzz
+cmake --build "$BUILD" -j "$JOBS" --target frame_parser_fuzz scenario_parser_fuzz
 
 # Seeds: the frames of the protocol, and real telemetry when the recordings are present.
 SEEDS="$BUILD/seeds/frame_parser"
@@ -63,5 +64,18 @@ cat >"$DICT" <<'DICT_EOF'
 DICT_EOF
 
 cd "$BUILD"
-exec ./frame_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 -timeout=10 \
+./frame_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 -timeout=10 \
   -rss_limit_mb=2048 -dict="$DICT" -print_final_stats=1 "$CORPUS" "$SEEDS"
+
+# The CommonRoad readers: a hand-made scenario (every element they read) and solution, with the
+# small solution files of the shared highD set when present (the scenarios are too long).
+SEEDS="$BUILD/seeds/scenario_parser"
+CORPUS="$BUILD/corpus/scenario_parser"
+mkdir -p "$SEEDS" "$CORPUS"
+cp "$ROOT"/tests/fuzz/seeds/scenario_parser/*.xml "$SEEDS/"
+for f in "$SHARED"/commonroad/highD/*.solution.xml; do
+  if [ -f "$f" ] && [ "$(wc -c <"$f")" -le 16384 ]; then cp "$f" "$SEEDS/"; fi
+done
+./scenario_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 \
+  -timeout=10 -rss_limit_mb=2048 -dict="$ROOT/tests/fuzz/seeds/scenario_parser/xml.dict" \
+  -print_final_stats=1 "$CORPUS" "$SEEDS"

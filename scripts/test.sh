@@ -2,7 +2,8 @@
 # Installs what is missing, builds frenetic with its tests, and runs every test:
 #   1. the ctest suite (unit, scenario, network, browser and end-to-end tests);
 #   2. `frenetic fidelity` against the real simulator recordings (when the shared dir has them);
-#   3. the frame-parser fuzzer for FRENETIC_FUZZ_SECONDS (default 60) in a clang build;
+#   3. the fuzzers (wire frames, CommonRoad files) for FRENETIC_FUZZ_SECONDS each (default 60) in
+#      a clang build;
 #   4. the ctest suite again under AddressSanitizer + UndefinedBehaviorSanitizer.
 #   scripts/test.sh [--shared DIR] [--quick]
 #     --shared DIR   holds data/highway_map.csv and realdata/telemetry/ (default: ../shared)
@@ -43,7 +44,7 @@ else
 fi
 [ "$QUICK" -eq 1 ] && { log "done in $((SECONDS - start)) s (quick)"; exit 0; }
 
-log "step 3/4: frame-parser fuzzer"
+log "step 3/4: fuzzers (wire frames, CommonRoad files)"
 bash "$FRENETIC_ROOT/scripts/fuzz.sh" "${FRENETIC_FUZZ_SECONDS:-60}"
 
 log "step 4/4: ctest under AddressSanitizer + UndefinedBehaviorSanitizer"
