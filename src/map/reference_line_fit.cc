@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -44,6 +45,20 @@ constexpr double kOpenMinSpacing = 1e-3;
 constexpr double kOpenSpacing = 2.0;
 constexpr double kOpenExtension = 30.0;
 constexpr double kOpenEndProbe = 5.0;
+// m: the longest line fitted (Fit: the loop, FitOpen: the polyline). Memory and time grow with
+// the length (a control point every control_spacing, FitOpen's samples every kOpenSpacing): one
+// coordinate off by a few orders of magnitude in a map file must fail here, with a message, not
+// take every gigabyte the machine has. Real roads fit so far are under 10 km.
+constexpr double kMaxLineLength = 200e3;
+
+std::string LengthError(const std::string& src, double length) {
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                ": the line is %.0f km long, more than the %.0f km a fit takes (a point far off "
+                "the rest?)",
+                length / 1e3, kMaxLineLength / 1e3);
+  return src + text;
+}
 
 // Polynomial coefficients (in local t in [0,1)) of the six uniform quintic B-spline weights of a
 // span, from the truncated-power form of the cardinal B-spline.
@@ -221,6 +236,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::FitLine(const Trac
   if (closed && (!std::isfinite(period) || !(track.max_s > wps.back().s))) {
     return Status::Error(src + ": max_s must be greater than the last waypoint's s");
   }
+  if (!(period <= kMaxLineLength)) return Status::Error(LengthError(src, period));
 
   // Control points: one every ~control_spacing m (spans; an open line has kDegree more).
   const int spans =
@@ -488,6 +504,7 @@ StatusOr<std::shared_ptr<const ReferenceLine>> ReferenceLine::FitOpen(
     cum[i] = cum[i - 1] + std::hypot(pts[i].x - pts[i - 1].x, pts[i].y - pts[i - 1].y);
   }
   const double total = cum.back();
+  if (!(total <= kMaxLineLength)) return Status::Error(LengthError(src, total));
   // The point at chord length c along the polyline (c may lie beyond either end: straight on).
   auto at = [&](double c) {
     size_t i = std::upper_bound(cum.begin(), cum.end(), c) - cum.begin();

@@ -15,6 +15,11 @@ namespace {
 constexpr double kNormalTolerance = 1e-3;
 // Two waypoints closer than this are the same point: the line through them has no direction.
 constexpr double kDuplicateDistance = 1e-6;
+// s is the distance along the road: a point farther from the previous row's than
+// kChordRatio x the s between them plus kChordSlack (m) has a coordinate off (a fit through it
+// would run thousands of kilometres out and back).
+constexpr double kChordRatio = 2.0;
+constexpr double kChordSlack = 10.0;
 
 std::string Where(std::string_view source, int line) {
   return std::string(source) + ":" + std::to_string(line) + ": ";
@@ -107,6 +112,15 @@ StatusOr<Track> ParseTrack(std::string_view text, std::string_view source,
       return Status::Error(Where(source, line_no) + "s = " + Fmt(w.s) +
                            " does not increase (previous row s = " + Fmt(track.waypoints.back().s) +
                            ")");
+    }
+    if (!track.waypoints.empty()) {
+      const Waypoint& p = track.waypoints.back();
+      const double chord = std::hypot(w.x - p.x, w.y - p.y);
+      if (chord > kChordRatio * (w.s - p.s) + kChordSlack) {
+        return Status::Error(Where(source, line_no) + "point (" + Fmt(w.x) + ", " + Fmt(w.y) +
+                             ") lies " + Fmt(chord) + " m from the previous row's, but s advances " +
+                             Fmt(w.s - p.s) + " m (a coordinate off?)");
+      }
     }
     track.waypoints.push_back(w);
     line_of.push_back(line_no);

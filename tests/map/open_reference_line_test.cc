@@ -122,6 +122,15 @@ TEST(OpenReferenceLineTest, BadPolylinesFailNamingTheProblem) {
   EXPECT_NE(r.message().find("point 1 is not finite"), std::string::npos) << r.message();
   const std::vector<Point> empty;
   EXPECT_FALSE(ReferenceLine::FitOpen(empty, o, "x").ok());
+  // One point off by orders of magnitude (a mangled lanelet): refused before any sample is
+  // taken (the fit took gigabytes and minutes), and a long road still fits.
+  const std::vector<Point> far = {{0, 0}, {50, 0}, {100, 6.2e7}, {150, 0}};
+  r = ReferenceLine::FitOpen(far, o, "lane 9");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("lane 9: the line is 124000 km long, more than the 200 km"),
+            std::string::npos)
+      << r.message();
+  EXPECT_TRUE(ReferenceLine::FitOpen(std::vector<Point>{{0, 0}, {20000, 0}}, o, "20 km").ok());
 }
 
 TEST(OpenReferenceLineTest, NonFiniteQueriesAreSafe) {

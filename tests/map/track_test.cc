@@ -91,6 +91,16 @@ TEST(TrackTest, RejectsDuplicatePoint) {
               "bad.csv:4:", "duplicate point (100, 0) of line 2");
 }
 
+// One coordinate off by orders of magnitude (a mangled row): refused at its line, not fitted
+// (a fit through it ran for minutes).
+TEST(TrackTest, RejectsAPointFarFromWhereItsSPutsIt) {
+  ExpectError("0 0 0 0 -1\n100 0 100 1 0\n100 100000000 200 0 1\n0 100 300 -1 0\n",
+              "bad.csv:3:", "lies 1e+08 m from the previous row's, but s advances 100 m");
+  // A bend cuts its chord shorter than s: fine, and so is a chord a little longer than s.
+  EXPECT_TRUE(ParseTrack("0 0 0 0 -1\n100 0 100 1 0\n100 100 220 0 1\n0 100 300 -1 0\n", "ok").ok());
+  EXPECT_TRUE(ParseTrack("0 0 0 0 -1\n100 0 95 1 0\n100 100 200 0 1\n0 100 300 -1 0\n", "ok").ok());
+}
+
 TEST(TrackTest, LoadMissingFileNamesIt) {
   auto t = LoadTrack("/nonexistent/map.csv");
   ASSERT_FALSE(t.ok());
