@@ -9,11 +9,11 @@
 //   - a lanelet's centre line and polygon are built from its bounds;
 //   - a solution that parses writes back (WriteSolution) to text that parses to the same states.
 // Build: scripts/fuzz.sh (clang, -DFRENETIC_BUILD_FUZZERS=ON).
-#include <climits>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -23,14 +23,7 @@
 
 namespace {
 
-using frenetic::commonroad::Obstacle;
-using frenetic::commonroad::ObstacleRole;
-using frenetic::commonroad::Scenario;
-using frenetic::commonroad::Shape;
-using frenetic::commonroad::ShapeGroup;
-using frenetic::commonroad::Solution;
-using frenetic::commonroad::State;
-using frenetic::commonroad::Vec2;
+namespace cr = frenetic::commonroad;
 
 void Check(bool ok, const char* what) {
   if (!ok) {
@@ -39,9 +32,9 @@ void Check(bool ok, const char* what) {
   }
 }
 
-bool Finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+bool Finite(cr::Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
-void CheckState(const State& s, const char* what) {
+void CheckState(const cr::State& s, const char* what) {
   Check(Finite(s.position), what);
   for (const std::optional<double>& v : {s.orientation, s.velocity, s.acceleration, s.yaw_rate,
                                          s.slip_angle, s.steering_angle}) {
@@ -49,18 +42,18 @@ void CheckState(const State& s, const char* what) {
   }
 }
 
-void CheckShapes(const ShapeGroup& g, const char* what) {
-  for (const Shape& sh : g.shapes) {
+void CheckShapes(const cr::ShapeGroup& g, const char* what) {
+  for (const cr::Shape& sh : g.shapes) {
     Check(Finite(sh.center), what);
-    for (const Vec2& v : sh.Vertices()) Check(Finite(v), what);
+    for (const cr::Vec2& v : sh.Vertices()) Check(Finite(v), what);
   }
 }
 
-void CheckObstacle(const Obstacle& o) {
+void CheckObstacle(const cr::Obstacle& o) {
   CheckState(o.initial, "an obstacle's initial state is finite");
   CheckShapes(o.shape, "an obstacle's shape is finite");
   int step = o.initial.time_step;
-  for (const State& s : o.trajectory) {
+  for (const cr::State& s : o.trajectory) {
     CheckState(s, "a trajectory state is finite");
     Check(s.time_step == ++step, "trajectory steps follow the initial one");
   }
@@ -72,29 +65,29 @@ void CheckObstacle(const Obstacle& o) {
   // What the runner and the verdict ask of every obstacle.
   const int last = o.LastStep();
   for (const int k : {o.initial.time_step, o.initial.time_step + 1,
-                      o.role == ObstacleRole::kStatic ? o.initial.time_step + 2 : last}) {
+                      o.role == cr::ObstacleRole::kStatic ? o.initial.time_step + 2 : last}) {
     if (k < o.initial.time_step) continue;
-    const std::optional<State> st = o.StateAt(k);
+    const std::optional<cr::State> st = o.StateAt(k);
     if (st) CheckState(*st, "StateAt gives a finite state");
     (void)o.OccupancyAt(k);
   }
 }
 
-void CheckScenario(const Scenario& sc) {
+void CheckScenario(const cr::Scenario& sc) {
   Check(std::isfinite(sc.dt) && sc.dt > 0, "the step is finite and positive");
   Check(Finite(sc.origin), "the origin is finite");
   for (const auto& l : sc.lanelets) {
     Check(l.left.size() >= 2 && l.right.size() >= 2, "a bound has two points");
-    for (const Vec2& p : l.left) Check(Finite(p), "a left bound is finite");
-    for (const Vec2& p : l.right) Check(Finite(p), "a right bound is finite");
+    for (const cr::Vec2& p : l.left) Check(Finite(p), "a left bound is finite");
+    for (const cr::Vec2& p : l.right) Check(Finite(p), "a right bound is finite");
     (void)l.CenterLine();
     (void)l.Polygon();
   }
-  for (const Obstacle& o : sc.obstacles) CheckObstacle(o);
+  for (const cr::Obstacle& o : sc.obstacles) CheckObstacle(o);
   for (const auto& p : sc.problems) {
     CheckState(p.initial, "a problem's initial state is finite");
     for (const auto& g : p.goals) {
-      for (const Shape& sh : g.shapes) Check(Finite(sh.center), "a goal shape is finite");
+      for (const cr::Shape& sh : g.shapes) Check(Finite(sh.center), "a goal shape is finite");
       if (g.velocity) {
         Check(std::isfinite(g.velocity->start) && std::isfinite(g.velocity->end),
               "a goal's velocity interval is finite");
@@ -107,9 +100,8 @@ void CheckScenario(const Scenario& sc) {
   }
 }
 
-void CheckSolution(const Solution& s) {
-  const auto again = frenetic::commonroad::ParseSolution(
-      frenetic::commonroad::WriteSolution(s), "rewritten");
+void CheckSolution(const cr::Solution& s) {
+  const auto again = cr::ParseSolution(cr::WriteSolution(s), "rewritten");
   Check(again.ok(), "a solution written back parses");
   Check(again->trajectories.size() == s.trajectories.size(), "the same trajectories");
   for (std::size_t i = 0; i < s.trajectories.size(); ++i) {
@@ -129,7 +121,7 @@ void CheckSolution(const Solution& s) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  if (auto sc = frenetic::commonroad::ParseScenario(text, "fuzz"); sc.ok()) CheckScenario(*sc);
-  if (auto sol = frenetic::commonroad::ParseSolution(text, "fuzz"); sol.ok()) CheckSolution(*sol);
+  if (auto sc = cr::ParseScenario(text, "fuzz"); sc.ok()) CheckScenario(*sc);
+  if (auto sol = cr::ParseSolution(text, "fuzz"); sol.ok()) CheckSolution(*sol);
   return 0;
 }
