@@ -31,9 +31,9 @@
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
+#include "frenetic/json_text.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/tune/cluster.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {

@@ -16,6 +16,7 @@
 #include "apps/drive_connect.h"
 #include "frenetic/drive/episode.h"
 #include "frenetic/drive/record.h"
+#include "frenetic/json_text.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
@@ -23,7 +24,6 @@
 #include "frenetic/sim/scenario.h"
 #include "frenetic/sim/world.h"
 #include "frenetic/units.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {

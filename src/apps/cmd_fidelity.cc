@@ -18,9 +18,9 @@
 #include "apps/commands.h"
 #include "frenetic/drive/traffic_runs.h"
 #include "frenetic/eval/fidelity.h"
+#include "frenetic/json_text.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/world.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {

@@ -11,10 +11,10 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "frenetic/json_text.h"
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/map/track_generator.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "frenetic/json_text.h"
 #include "frenetic/record/reader.h"
 #include "frenetic/report/page.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {
@@ -40,7 +40,7 @@ std::string Verdict(const record::RunData& run) {
   if (!f.is_object() || !f.contains("solved") || !f["solved"].is_boolean()) return "";
   if (f["solved"].get<bool>()) {
     return "; solved, goal at step " +
-           (f.contains("goal_step") ? JsonText(f["goal_step"]) : std::string("?"));
+           (f.contains("goal_step") ? f["goal_step"].dump() : std::string("?"));
   }
   std::string out = "; NOT solved:";
   if (f.contains("failures") && f["failures"].is_array()) {
@@ -48,7 +48,7 @@ std::string Verdict(const record::RunData& run) {
       if (!e.is_object()) continue;
       const bool named = e.contains("kind") && e["kind"].is_string();
       out += " " + (named ? e["kind"].get<std::string>() : std::string("?")) + " at step " +
-             (e.contains("step") ? JsonText(e["step"]) : std::string("?"));
+             (e.contains("step") ? e["step"].dump() : std::string("?"));
     }
   }
   return out;

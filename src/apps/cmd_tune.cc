@@ -11,10 +11,10 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "frenetic/json_text.h"
 #include "frenetic/tune/cluster.h"
 #include "frenetic/tune/suite.h"
 #include "frenetic/tune/tuner.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::apps {
 namespace {

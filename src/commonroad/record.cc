@@ -12,12 +12,12 @@
 #include <utility>
 
 #include "frenetic/commonroad/vehicle_params.h"
+#include "frenetic/json_text.h"
 #include "frenetic/record/plan_json.h"
 #include "frenetic/record/replica.h"
 #include "frenetic/record/schema.h"
 #include "frenetic/record/writer.h"
 #include "frenetic/units.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::commonroad {
 namespace {

@@ -18,54 +18,59 @@ std::string_view Trim(std::string_view s) {
   return s;
 }
 
-// Element text shortened for a message (a mangled file may hold anything there).
+// Element text shortened for a message (a mangled file may hold anything there: Error makes the
+// whole message Printable).
 std::string Quote(std::string_view text) {
-  std::string out;
-  for (char c : text.substr(0, 40)) out += (c == '\n' || c == '\r' || c == '\t') ? ' ' : c;
-  if (text.size() > 40) out += "...";
-  return "'" + out + "'";
+  std::string out(1, '\'');
+  out.append(text.substr(0, 40));
+  out += text.size() > 40 ? "...'" : "'";
+  return out;
 }
 
 }  // namespace
 
 std::string Printable(std::string_view text) {
-  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
-  const auto cont = [&](std::size_t i, unsigned lo = 0x80, unsigned hi = 0xBF) {
-    return i < text.size() && byte(i) >= lo && byte(i) <= hi;
-  };
   std::string out;
   out.reserve(text.size());
   for (std::size_t i = 0; i < text.size();) {
-    const unsigned c = byte(i);
-    // The length of a well-formed UTF-8 sequence starting at i (RFC 3629: no overlong forms,
-    // no surrogates, nothing above U+10FFFF), 0 when there is none.
+    const unsigned c = static_cast<unsigned char>(text[i]);
+    // A well-formed UTF-8 sequence (RFC 3629: no overlong forms, no surrogates, nothing above
+    // U+10FFFF): its length n by the lead byte, the second byte within [lo, hi], the others
+    // continuation bytes.
     std::size_t n = 0;
+    unsigned lo = 0x80, hi = 0xBF;
     if (c >= 0x20 && c < 0x7F) {
       n = 1;
     } else if (c >= 0xC2 && c <= 0xDF) {
-      n = cont(i + 1) ? 2 : 0;
+      n = 2;
     } else if (c >= 0xE0 && c <= 0xEF) {
-      const bool second = c == 0xE0 ? cont(i + 1, 0xA0) : c == 0xED ? cont(i + 1, 0x80, 0x9F)
-                                                                     : cont(i + 1);
-      n = second && cont(i + 2) ? 3 : 0;
+      n = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
     } else if (c >= 0xF0 && c <= 0xF4) {
-      const bool second = c == 0xF0 ? cont(i + 1, 0x90) : c == 0xF4 ? cont(i + 1, 0x80, 0x8F)
-                                                                     : cont(i + 1);
-      n = second && cont(i + 2) && cont(i + 3) ? 4 : 0;
+      n = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
     }
-    if (n > 0) {
+    bool whole = n > 0 && i + n <= text.size();
+    for (std::size_t k = 1; whole && k < n; ++k) {
+      const unsigned b = static_cast<unsigned char>(text[i + k]);
+      whole = k == 1 ? b >= lo && b <= hi : b >= 0x80 && b <= 0xBF;
+    }
+    if (whole) {
       out.append(text.substr(i, n));
       i += n;
-    } else if (c == '\n' || c == '\r' || c == '\t') {
+      continue;
+    }
+    if (c == '\n' || c == '\r' || c == '\t') {
       out += ' ';
-      ++i;
     } else {
       static constexpr char kHex[] = "0123456789abcdef";
       out += "\\x";
       out += kHex[c >> 4];
       out += kHex[c & 0xF];
-      ++i;
     }
+    ++i;
   }
   return out;
 }

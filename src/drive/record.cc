@@ -6,11 +6,11 @@
 #include <cmath>
 
 #include "frenetic/drive/episode.h"
+#include "frenetic/json_text.h"
 #include "frenetic/record/plan_json.h"
 #include "frenetic/record/schema.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/protocol.h"
-#include "frenetic/json_text.h"
 
 namespace frenetic::sim {
 namespace {
@@ -101,13 +101,13 @@ void FormatExchange(int index, double t, const std::string& telemetry_json,
   // type, the cycle and the time.
   *line += '{';
   AppendKey(key::kType, line);
-  *line += JsonText(nlohmann::json(key::kExchange));
+  *line += nlohmann::json(key::kExchange).dump();
   *line += ',';
   AppendKey(key::kCycle, line);
   *line += std::to_string(index);
   *line += ',';
   AppendKey(key::kTime, line);
-  *line += JsonText(nlohmann::json(t));
+  *line += nlohmann::json(t).dump();
   *line += ',';
   AppendKey(key::kTelemetry, line);
   *line += telemetry_json.empty() ? "null" : telemetry_json;

@@ -15,8 +15,8 @@
 #include <sstream>
 #include <utility>
 
-#include "frenetic/tune/tuner.h"
 #include "frenetic/json_text.h"
+#include "frenetic/tune/tuner.h"
 
 namespace frenetic::tune {
 namespace {

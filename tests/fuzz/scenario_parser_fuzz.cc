@@ -66,7 +66,6 @@ void CheckObstacle(const cr::Obstacle& o) {
   const int last = o.LastStep();
   for (const int k : {o.initial.time_step, o.initial.time_step + 1,
                       o.role == cr::ObstacleRole::kStatic ? o.initial.time_step + 2 : last}) {
-    if (k < o.initial.time_step) continue;
     const std::optional<cr::State> st = o.StateAt(k);
     if (st) CheckState(*st, "StateAt gives a finite state");
     (void)o.OccupancyAt(k);
