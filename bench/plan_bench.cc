@@ -18,7 +18,6 @@
 #include <vector>
 
 // Before bench_util.h, which includes it for the counters only.
-#define FRENETIC_DEFINE_MALLOC_INTERPOSER
 #include "../tests/common/malloc_counter.h"
 #include "bench_util.h"
 #include "frenetic/commonroad/rescue.h"

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "frenetic/plan/scratch_heap.h"
+
 namespace frenetic::plan::search {
 namespace {
 
@@ -72,6 +74,8 @@ Refiner::Eval& Refiner::Entry(const double* x) {
 double Refiner::Objective(unsigned n, const double* x, double* grad, void* data) {
   (void)n;
   (void)grad;  // derivative-free
+  // The planner's own buffers outlive the refinement: not from the scratch slot.
+  const heap::ScratchPause ours;
   auto* self = static_cast<Refiner*>(data);
   ++self->evals_;
   Eval& seen = self->Entry(x);
@@ -92,6 +96,7 @@ double Refiner::Objective(unsigned n, const double* x, double* grad, void* data)
 double Refiner::Constraint(unsigned n, const double* x, double* grad, void* data) {
   (void)n;
   (void)grad;
+  const heap::ScratchPause ours;
   auto* self = static_cast<Refiner*>(data);
   Eval& seen = self->Entry(x);
   if (seen.has_g) return seen.g;
@@ -162,7 +167,13 @@ void Refiner::Refine(PlanSummary& sum) {
     }
   }
   double best = 0;
-  const nlopt_result r = nlopt_optimize(opt_, x, &best);
+  nlopt_result r;
+  {
+    // NLopt mallocs its work arrays on every call: from the thread's scratch slot, so that a
+    // refined cycle makes no heap allocation after warm-up.
+    const heap::ScratchScope scratch;
+    r = nlopt_optimize(opt_, x, &best);
+  }
   sum.refine_iterations = evals_;
   if (r < 0 || !Finite(best) || best >= before) return;
   // Safety re-check of the refined trajectory; keep the unrefined winner if it fails.

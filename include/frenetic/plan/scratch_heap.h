@@ -1,0 +1,77 @@
+// The process's C heap, interposed, so that a library call that mallocs its scratch on every
+// call (NLopt's nlopt_optimize allocates its work arrays per call and has no API to hand it a
+// workspace) allocates nothing after warm-up: inside a ScratchScope, the calling thread's
+// malloc, calloc and realloc are served from the thread's slot of one reserved region (a bump
+// pointer, wound back when everything it handed out has been freed); anywhere else, and when a
+// slot is full, they go to glibc (its __libc_* entry points). free() knows the region's pointers
+// by their address, on any thread. The planner's refinement runs NLopt in a scope and pauses it
+// (ScratchPause) around its own callbacks, whose buffers live on.
+//
+// Sanitizer builds own malloc: nothing is interposed there (kInterposed is false), scopes do
+// nothing and nothing is counted.
+//
+// The interposer also counts the allocations it passes to glibc while g_count_allocations is
+// set, C libraries' included: the tests' and the benchmarks' allocation counters.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define FRENETIC_HEAP_INTERPOSED 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+#define FRENETIC_HEAP_INTERPOSED 0
+#endif
+#endif
+#ifndef FRENETIC_HEAP_INTERPOSED
+#define FRENETIC_HEAP_INTERPOSED 1
+#endif
+
+namespace frenetic::plan::heap {
+
+inline constexpr bool kInterposed = FRENETIC_HEAP_INTERPOSED != 0;
+
+// Counted: every malloc, calloc and realloc passed to glibc while set (any thread).
+extern std::atomic<bool> g_count_allocations;
+extern std::atomic<std::int64_t> g_allocations;
+
+// The bytes of one thread's slot, and how many slots the region has (threads beyond them, and
+// requests beyond a slot, are served by glibc).
+inline constexpr std::size_t kSlotBytes = std::size_t{256} << 10;
+inline constexpr int kSlots = 256;
+
+// While one lives, the thread's allocations come from its slot (nested scopes: the outermost
+// counts). The first scope of a thread claims a slot (given back when the thread ends).
+class ScratchScope {
+ public:
+  ScratchScope();
+  ~ScratchScope();
+  ScratchScope(const ScratchScope&) = delete;
+  ScratchScope& operator=(const ScratchScope&) = delete;
+};
+
+// While one lives, the thread's allocations go to glibc again (a callback inside a scope whose
+// buffers outlive it).
+class ScratchPause {
+ public:
+  ScratchPause();
+  ~ScratchPause();
+  ScratchPause(const ScratchPause&) = delete;
+  ScratchPause& operator=(const ScratchPause&) = delete;
+
+ private:
+  int saved_;
+};
+
+// The thread's slot: bytes handed out since it was last wound back, and the blocks not yet
+// freed (0 and 0 before its first scope, or without a slot).
+struct SlotUse {
+  std::size_t bytes = 0;
+  std::int64_t live = 0;
+};
+SlotUse ThreadSlotUse();
+
+}  // namespace frenetic::plan::heap
