@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <set>
 #include <utility>
@@ -45,6 +48,32 @@ TEST(SpreadOrderTest, RoundRobinOverStrataEachInHashOrder) {
   std::vector<std::pair<std::size_t, std::size_t>> again;
   SpreadOrder(next, [](int state) { return static_cast<std::uint64_t>(state % 3); }, scratch, again);
   EXPECT_EQ(again, rank);
+}
+
+// The radix sort gives std::sort's order at every size, across the small-size cut.
+TEST(SortByHashTest, TheOrderOfStdSort) {
+  std::vector<std::pair<std::uint64_t, std::size_t>> other;
+  std::vector<std::uint32_t> counts;
+  for (const std::size_t n : {0, 1, 2, 255, 256, 257, 3000}) {
+    std::vector<std::pair<std::uint64_t, std::size_t>> keys;
+    for (std::size_t i = 0; i < n; ++i) keys.push_back({MixKey(i * 7919 + n), i});
+    keys.push_back({0, n});  // the extremes of the range
+    keys.push_back({~std::uint64_t{0}, n + 1});
+    auto expected = keys;
+    std::sort(expected.begin(), expected.end());
+    SortByHash(keys, other, counts);
+    EXPECT_EQ(keys, expected) << n;
+  }
+}
+
+TEST(FloorToIntTest, FloorAsAnInteger) {
+  for (const double x : {0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999999, -2.000001, -3.0, 1e15 + 0.5,
+                         -1e15 - 0.5, 4503599627370497.0, -4503599627370497.0,
+                         std::nextafter(-7.0, 0.0), std::nextafter(-7.0, -8.0),
+                         std::numeric_limits<double>::denorm_min(),
+                         -std::numeric_limits<double>::denorm_min()}) {
+    EXPECT_EQ(FloorToInt(x), static_cast<std::int64_t>(std::floor(x))) << x;
+  }
 }
 
 }  // namespace
