@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <set>
 
+#include "commonroad/xml_source.h"
+
 namespace frenetic::apps::commonroad_cli {
 
 using nlohmann::json;
@@ -150,7 +152,9 @@ std::string Reasons(const std::map<std::string, int>& reasons) {
 
 std::string FamilyTable(const Summary& s) {
   size_t width = 3;
-  for (const auto& [name, c] : s.families) width = std::max(width, name.size());
+  for (const auto& [name, c] : s.families) {
+    width = std::max(width, commonroad::Printable(name).size());
+  }
   const int w = static_cast<int>(width);
   std::string text =
       Format("by family (solved of the problems feasible at start; planning time per cycle; "
@@ -158,7 +162,8 @@ std::string FamilyTable(const Summary& s) {
              "p99 ms    max ms  unsolved\n",
              w, "family");
   auto row = [&](const std::string& name, const Counts& c) {
-    text += Format("  %-*s  %8d  %10d  %9s  %8.2f  %8.2f  %8.2f  %s\n", w, name.c_str(),
+    text += Format("  %-*s  %8d  %10d  %9s  %8.2f  %8.2f  %8.2f  %s\n", w,
+                   commonroad::Printable(name).c_str(),
                    c.problems, c.infeasible_at_start,
                    Format("%d / %d", c.solved, c.problems - c.infeasible_at_start).c_str(),
                    Percentile(c.plan_ms, 0.5), Percentile(c.plan_ms, 0.99), Max(c.plan_ms),

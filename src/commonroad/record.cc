@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -11,6 +10,7 @@
 #include <optional>
 #include <utility>
 
+#include "frenetic/commonroad/solution.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/json_text.h"
 #include "frenetic/record/plan_json.h"
@@ -125,12 +125,7 @@ double Percentile(std::vector<double> v, double q) {
 }  // namespace
 
 std::string RecordFileName(std::string_view benchmark_id, int problem_id) {
-  std::string name(benchmark_id);
-  for (char& c : name) {
-    const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
-                      c == '.' || c == ':';
-    if (!keep) c = '_';
-  }
+  std::string name = FileNamePart(benchmark_id);
   if (name.empty()) name = "scenario";
   return name + "_" + std::to_string(problem_id) + ".jsonl.gz";
 }

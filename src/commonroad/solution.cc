@@ -1,6 +1,7 @@
 #include "frenetic/commonroad/solution.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <ctime>
 #include <filesystem>
@@ -85,7 +86,19 @@ std::string Solution::BenchmarkId() const {
   return JoinIds(vehicles) + ":" + JoinIds(costs) + ":" + scenario_id + ":" + version;
 }
 
-std::string Solution::FileName() const { return "solution_" + BenchmarkId() + ".xml"; }
+std::string FileNamePart(std::string_view text) {
+  std::string name(text);
+  for (char& c : name) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
+                      c == '.' || c == ':';
+    if (!keep) c = '_';
+  }
+  return name;
+}
+
+std::string Solution::FileName() const {
+  return "solution_" + FileNamePart(BenchmarkId()) + ".xml";
+}
 
 std::string WriteSolution(const Solution& solution) {
   pugi::xml_document doc;

@@ -25,6 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 namespace crt = commonroad::testing;
 using nlohmann::json;
+using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -344,6 +345,31 @@ TEST_F(CommonRoadCliTest, BytesThatAreNotTextNeverAbortTheOutput) {
   EXPECT_EQ(t.exit_code, 1) << t.out;
   EXPECT_THAT(t.out, HasSubstr("'\\xff\\x01"));
   EXPECT_THAT(t.out, HasSubstr("solved 1 / 1 problems feasible at start"));
+  // The text shows the id's byte escaped, in its problem's line and in the family table.
+  EXPECT_THAT(t.out, HasSubstr("ZAM_R\\xe9ach-1_1_T-1"));
+  EXPECT_THAT(t.out, HasSubstr("  ZAM_R\\xe9ach  "));
+  EXPECT_EQ(t.out.find('\xe9'), std::string::npos);
+}
+
+// A benchmark id names the files written for it: a '/' or a control character in it stays out
+// of the path (the solution lands in --solution-dir, under a name of safe bytes).
+TEST_F(CommonRoadCliTest, AnIdWithASlashWritesItsSolutionInsideTheDir) {
+  const fs::path dir = dir_ / "slash";
+  fs::create_directories(dir);
+  std::string named = SolvableXml();
+  const std::size_t id = named.find("ZAM_Reach");
+  ASSERT_NE(id, std::string::npos);
+  named.replace(id, 9, "../ZAM_\x07Reach");
+  std::ofstream(dir / "named.xml", std::ios::binary) << named;
+  const fs::path out = dir / "solutions";
+  CommandResult r = RunFrenetic("commonroad " + (dir / "named.xml").string() +
+                                " --no-timing --solution-dir " + out.string() + " 2>&1");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("../ZAM_\\x07Reach-1_1_T-1"));
+  std::vector<std::string> written;
+  for (const auto& e : fs::directory_iterator(out)) written.push_back(e.path().filename().string());
+  EXPECT_THAT(written, ElementsAre("solution_KS2:WX1:.._ZAM__Reach-1_1_T-1:2020a.xml"));
+  EXPECT_FALSE(fs::exists(dir / "ZAM_\x07Reach-1_1_T-1"));
 }
 
 TEST_F(CommonRoadCliTest, BadArgumentsFailWithOneLine) {

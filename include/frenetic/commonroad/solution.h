@@ -39,9 +39,14 @@ struct Solution {
   std::vector<SolutionTrajectory> trajectories;
 
   std::string BenchmarkId() const;
-  // "solution_" + BenchmarkId() + ".xml"
+  // "solution_" + FileNamePart(BenchmarkId()) + ".xml"
   std::string FileName() const;
 };
+
+// `text` fit to be part of a file name: every byte other than a letter, a digit or one of
+// - _ . : becomes '_' (a scenario's benchmark id, which names the files written for it, may
+// hold anything: a '/' or a control character).
+std::string FileNamePart(std::string_view text);
 
 // The solution as XML text.
 std::string WriteSolution(const Solution& solution);
