@@ -24,7 +24,9 @@ struct Slot {
 };
 
 Slot g_slots[kSlots];
-char* g_region = nullptr;  // set once, before any block of it exists
+// Set once (by the first scope of any thread), before any block of it exists; read by every
+// free().
+std::atomic<char*> g_region{nullptr};
 constexpr std::size_t kHeader = 16;
 constexpr std::size_t kRegionBytes = kSlotBytes * kSlots;
 
@@ -35,7 +37,8 @@ thread_local int t_depth = 0;
 
 bool InRegion(const void* p) {
   const char* c = static_cast<const char*>(p);
-  return g_region != nullptr && c >= g_region && c < g_region + kRegionBytes;
+  const char* region = g_region.load(std::memory_order_relaxed);
+  return region != nullptr && c >= region && c < region + kRegionBytes;
 }
 
 // Gives the slot back when its thread ends (its blocks may outlive it: a slot with live blocks
@@ -53,7 +56,7 @@ void ClaimSlot() {
                    MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
     return p == MAP_FAILED ? nullptr : static_cast<char*>(p);
   }();
-  g_region = region;
+  g_region.store(region, std::memory_order_relaxed);
   t_slot = -2;
   if (region == nullptr) return;
   for (int i = 0; i < kSlots; ++i) {
@@ -78,7 +81,8 @@ void* FromSlot(std::size_t size) {
   Slot& s = g_slots[t_slot];
   const std::size_t rounded = (size + 15) / 16 * 16;
   if (size > kSlotBytes || rounded + kHeader > kSlotBytes - s.used) return nullptr;
-  char* block = g_region + static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
+  char* block = g_region.load(std::memory_order_relaxed) +
+                static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
   s.used += rounded + kHeader;
   s.live.fetch_add(1, std::memory_order_relaxed);
   std::memcpy(block, &size, sizeof(size));
@@ -92,7 +96,8 @@ std::size_t BlockSize(const void* p) {
 }
 
 void FreeBlock(const void* p) {
-  const auto slot = static_cast<std::size_t>(static_cast<const char*>(p) - g_region) / kSlotBytes;
+  const char* region = g_region.load(std::memory_order_relaxed);
+  const auto slot = static_cast<std::size_t>(static_cast<const char*>(p) - region) / kSlotBytes;
   g_slots[slot].live.fetch_sub(1, std::memory_order_release);
 }
 
