@@ -29,9 +29,10 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-// A goal 140 m ahead at the ego's speed, within 5-9 s: solved.
-std::string SolvableXml() {
-  crt::ScenarioXml xml("ZAM_Reach-1_1_T-1");
+// A goal 140 m ahead at the ego's speed, within 5-9 s: solved. `id`: its benchmark id, as
+// written (any bytes).
+std::string SolvableXml(const std::string& id = "ZAM_Reach-1_1_T-1") {
+  crt::ScenarioXml xml(id);
   crt::AddStraightRoad(xml, 400).Problem(1, {10, -1.75}, 0, 20,
                                          {crt::GoalRectangleXml({150, -1.75}, 10, 3, 0, 50, 90)});
   return xml.Str();
@@ -324,11 +325,8 @@ TEST_F(CommonRoadCliTest, BytesThatAreNotTextNeverAbortTheOutput) {
   ASSERT_NE(at, std::string::npos);
   broken.insert(at + 3, "\xff\x01");
   std::ofstream(dir / "a_broken.xml", std::ios::binary) << broken;
-  std::string named = SolvableXml();
-  const std::size_t id = named.find("ZAM_Reach");
-  ASSERT_NE(id, std::string::npos);
-  named.replace(id, 9, "ZAM_R\xe9" "ach");  // Latin-1, not UTF-8
-  std::ofstream(dir / "b_named.xml", std::ios::binary) << named;
+  std::ofstream(dir / "b_named.xml", std::ios::binary)
+      << SolvableXml("ZAM_R\xe9" "ach-1_1_T-1");  // Latin-1, not UTF-8
 
   CommandResult j = RunFrenetic("commonroad " + dir.string() + " --json --no-timing");
   EXPECT_EQ(j.exit_code, 1) << j.out;  // one file unreadable
@@ -356,11 +354,7 @@ TEST_F(CommonRoadCliTest, BytesThatAreNotTextNeverAbortTheOutput) {
 TEST_F(CommonRoadCliTest, AnIdWithASlashWritesItsSolutionInsideTheDir) {
   const fs::path dir = dir_ / "slash";
   fs::create_directories(dir);
-  std::string named = SolvableXml();
-  const std::size_t id = named.find("ZAM_Reach");
-  ASSERT_NE(id, std::string::npos);
-  named.replace(id, 9, "../ZAM_\x07Reach");
-  std::ofstream(dir / "named.xml", std::ios::binary) << named;
+  std::ofstream(dir / "named.xml", std::ios::binary) << SolvableXml("../ZAM_\x07Reach-1_1_T-1");
   const fs::path out = dir / "solutions";
   CommandResult r = RunFrenetic("commonroad " + (dir / "named.xml").string() +
                                 " --no-timing --solution-dir " + out.string() + " 2>&1");
