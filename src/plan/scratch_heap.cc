@@ -5,9 +5,11 @@
 // any thread; the slot is wound back, at the next scope's start or end, once none is live.
 #include "frenetic/plan/scratch_heap.h"
 
+#include <dlfcn.h>
 #include <sys/mman.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 
 namespace frenetic::plan::heap {
@@ -20,6 +22,7 @@ namespace {
 struct Slot {
   std::atomic<std::int64_t> live{0};  // blocks handed out and not yet freed
   std::size_t used = 0;               // bytes handed out since it was last wound back (owner only)
+  std::int64_t served = 0;            // blocks handed out since its thread took it (owner only)
   std::atomic<bool> taken{false};
 };
 
@@ -64,6 +67,7 @@ void ClaimSlot() {
     if (g_slots[i].taken.compare_exchange_strong(expected, true, std::memory_order_acquire)) {
       thread_local SlotRelease release;  // registered once a thread, before the slot is used
       (void)release;
+      g_slots[i].served = 0;
       t_slot = i;
       return;
     }
@@ -84,6 +88,7 @@ void* FromSlot(std::size_t size) {
   char* block = g_region.load(std::memory_order_relaxed) +
                 static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
   s.used += rounded + kHeader;
+  ++s.served;
   s.live.fetch_add(1, std::memory_order_relaxed);
   std::memcpy(block, &size, sizeof(size));
   return block + kHeader;
@@ -127,7 +132,7 @@ ScratchPause::~ScratchPause() { t_depth = saved_; }
 SlotUse ThreadSlotUse() {
   if (t_slot < 0) return {};
   const Slot& s = g_slots[t_slot];
-  return {s.used, s.live.load(std::memory_order_acquire)};
+  return {s.used, s.live.load(std::memory_order_acquire), s.served};
 }
 
 }  // namespace frenetic::plan::heap
@@ -157,6 +162,10 @@ void* calloc(std::size_t n, std::size_t size) noexcept {
 
 void* realloc(void* p, std::size_t size) noexcept {
   if (p != nullptr && fh::InRegion(p)) {
+    if (size == 0) {  // glibc's: p freed, null returned
+      fh::FreeBlock(p);
+      return nullptr;
+    }
     void* q = fh::FromSlot(size);
     if (q == nullptr) {
       fh::Count();
@@ -172,6 +181,51 @@ void* realloc(void* p, std::size_t size) noexcept {
   }
   fh::Count();
   return __libc_realloc(p, size);
+}
+
+// The aligned allocations are glibc's, counted.
+void* __libc_memalign(std::size_t alignment, std::size_t size);
+void* __libc_valloc(std::size_t size);
+void* __libc_pvalloc(std::size_t size);
+
+void* memalign(std::size_t alignment, std::size_t size) noexcept {
+  fh::Count();
+  return __libc_memalign(alignment, size);
+}
+
+void* aligned_alloc(std::size_t alignment, std::size_t size) noexcept {
+  fh::Count();
+  return __libc_memalign(alignment, size);
+}
+
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) noexcept {
+  if (alignment % sizeof(void*) != 0 || (alignment & (alignment - 1)) != 0 || alignment == 0) {
+    return EINVAL;
+  }
+  fh::Count();
+  void* p = __libc_memalign(alignment, size);
+  if (p == nullptr) return ENOMEM;
+  *out = p;
+  return 0;
+}
+
+void* valloc(std::size_t size) noexcept {
+  fh::Count();
+  return __libc_valloc(size);
+}
+
+void* pvalloc(std::size_t size) noexcept {
+  fh::Count();
+  return __libc_pvalloc(size);
+}
+
+// A region block's usable size is its size rounded up to 16; any other is glibc's (its own
+// malloc_usable_size, found once past this executable's).
+std::size_t malloc_usable_size(void* p) noexcept {
+  if (p != nullptr && fh::InRegion(p)) return (fh::BlockSize(p) + 15) / 16 * 16;
+  using Usable = std::size_t (*)(void*);
+  static const Usable glibc = reinterpret_cast<Usable>(dlsym(RTLD_NEXT, "malloc_usable_size"));
+  return glibc != nullptr ? glibc(p) : 0;
 }
 
 void free(void* p) noexcept {

@@ -3,8 +3,10 @@
 #include "frenetic/plan/scratch_heap.h"
 
 #include <gtest/gtest.h>
+#include <malloc.h>
 #include <nlopt.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -115,6 +117,32 @@ TEST(ScratchHeapTest, BeyondTheSlotGlibcServesAndABlockMayBeFreedOnAnotherThread
   another.join();
   EXPECT_EQ(live_there, 1);
   EXPECT_EQ(ThreadSlotUse().live, 0);
+}
+
+// As glibc's: realloc(p, 0) frees p and returns null; malloc_usable_size answers for a block of
+// the slot; the aligned allocations are glibc's and counted.
+TEST(ScratchHeapTest, ReallocToZeroUsableSizeAndAlignedAllocationsAsGlibc) {
+  if (!kInterposed) GTEST_SKIP() << "malloc is the sanitizer's";
+  {
+    const ScratchScope scope;
+    void* p = std::malloc(20);
+    EXPECT_EQ(malloc_usable_size(p), 32u);
+    EXPECT_EQ(std::realloc(p, 0), nullptr);
+    EXPECT_EQ(ThreadSlotUse().live, 0);
+    const std::int64_t counted = Counted([] {
+      void* a = nullptr;
+      EXPECT_EQ(posix_memalign(&a, 64, 100), 0);
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(a) % 64, 0u);
+      EXPECT_GE(malloc_usable_size(a), 100u);  // glibc's own answer
+      std::free(a);
+      g_sink = std::aligned_alloc(32, 64);
+      std::free(g_sink);
+    });
+    EXPECT_EQ(counted, 2);
+    void* a = nullptr;
+    EXPECT_EQ(posix_memalign(&a, 3, 8), EINVAL);
+  }
+  EXPECT_EQ(ThreadSlotUse().bytes, 0u);
 }
 
 double Bowl(unsigned n, const double* x, double* grad, void*) {

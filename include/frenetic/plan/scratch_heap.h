@@ -11,19 +11,25 @@
 // nothing and nothing is counted.
 //
 // The interposer also counts the allocations it passes to glibc while g_count_allocations is
-// set, C libraries' included: the tests' and the benchmarks' allocation counters.
+// set (the aligned ones too: posix_memalign, aligned_alloc, memalign, valloc, pvalloc), C
+// libraries' included: the tests' and the benchmarks' allocation counters. realloc(p, 0) frees
+// p and returns null, as glibc's; malloc_usable_size knows the region's blocks.
 #pragma once
 
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 
+// FRENETIC_HEAP_INTERPOSED may be given (CMake sets it to 0 for every sanitizer but UBSan's:
+// LeakSanitizer, for one, defines no macro of its own and owns the aligned allocations).
+#ifndef FRENETIC_HEAP_INTERPOSED
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define FRENETIC_HEAP_INTERPOSED 0
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer)
+    __has_feature(memory_sanitizer) || __has_feature(leak_sanitizer)
 #define FRENETIC_HEAP_INTERPOSED 0
+#endif
 #endif
 #endif
 #ifndef FRENETIC_HEAP_INTERPOSED
@@ -66,11 +72,13 @@ class ScratchPause {
   int saved_;
 };
 
-// The thread's slot: bytes handed out since it was last wound back, and the blocks not yet
-// freed (0 and 0 before its first scope, or without a slot).
+// The thread's slot: bytes handed out since it was last wound back, the blocks not yet freed,
+// and every block it has served since the thread took it (all 0 before the thread's first
+// scope, or without a slot).
 struct SlotUse {
   std::size_t bytes = 0;
   std::int64_t live = 0;
+  std::int64_t served = 0;
 };
 SlotUse ThreadSlotUse();
 
