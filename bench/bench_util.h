@@ -34,9 +34,9 @@
 
 namespace frenetic::bench {
 
-// Process-wide count of malloc/calloc/realloc calls passed to glibc while g_count_allocations
-// is set (the planner library's interposed C heap counts them, C libraries' such as NLopt's
-// included: frenetic/plan/scratch_heap.h). Stays 0 in sanitizer builds.
+// Process-wide count of the allocations passed to glibc while g_count_allocations is set (the
+// planner library's interposed C heap counts them, C libraries' such as NLopt's included:
+// frenetic/plan/scratch_heap.h). Stays 0 in sanitizer builds.
 using testing_util::g_allocations;
 using testing_util::g_count_allocations;
 

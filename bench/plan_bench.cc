@@ -17,8 +17,6 @@
 #include <string>
 #include <vector>
 
-// Before bench_util.h, which includes it for the counters only.
-#include "../tests/common/malloc_counter.h"
 #include "bench_util.h"
 #include "frenetic/commonroad/rescue.h"
 #include "frenetic/plan/planner.h"

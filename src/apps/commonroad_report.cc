@@ -140,7 +140,8 @@ std::string ProblemText(const FileReport& f, const ProblemReport& p) {
   char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "%-24s #%-5d %d lanes %5.0f m  %3zu steps  plan p50 %.2f p99 %.2f ms",
-                commonroad::Printable(f.benchmark_id).c_str(), p.problem_id, p.lanes, p.road_length_m, p.plan_ms.size(),
+                commonroad::Printable(f.benchmark_id).c_str(), p.problem_id, p.lanes,
+                p.road_length_m, p.plan_ms.size(),
                 Percentile(p.plan_ms, 0.5), Percentile(p.plan_ms, 0.99));
   std::string text = buf;
   if (p.costs.count("WX1")) {

@@ -79,11 +79,14 @@ void WindBack() {
   if (s.live.load(std::memory_order_acquire) == 0) s.used = 0;
 }
 
+// The bytes a block of `size` takes after its header (its usable size).
+std::size_t Rounded(std::size_t size) { return (size + 15) / 16 * 16; }
+
 // A block of the thread's slot, or nullptr (no scope, no slot, or full).
 void* FromSlot(std::size_t size) {
   if (t_depth <= 0 || t_slot < 0) return nullptr;
   Slot& s = g_slots[t_slot];
-  const std::size_t rounded = (size + 15) / 16 * 16;
+  const std::size_t rounded = Rounded(size);
   if (size > kSlotBytes || rounded + kHeader > kSlotBytes - s.used) return nullptr;
   char* block = g_region.load(std::memory_order_relaxed) +
                 static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
@@ -222,7 +225,7 @@ void* pvalloc(std::size_t size) noexcept {
 // A region block's usable size is its size rounded up to 16; any other is glibc's (its own
 // malloc_usable_size, found once past this executable's).
 std::size_t malloc_usable_size(void* p) noexcept {
-  if (p != nullptr && fh::InRegion(p)) return (fh::BlockSize(p) + 15) / 16 * 16;
+  if (p != nullptr && fh::InRegion(p)) return fh::Rounded(fh::BlockSize(p));
   using Usable = std::size_t (*)(void*);
   static const Usable glibc = reinterpret_cast<Usable>(dlsym(RTLD_NEXT, "malloc_usable_size"));
   return glibc != nullptr ? glibc(p) : 0;
