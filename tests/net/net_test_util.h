@@ -5,15 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <boost/asio/connect.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/websocket.hpp>
+#include <boost/system/error_code.hpp>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 
 #include "frenetic/net/server.h"
@@ -106,77 +104,32 @@ class TestServer {
   std::thread thread_;
 };
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-
-// Synchronous-looking Beast client; each step gives up after `timeout` seconds.
+// Synchronous-looking Beast client; each step gives up after `timeout` seconds. Its Beast
+// stream lives in net_test_util.cc: the WebSocket templates are compiled once for every net test
+// file, not once per file that includes this header.
 class TestClient {
  public:
-  explicit TestClient(double timeout = 10.0) : timeout_(timeout), ws_(io_) {}
+  explicit TestClient(double timeout = 10.0);
+  ~TestClient();
+  TestClient(const TestClient&) = delete;
+  TestClient& operator=(const TestClient&) = delete;
 
-  bool Connect(int port, const std::string& target = "/socket.io/?EIO=4&transport=websocket") {
-    const asio::ip::tcp::endpoint ep(asio::ip::make_address("127.0.0.1"),
-                                     static_cast<unsigned short>(port));
-    auto ec = Await([&](auto h) {
-      beast::get_lowest_layer(ws_).async_connect(ep, [h](beast::error_code e) mutable { h(e); });
-    });
-    if (ec) return false;
-    ec = Await([&](auto h) {
-      ws_.async_handshake("127.0.0.1:" + std::to_string(port), target,
-                          [h](beast::error_code e) mutable { h(e); });
-    });
-    return !ec;
-  }
-  beast::error_code Send(std::string_view frame, bool binary = false) {
-    ws_.binary(binary);
-    return Await([&](auto h) {
-      ws_.async_write(asio::buffer(frame.data(), frame.size()),
-                      [h](beast::error_code e, std::size_t) mutable { h(e); });
-    });
-  }
+  bool Connect(int port, const std::string& target = "/socket.io/?EIO=4&transport=websocket");
+  // The error of the write, none (false) when it was sent.
+  boost::system::error_code Send(std::string_view frame, bool binary = false);
   // The next message, or nullopt on error / timeout.
-  std::optional<std::string> Receive() {
-    beast::flat_buffer buffer;
-    auto ec = Await([&](auto h) {
-      ws_.async_read(buffer, [h](beast::error_code e, std::size_t) mutable { h(e); });
-    });
-    if (ec) return std::nullopt;
-    return beast::buffers_to_string(buffer.data());
-  }
+  std::optional<std::string> Receive();
   std::optional<std::string> Exchange(std::string_view frame) {
     if (Send(frame)) return std::nullopt;
     return Receive();
   }
-  void Close() {
-    Await([&](auto h) {
-      ws_.async_close(websocket::close_code::normal, [h](beast::error_code e) mutable { h(e); });
-    });
-  }
+  void Close();
   // Drops the TCP connection without a WebSocket close frame.
-  void Abort() {
-    beast::error_code ec;
-    beast::get_lowest_layer(ws_).socket().close(ec);
-  }
+  void Abort();
 
  private:
-  template <typename Start>
-  beast::error_code Await(Start start) {
-    std::optional<beast::error_code> result;
-    start([&result](beast::error_code ec) { result = ec; });
-    io_.restart();
-    io_.run_for(std::chrono::duration_cast<std::chrono::nanoseconds>(
-        std::chrono::duration<double>(timeout_)));
-    if (result) return *result;
-    Abort();
-    io_.restart();
-    io_.run();
-    return asio::error::timed_out;
-  }
-
-  double timeout_;
-  asio::io_context io_;
-  websocket::stream<beast::tcp_stream> ws_;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace frenetic::net::testing
