@@ -38,7 +38,9 @@ constexpr std::size_t kRegionBytes = kSlotBytes * kSlots;
 thread_local int t_slot = -1;
 thread_local int t_depth = 0;
 
-bool InRegion(const void* p) {
+// [[maybe_unused]]: the interposer's helpers below are unused when it is off
+// (FRENETIC_HEAP_INTERPOSED=0, under sanitizers).
+[[maybe_unused]] bool InRegion(const void* p) {
   const char* c = static_cast<const char*>(p);
   const char* region = g_region.load(std::memory_order_relaxed);
   return region != nullptr && c >= region && c < region + kRegionBytes;
@@ -83,7 +85,7 @@ void WindBack() {
 std::size_t Rounded(std::size_t size) { return (size + 15) / 16 * 16; }
 
 // A block of the thread's slot, or nullptr (no scope, no slot, or full).
-void* FromSlot(std::size_t size) {
+[[maybe_unused]] void* FromSlot(std::size_t size) {
   if (t_depth <= 0 || t_slot < 0) return nullptr;
   Slot& s = g_slots[t_slot];
   const std::size_t rounded = Rounded(size);
@@ -97,19 +99,19 @@ void* FromSlot(std::size_t size) {
   return block + kHeader;
 }
 
-std::size_t BlockSize(const void* p) {
+[[maybe_unused]] std::size_t BlockSize(const void* p) {
   std::size_t size = 0;
   std::memcpy(&size, static_cast<const char*>(p) - kHeader, sizeof(size));
   return size;
 }
 
-void FreeBlock(const void* p) {
+[[maybe_unused]] void FreeBlock(const void* p) {
   const char* region = g_region.load(std::memory_order_relaxed);
   const auto slot = static_cast<std::size_t>(static_cast<const char*>(p) - region) / kSlotBytes;
   g_slots[slot].live.fetch_sub(1, std::memory_order_release);
 }
 
-void Count() {
+[[maybe_unused]] void Count() {
   if (g_count_allocations.load(std::memory_order_relaxed)) {
     g_allocations.fetch_add(1, std::memory_order_relaxed);
   }

@@ -59,7 +59,8 @@ void MapReader::Error(std::string_view message) {
 }
 
 void MapReader::Fail(std::string_view name, std::string_view what) {
-  Error("'" + std::string(name) + "' " + std::string(what));
+  // Appended, not "'" + std::string(name): GCC 12 warns falsely (-Wrestrict) on the latter.
+  Error(std::string("'").append(name).append("' ").append(what));
 }
 
 bool MapReader::Has(std::string_view key) const {

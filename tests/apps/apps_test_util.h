@@ -12,7 +12,7 @@
 
 namespace frenetic::testing {
 
-inline std::string UdacityMap() { return std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv"; }
+inline std::string UdacityMap() { return std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv"); }
 inline bool HaveUdacityMap() { return std::filesystem::exists(UdacityMap()); }
 
 struct CommandResult {

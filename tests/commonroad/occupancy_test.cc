@@ -242,7 +242,7 @@ TEST(OccupancySetTest, AStartOnItsInitialShapeIsInfeasibleAtStart) {
 
 TEST(OccupancySetTest, TheSharedSpotSceneIsRead) {
   const std::string path =
-      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+      std::string(FRENETIC_SHARED_DIR "/commonroad/us101/USA_US101-1_1_S-1.xml");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
   const StatusOr<Scenario> s = LoadScenario(path);
   ASSERT_TRUE(s.ok()) << s.message();

@@ -521,7 +521,7 @@ TEST(RunnerTest, PassesACarGivenAsASetBasedPrediction) {
 // by what the vehicle can reach across the road and checked against each step's occupancy.
 TEST(RunnerTest, TheSharedSetBasedSceneIsSolvedWithItsOccupancies) {
   const std::string path =
-      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+      std::string(FRENETIC_SHARED_DIR "/commonroad/us101/USA_US101-1_1_S-1.xml");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent";
   auto sc = LoadScenario(path);
   ASSERT_TRUE(sc.ok()) << sc.message();

@@ -570,7 +570,7 @@ TEST(ScenarioReaderFuzzTest, SetBasedFileTruncatedAndMutated) {
 
 TEST(ScenarioReaderFuzzTest, RealSetBasedFileTruncatedAndMutated) {
   const std::string path =
-      std::string(FRENETIC_SHARED_DIR) + "/commonroad/us101/USA_US101-1_1_S-1.xml";
+      std::string(FRENETIC_SHARED_DIR "/commonroad/us101/USA_US101-1_1_S-1.xml");
   std::ifstream in(path);
   if (!in) GTEST_SKIP() << path << " is absent";
   std::stringstream text;
@@ -579,7 +579,7 @@ TEST(ScenarioReaderFuzzTest, RealSetBasedFileTruncatedAndMutated) {
 }
 
 TEST(ScenarioReaderFuzzTest, RealFileTruncatedAndMutated) {
-  const std::string path = std::string(FRENETIC_SHARED_DIR) + "/commonroad/DEU_Muc-2_1_T-1.xml";
+  const std::string path = std::string(FRENETIC_SHARED_DIR "/commonroad/DEU_Muc-2_1_T-1.xml");
   std::ifstream in(path);
   if (!in) GTEST_SKIP() << path << " is absent";
   std::stringstream text;

@@ -13,7 +13,7 @@
 namespace frenetic::commonroad {
 namespace {
 
-std::string SharedDir() { return std::string(FRENETIC_SHARED_DIR) + "/commonroad"; }
+std::string SharedDir() { return std::string(FRENETIC_SHARED_DIR "/commonroad"); }
 
 std::vector<std::string> SharedFiles() {
   std::vector<std::string> files;

@@ -168,7 +168,7 @@ TEST(SolutionTest, ReadsTheTrafficRuleCostIdAndVehicleOne) {
 // Every solution file of ../shared/commonroad/highD (the recorded human drivers) reads: KS1, TR2,
 // one trajectory for the scenario beside it (named like the file, which the CLI does not rely on).
 TEST(SolutionTest, ReadsTheSharedHighDSolutionFiles) {
-  const std::filesystem::path dir = std::string(FRENETIC_SHARED_DIR) + "/commonroad/highD";
+  const std::filesystem::path dir = std::string(FRENETIC_SHARED_DIR "/commonroad/highD");
   std::vector<std::filesystem::path> files;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {

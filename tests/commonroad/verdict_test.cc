@@ -513,7 +513,7 @@ TEST(VerdictTest, MeetsGoalForARunner) {
 // The examples: a straight constant-speed run from each initial state is checked without trouble
 // (start and dynamics hold; what else fails depends on the scene).
 TEST(VerdictTest, SharedExamplesCheckAStraightRun) {
-  const std::string dir = std::string(FRENETIC_SHARED_DIR) + "/commonroad";
+  const std::string dir = std::string(FRENETIC_SHARED_DIR "/commonroad");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) GTEST_SKIP() << dir << " absent";
   int files = 0;

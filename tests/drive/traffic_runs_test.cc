@@ -80,7 +80,7 @@ TEST(SimulateTraffic, RejectsBadProfiles) {
   TrafficRunOptions options;
   options.ego_profiles = {p};
   options.ego_profiles[0].t = {0, 2, 1};  // not increasing
-  auto world = LoadWorld(std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv");
+  auto world = LoadWorld(std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv"));
   if (!world.ok()) GTEST_SKIP() << "Udacity map absent: " << world.message();
   auto r = SimulateTraffic(*world, options, "");
   ASSERT_FALSE(r.ok());

@@ -15,7 +15,7 @@ namespace {
 class ChordFrenetUdacity : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string path = std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv";
+    const std::string path = std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv");
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "Udacity map absent: " << path;
     auto track = LoadTrack(path);
     ASSERT_TRUE(track.ok()) << track.message();

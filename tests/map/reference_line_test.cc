@@ -18,7 +18,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 const double kOffsets[] = {-2, 0, 2, 6, 10, 14};
 
-std::string UdacityMapPath() { return std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv"; }
+std::string UdacityMapPath() { return std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv"); }
 
 // Fits once per map for the whole test binary: fitting is the expensive part.
 std::shared_ptr<const ReferenceLine> FitOrDie(const std::string& path) {

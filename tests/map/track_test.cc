@@ -120,7 +120,7 @@ TEST(TrackTest, FormatParsesBack) {
 }
 
 TEST(TrackTest, UdacityMapFacts) {
-  const std::string path = std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv";
+  const std::string path = std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "Udacity map absent: " << path;
   auto t = LoadTrack(path);
   ASSERT_TRUE(t.ok()) << t.message();

@@ -15,7 +15,7 @@
 namespace frenetic::sim::testing {
 
 inline std::string UdacityMapPath() {
-  return std::string(FRENETIC_SHARED_DIR) + "/data/highway_map.csv";
+  return std::string(FRENETIC_SHARED_DIR "/data/highway_map.csv");
 }
 
 // The Udacity world, or nullptr when the map is absent (callers GTEST_SKIP).

@@ -193,8 +193,10 @@ std::string WithRawValue(const char* key, const std::string& raw) {
   json j = FirstPayload();
   j[key] = 12345.5;
   std::string s = Frame(j);
-  const std::string needle = "\"" + std::string(key) + "\":12345.5";
-  s.replace(s.find(needle), needle.size(), "\"" + std::string(key) + "\":" + raw);
+  // Appended: GCC 12 warns falsely (-Wrestrict) on "\"" + std::string(key).
+  const std::string quoted = std::string("\"").append(key).append("\":");
+  const std::string needle = quoted + "12345.5";
+  s.replace(s.find(needle), needle.size(), quoted + raw);
   return s;
 }
 
