@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang in build-fuzz and runs them one after the other: the
-# wire-protocol fuzzer, then the CommonRoad readers' (scenario and solution files).
+# Builds the libFuzzer targets with clang in build-fuzz and runs them, side by side with two cores
+# or more (FRENETIC_JOBS, default 2): the wire-protocol fuzzer and the CommonRoad readers'
+# (scenario and solution files).
 #   scripts/fuzz.sh [SECONDS]     run each for SECONDS (default 60); exit 0 when nothing was found
 #   FRENETIC_FUZZ_SEED=N          libFuzzer seed (default 1, so CI runs are repeatable)
 # Needs clang and libclang-rt-14-dev. Findings (crash-*, leak-*, timeout-*) land in build-fuzz/.
@@ -64,8 +65,8 @@ cat >"$DICT" <<'DICT_EOF'
 DICT_EOF
 
 cd "$BUILD"
-./frame_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 -timeout=10 \
-  -rss_limit_mb=2048 -dict="$DICT" -print_final_stats=1 "$CORPUS" "$SEEDS"
+FRAME_RUN=(./frame_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN"
+  -max_len=16384 -timeout=10 -rss_limit_mb=2048 -dict="$DICT" -print_final_stats=1 "$CORPUS" "$SEEDS")
 
 # The CommonRoad readers: a hand-made scenario (every element they read) and solution, with the
 # small solution files of the shared highD set when present (the scenarios are too long).
@@ -76,6 +77,28 @@ cp "$ROOT"/tests/fuzz/seeds/scenario_parser/*.xml "$SEEDS/"
 for f in "$SHARED"/commonroad/highD/*.solution.xml; do
   if [ -f "$f" ] && [ "$(wc -c <"$f")" -le 16384 ]; then cp "$f" "$SEEDS/"; fi
 done
-./scenario_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN" -max_len=16384 \
-  -timeout=10 -rss_limit_mb=2048 -dict="$ROOT/tests/fuzz/seeds/scenario_parser/xml.dict" \
-  -print_final_stats=1 "$CORPUS" "$SEEDS"
+SCENARIO_RUN=(./scenario_parser_fuzz -seed="${FRENETIC_FUZZ_SEED:-1}" -max_total_time="$SECONDS_TO_RUN"
+  -max_len=16384 -timeout=10 -rss_limit_mb=2048 -dict="$ROOT/tests/fuzz/seeds/scenario_parser/xml.dict"
+  -print_final_stats=1 "$CORPUS" "$SEEDS")
+
+# With two cores or more the fuzzers run side by side, each into its log, then the end of each
+# log is printed (all of a log whose fuzzer found something); else one after the other.
+if [ "$JOBS" -lt 2 ]; then
+  "${FRAME_RUN[@]}"
+  "${SCENARIO_RUN[@]}"
+  exit 0
+fi
+"${FRAME_RUN[@]}" >frame_parser_fuzz.log 2>&1 &
+frame_pid=$!
+"${SCENARIO_RUN[@]}" >scenario_parser_fuzz.log 2>&1 &
+scenario_pid=$!
+frame_status=0
+scenario_status=0
+wait "$frame_pid" || frame_status=$?
+wait "$scenario_pid" || scenario_status=$?
+for run in "frame_parser_fuzz $frame_status" "scenario_parser_fuzz $scenario_status"; do
+  set -- $run
+  echo "== $1 (exit $2; the whole log: $BUILD/$1.log)"
+  if [ "$2" -eq 0 ]; then tail -n 12 "$1.log"; else cat "$1.log"; fi
+done
+[ "$frame_status" -eq 0 ] && [ "$scenario_status" -eq 0 ]
