@@ -38,14 +38,6 @@ constexpr std::size_t kRegionBytes = kSlotBytes * kSlots;
 thread_local int t_slot = -1;
 thread_local int t_depth = 0;
 
-// [[maybe_unused]]: the interposer's helpers below are unused when it is off
-// (FRENETIC_HEAP_INTERPOSED=0, under sanitizers).
-[[maybe_unused]] bool InRegion(const void* p) {
-  const char* c = static_cast<const char*>(p);
-  const char* region = g_region.load(std::memory_order_relaxed);
-  return region != nullptr && c >= region && c < region + kRegionBytes;
-}
-
 // Gives the slot back when its thread ends (its blocks may outlive it: a slot with live blocks
 // is not wound back until they are freed, by whoever takes it next).
 struct SlotRelease {
@@ -81,42 +73,6 @@ void WindBack() {
   if (s.live.load(std::memory_order_acquire) == 0) s.used = 0;
 }
 
-// The bytes a block of `size` takes after its header (its usable size).
-std::size_t Rounded(std::size_t size) { return (size + 15) / 16 * 16; }
-
-// A block of the thread's slot, or nullptr (no scope, no slot, or full).
-[[maybe_unused]] void* FromSlot(std::size_t size) {
-  if (t_depth <= 0 || t_slot < 0) return nullptr;
-  Slot& s = g_slots[t_slot];
-  const std::size_t rounded = Rounded(size);
-  if (size > kSlotBytes || rounded + kHeader > kSlotBytes - s.used) return nullptr;
-  char* block = g_region.load(std::memory_order_relaxed) +
-                static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
-  s.used += rounded + kHeader;
-  ++s.served;
-  s.live.fetch_add(1, std::memory_order_relaxed);
-  std::memcpy(block, &size, sizeof(size));
-  return block + kHeader;
-}
-
-[[maybe_unused]] std::size_t BlockSize(const void* p) {
-  std::size_t size = 0;
-  std::memcpy(&size, static_cast<const char*>(p) - kHeader, sizeof(size));
-  return size;
-}
-
-[[maybe_unused]] void FreeBlock(const void* p) {
-  const char* region = g_region.load(std::memory_order_relaxed);
-  const auto slot = static_cast<std::size_t>(static_cast<const char*>(p) - region) / kSlotBytes;
-  g_slots[slot].live.fetch_sub(1, std::memory_order_release);
-}
-
-[[maybe_unused]] void Count() {
-  if (g_count_allocations.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-}
-
 }  // namespace
 
 ScratchScope::ScratchScope() {
@@ -143,6 +99,56 @@ SlotUse ThreadSlotUse() {
 }  // namespace frenetic::plan::heap
 
 #if FRENETIC_HEAP_INTERPOSED
+namespace frenetic::plan::heap {
+namespace {
+
+// The interposer's own helpers (compiled only with it).
+
+bool InRegion(const void* p) {
+  const char* c = static_cast<const char*>(p);
+  const char* region = g_region.load(std::memory_order_relaxed);
+  return region != nullptr && c >= region && c < region + kRegionBytes;
+}
+
+// The bytes a block of `size` takes after its header (its usable size).
+std::size_t Rounded(std::size_t size) { return (size + 15) / 16 * 16; }
+
+// A block of the thread's slot, or nullptr (no scope, no slot, or full).
+void* FromSlot(std::size_t size) {
+  if (t_depth <= 0 || t_slot < 0) return nullptr;
+  Slot& s = g_slots[t_slot];
+  const std::size_t rounded = Rounded(size);
+  if (size > kSlotBytes || rounded + kHeader > kSlotBytes - s.used) return nullptr;
+  char* block = g_region.load(std::memory_order_relaxed) +
+                static_cast<std::size_t>(t_slot) * kSlotBytes + s.used;
+  s.used += rounded + kHeader;
+  ++s.served;
+  s.live.fetch_add(1, std::memory_order_relaxed);
+  std::memcpy(block, &size, sizeof(size));
+  return block + kHeader;
+}
+
+std::size_t BlockSize(const void* p) {
+  std::size_t size = 0;
+  std::memcpy(&size, static_cast<const char*>(p) - kHeader, sizeof(size));
+  return size;
+}
+
+void FreeBlock(const void* p) {
+  const char* region = g_region.load(std::memory_order_relaxed);
+  const auto slot = static_cast<std::size_t>(static_cast<const char*>(p) - region) / kSlotBytes;
+  g_slots[slot].live.fetch_sub(1, std::memory_order_release);
+}
+
+void Count() {
+  if (g_count_allocations.load(std::memory_order_relaxed)) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+}  // namespace
+}  // namespace frenetic::plan::heap
+
 namespace fh = frenetic::plan::heap;
 
 extern "C" {

@@ -6,7 +6,6 @@
 
 #include <atomic>
 #include <boost/system/error_code.hpp>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <optional>
