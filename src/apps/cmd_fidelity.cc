@@ -53,8 +53,6 @@ std::string Number(double v) {
   return buf;
 }
 
-nlohmann::json Finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 int Error(const std::string& message) {
   std::fprintf(stderr, "frenetic fidelity: %s\n", message.c_str());
   return 2;
@@ -162,7 +160,7 @@ int RunFidelity(const FidelityArgs& args) {
       j["checks"].push_back({{"check", row.check},
                              {"cases", row.cases},
                              {"passed", row.passed},
-                             {"worst", Finite(row.worst)},
+                             {"worst", FiniteOrNull(row.worst)},
                              {"tolerance", row.tolerance},
                              {"unit", row.unit},
                              {"ok", row.ok()},
@@ -172,9 +170,9 @@ int RunFidelity(const FidelityArgs& args) {
     for (const auto& s : stats) {
       j["traffic"].push_back({{"statistic", s.name},
                               {"unit", s.unit},
-                              {"real", Finite(s.real)},
-                              {"sim", Finite(s.sim)},
-                              {"ratio", Finite(s.ratio)},
+                              {"real", FiniteOrNull(s.real)},
+                              {"sim", FiniteOrNull(s.sim)},
+                              {"ratio", FiniteOrNull(s.ratio)},
                               {"band", {s.lo, s.hi}},
                               {"real_samples", s.real_n},
                               {"sim_samples", s.sim_n},

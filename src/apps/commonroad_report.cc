@@ -18,6 +18,10 @@ double Percentile(std::vector<double> values, double q) {
   return values[i];
 }
 
+double Max(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
+}
+
 Outcome CompareOutcome(const ProblemReport& p) {
   if (p.verdict.infeasible_at_start) return Outcome::kInfeasibleAtStart;
   const bool ours = p.verdict.solved;
@@ -116,10 +120,6 @@ std::string ReferenceLine(const ProblemReport& p, double dt) {
     case Outcome::kNeither: line += "neither reaches the goal"; break;
   }
   return line + "\n";
-}
-
-double Max(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
 std::string VerdictLine(const ProblemReport& p) {

@@ -76,6 +76,9 @@ struct FileReport {
 // for none.
 double Percentile(std::vector<double> values, double q);
 
+// The largest of the values; 0 for none.
+double Max(const std::vector<double>& values);
+
 // How a problem with a reference compares. Ours reaches the goal when its verdict says solved;
 // the reference when one of its states meets a goal state (its verdict is not asked: recorded
 // trajectories fail the start and dynamics checks for reasons of the recording, see

@@ -37,10 +37,6 @@ std::string FirstFailure(const ProblemReport& p) {
 
 namespace {
 
-double Max(const std::vector<double>& values) {
-  return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
-}
-
 std::string Format(const char* format, auto... args) {
   char buf[512];
   std::snprintf(buf, sizeof(buf), format, args...);

@@ -133,7 +133,8 @@ std::vector<int> RouteTo(const Network& net, int start, const std::set<int>& goa
       reached = i;
       break;
     }
-    auto relax = [&](int j, double cost) {
+    // (The bindings by value: clang 14 cannot capture structured bindings.)
+    auto relax = [&, d = d, i = i](int j, double cost) {
       if (j >= 0 && d + cost < dist[j]) {
         dist[j] = d + cost;
         from[j] = i;

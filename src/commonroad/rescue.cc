@@ -12,7 +12,6 @@
 namespace frenetic::commonroad {
 namespace {
 
-constexpr double kTick = plan::kTickSeconds;
 // Grid cells: position, speed, heading, steering angle; the strata of the spread (position,
 // speed, speed across the search's start heading; the 1e3 cell leaves of the steering only its
 // sign). See Rescue::Stratum.
@@ -66,7 +65,7 @@ bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, int
   if (j + 1 >= n) return false;
   const int a = std::max(0, j - 1);
   const double dx = x[j + 1] - x[a], dy = y[j + 1] - y[a];
-  *p = {x[j], y[j], std::atan2(dy, dx), std::hypot(dx, dy) / ((j + 1 - a) * kTick)};
+  *p = {x[j], y[j], std::atan2(dy, dx), std::hypot(dx, dy) / ((j + 1 - a) * plan::kTickSeconds)};
   return true;
 }
 
@@ -239,7 +238,7 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
 
 Rescue::PathCheck Rescue::Walk(const std::vector<double>& x, const std::vector<double>& y,
                                const std::vector<cost::GoalRegion>& goals) const {
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / plan::kTickSeconds)));
   PathCheck c;
   PathPoint p;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
@@ -600,7 +599,7 @@ std::uint64_t Rescue::StratumAcross(const KsState& q, double across) {
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {
   x->clear();
   y->clear();
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / kTick)));
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / plan::kTickSeconds)));
   const double h = dt_ / ticks;
   KsState s = ego;
   for (const KsInput& u : way_) {

@@ -11,7 +11,9 @@
 
 // Boost.Geometry 1.74's rescale policy (get_rescale_policy.hpp) trips GCC 12's
 // -Wmaybe-uninitialized once inlined into Build(); the value is set on every path that reads it.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 namespace frenetic::commonroad {
 

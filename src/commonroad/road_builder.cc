@@ -68,7 +68,6 @@ LaneletStations ProjectLanelet(const Lanelet& l, const map::ReferenceLine& line)
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // m: where the skeleton moves to a neighbour lane (its own ends), the reference polyline leaves
 // out this much on both sides of the junction, so that it crosses over gently.
 constexpr double kJumpBlend = 25.0;
@@ -340,7 +339,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     // Contiguous pieces make one lane; a gap starts another at the same position.
     map::LaneProfile lane;
     std::vector<int> ids;
-    auto flush = [&] {
+    auto flush = [&, pos = pos] {  // (clang 14 cannot capture structured bindings)
       if (lane.s.size() >= 2) {
         // Open ends (a first lanelet without predecessors, a last one without successors) go on
         // kOpenEnd m, as the verdict's road area does: a car may start there with its rear
@@ -397,7 +396,7 @@ StatusOr<BuiltRoad> BuildRoad(const Scenario& scenario, const PlanningProblem& p
     std::vector<char> touching(l.s.size(), 1);
     bool apart = false;
     for (size_t k = 0; k < l.s.size(); ++k) {
-      double gap = kInf;
+      double gap = std::numeric_limits<double>::infinity();
       bool beside = false;
       for (size_t j = 0; j < lanes.size(); ++j) {
         double right = 0;

@@ -21,7 +21,6 @@
 namespace frenetic::commonroad {
 namespace {
 
-constexpr double kTick = plan::kTickSeconds;
 // The planner's limits sit this far inside the verdict's: it measures them on its own path,
 // which the KS ego follows to within centimetres, not exactly.
 constexpr double kLimitMargin = 0.85;
@@ -66,7 +65,7 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
   constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
   constexpr double kMinSpan = 0.5;      // m: the shortest chord the path's direction is taken on
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
+  const int ticks = std::max(1, static_cast<int>(std::lround(dt / plan::kTickSeconds)));
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
   const int j = ticks - 1;  // the point dt in
@@ -78,7 +77,7 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
     if (b + 1 < n) ++b;
   }
   const double theta = std::atan2(y[b] - y[a], x[b] - x[a]);
-  const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * kTick);
+  const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * plan::kTickSeconds);
   const double kappa = Curvature(x[a], y[a], x[j], y[j], x[b], y[b]);
   const double l_wb = vp.Wheelbase();
   const double delta_ff = std::atan(l_wb * kappa);
@@ -366,7 +365,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       cyc.checked = res.summary.candidates_checked;
       cyc.status = res.status;
       // The ego drives dt along the plan.
-      const int ticks = std::max(1, static_cast<int>(std::lround(dt / kTick)));
+      const int ticks = std::max(1, static_cast<int>(std::lround(dt / plan::kTickSeconds)));
       if (rescue_input) {
         // The way's input, exactly (the search simulated it); the planner gets the rest of the
         // way as its previous path.

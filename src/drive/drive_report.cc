@@ -7,12 +7,10 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include "frenetic/json_text.h"
+
 namespace frenetic::sim {
 namespace {
-
-nlohmann::json Finite(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
 
 std::string Maybe(double v, const char* fmt_unit) {
   return std::isfinite(v) ? fmt::format(fmt::runtime(fmt_unit), v) : std::string("none");
@@ -171,8 +169,8 @@ nlohmann::json DriveReport::ToJson() const {
       {"max_jerk", max_jerk},
       {"mean_squared_jerk", mean_squared_jerk},
       {"lane_changes", lane_changes},
-      {"min_gap_m", Finite(min_gap_m)},
-      {"min_headway_s", Finite(min_headway_s)},
+      {"min_gap_m", FiniteOrNull(min_gap_m)},
+      {"min_headway_s", FiniteOrNull(min_headway_s)},
       {"plan_ms", {{"p50", plan_ms_p50}, {"p99", plan_ms_p99}, {"max", plan_ms_max}}},
       {"plan_fallbacks", plan_fallbacks},
       {"breakdown", BreakdownJson(breakdown, &laps)},

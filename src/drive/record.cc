@@ -17,10 +17,6 @@ namespace {
 
 namespace key = record::key;
 
-nlohmann::json Finite(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 // `"key":`, as JSON text.
 void AppendKey(const char* key, std::string* line) {
   *line += '"';
@@ -70,8 +66,8 @@ void FormatExchange(int index, double t, const std::string& telemetry_json,
                             {"acc_n", mt.acc_n},
                             {"jerk", mt.jerk},
                             {"lane", mt.lane},
-                            {"gap", has_leader ? Finite(mt.gap) : nlohmann::json()},
-                            {"headway", has_leader ? Finite(mt.headway) : nlohmann::json()},
+                            {"gap", has_leader ? FiniteOrNull(mt.gap) : nlohmann::json()},
+                            {"headway", has_leader ? FiniteOrNull(mt.headway) : nlohmann::json()},
                             {"leader", mt.leader},
                             {"distance_m", mt.distance_m},
                             {"curr_miles", mt.curr_miles},

@@ -21,7 +21,6 @@ namespace judge {
 namespace {
 
 constexpr double kDt = 0.02;
-constexpr int kBlockTicks = 10;  // the monitor's acceleration block
 constexpr double kBlockSeconds = kBlockTicks * kDt;
 // Along-lane speed cap, m/s: 49.88 mph, under the simulator's 50 mph with room for the float32
 // jitter of positions (a speed still measured over 50 mph is caught by the monitor anyway).
@@ -516,7 +515,6 @@ StartJudgement SearchFrom(const World& world, const IncidentCase& c, std::int64_
 }  // namespace judge
 
 using judge::kBlockSeconds;
-using judge::kBlockTicks;
 using judge::kDt;
 
 Status JudgeOptions::Validate() const {

@@ -6,8 +6,6 @@
 namespace frenetic::sim {
 namespace {
 
-constexpr int kBlockTicks = 10;
-
 bool AnyFlag(const IncidentMonitor& m) {
   for (int k = 0; k < kIncidentKinds; ++k) {
     if (m.active(static_cast<IncidentKind>(k))) return true;

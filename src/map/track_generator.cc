@@ -3,16 +3,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
+#include <spdlog/fmt/fmt.h>
+
 namespace frenetic::map {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr int kFirstHarmonic = 2;
 constexpr int kLastHarmonic = 5;
 constexpr int kHarmonics = kLastHarmonic - kFirstHarmonic + 1;
@@ -22,11 +22,6 @@ constexpr double kRadiusMargin = 1.02;
 constexpr double kSpacingJitter = 0.12;
 constexpr double kClearanceSeparation = 300.0;  // m of arc: nearer parts are neighbours
 
-std::string Fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.6g", v);
-  return buf;
-}
 
 // std::uniform_real_distribution is implementation-defined; this is not.
 double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
@@ -50,7 +45,7 @@ struct Shape {
     *r1 = r0 * b;
     *r2 = r0 * c;
   }
-  double Phi(int i) const { return -0.5 * kPi + 2 * kPi * i / kGrid; }
+  double Phi(int i) const { return -0.5 * std::numbers::pi + 2 * std::numbers::pi * i / kGrid; }
 };
 
 struct ShapeStats {
@@ -68,7 +63,7 @@ ShapeStats Measure(const Shape& sh) {
     st.length += std::sqrt(q);
     max_k = std::max(max_k, std::abs(r * r + 2 * r1 * r1 - r * r2) / (q * std::sqrt(q)));
   }
-  st.length *= 2 * kPi / kGrid;  // periodic trapezoid rule: spectrally accurate
+  st.length *= 2 * std::numbers::pi / kGrid;  // periodic trapezoid rule: spectrally accurate
   st.min_radius = max_k > 0 ? 1.0 / max_k : INFINITY;
   return st;
 }
@@ -110,22 +105,25 @@ double Clearance(const Shape& sh, double length) {
 
 Status TrackGeneratorOptions::Validate() const {
   if (!(length >= 1000 && length <= 100000)) {
-    return Status::Error("track generator: length must be in [1000, 100000] m, got " + Fmt(length));
+    return Status::Error(
+        fmt::format("track generator: length must be in [1000, 100000] m, got {:.6g}", length));
   }
   if (!(spacing >= 5 && spacing <= 200) || spacing * 8 > length) {
-    return Status::Error(
-        "track generator: spacing must be in [5, 200] m and at most length/8, got " + Fmt(spacing));
+    return Status::Error(fmt::format(
+        "track generator: spacing must be in [5, 200] m and at most length/8, got {:.6g}",
+        spacing));
   }
-  if (!(min_radius >= 20 && min_radius < length / (2 * kPi))) {
-    return Status::Error("track generator: min_radius must be in [20, length/(2 pi) = " +
-                         Fmt(length / (2 * kPi)) + ") m, got " + Fmt(min_radius));
+  if (!(min_radius >= 20 && min_radius < length / (2 * std::numbers::pi))) {
+    return Status::Error(fmt::format(
+        "track generator: min_radius must be in [20, length/(2 pi) = {:.6g}) m, got {:.6g}",
+        length / (2 * std::numbers::pi), min_radius));
   }
   if (!std::isfinite(centre_x) || !std::isfinite(centre_y)) {
     return Status::Error("track generator: centre must be finite");
   }
   if (!(min_clearance >= 0 && min_clearance < length / 10)) {
-    return Status::Error("track generator: min_clearance must be in [0, length/10) m, got " +
-                         Fmt(min_clearance));
+    return Status::Error(fmt::format(
+        "track generator: min_clearance must be in [0, length/10) m, got {:.6g}", min_clearance));
   }
   return Status::Ok();
 }
@@ -139,7 +137,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
     const double k = kFirstHarmonic + i;
     // Lower harmonics dominate: an elongated, gently bent loop rather than a flower.
     sh.amp[i] = (0.3 + 0.7 * Uniform(rng)) / (k * k);
-    sh.phase[i] = 2 * kPi * Uniform(rng);
+    sh.phase[i] = 2 * std::numbers::pi * Uniform(rng);
     total += sh.amp[i];
   }
   for (double& a : sh.amp) a /= total;
@@ -153,8 +151,8 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
   };
   double lo = 0, hi = kMaxAlpha;
   if (!feasible(lo)) {
-    return Status::Error("track generator: no loop meets min_clearance " + Fmt(o.min_clearance) +
-                         " m");
+    return Status::Error(
+        fmt::format("track generator: no loop meets min_clearance {:.6g} m", o.min_clearance));
   }
   if (feasible(hi)) {
     lo = hi;
@@ -176,7 +174,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
     for (int i = 1; i <= kGrid; ++i) {
       sh.Radius(sh.Phi(i), &r, &r1, &r2);
       const double cur = std::hypot(r, r1);
-      arc[i] = arc[i - 1] + 0.5 * (prev + cur) * 2 * kPi / kGrid;
+      arc[i] = arc[i - 1] + 0.5 * (prev + cur) * 2 * std::numbers::pi / kGrid;
       prev = cur;
     }
   }
@@ -199,7 +197,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
   for (int k = 0; k < n; ++k) {
     while (cell + 1 < kGrid && arc[cell + 1] <= a) ++cell;
     const double f = (a - arc[cell]) / (arc[cell + 1] - arc[cell]);
-    const double phi = sh.Phi(cell) + f * 2 * kPi / kGrid;
+    const double phi = sh.Phi(cell) + f * 2 * std::numbers::pi / kGrid;
     double r, r1, r2;
     sh.Radius(phi, &r, &r1, &r2);
     const double c = std::cos(phi), s = std::sin(phi);

@@ -30,7 +30,6 @@ Slot g_slots[kSlots];
 // Set once (by the first scope of any thread), before any block of it exists; read by every
 // free().
 std::atomic<char*> g_region{nullptr};
-constexpr std::size_t kHeader = 16;
 constexpr std::size_t kRegionBytes = kSlotBytes * kSlots;
 
 // The thread's slot (-1: none yet, -2: none to be had) and how deep its scopes are; plain
@@ -103,6 +102,8 @@ namespace frenetic::plan::heap {
 namespace {
 
 // The interposer's own helpers (compiled only with it).
+
+constexpr std::size_t kHeader = 16;  // bytes before each block: its size
 
 bool InRegion(const void* p) {
   const char* c = static_cast<const char*>(p);

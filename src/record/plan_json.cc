@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "frenetic/json_text.h"
+
 namespace frenetic::record {
 namespace {
 
@@ -20,14 +22,11 @@ const char* StatusName(plan::PlanStatus s) {
   return "?";
 }
 
-nlohmann::json Finite(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 nlohmann::json Costs(const std::vector<plan::CostTermValue>& terms) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& t : terms) {
-    a.push_back({{"name", t.name}, {"weight", Finite(t.weight)}, {"value", Finite(t.value)}});
+    a.push_back(
+        {{"name", t.name}, {"weight", FiniteOrNull(t.weight)}, {"value", FiniteOrNull(t.value)}});
   }
   return a;
 }
@@ -100,15 +99,15 @@ nlohmann::json PlanJson(plan::PlanStatus status, const plan::PlanSummary& s, dou
       reject = plan::ToString(static_cast<plan::Reject>(c.reject));
     }
     traced.push_back({{"lane", c.lane},
-                      {"end_speed", Finite(c.end_speed)},
-                      {"duration", Finite(c.duration)},
-                      {"total_cost", Finite(c.total_cost)},
+                      {"end_speed", FiniteOrNull(c.end_speed)},
+                      {"duration", FiniteOrNull(c.duration)},
+                      {"total_cost", FiniteOrNull(c.total_cost)},
                       {"checked", c.checked},
                       {"winner", c.winner},
                       {"reject", reject},
                       {"reject_car", c.reject_car >= 0 ? nlohmann::json(c.reject_car)
                                                        : nlohmann::json(nullptr)},
-                      {"reject_t", Finite(c.reject_time)},
+                      {"reject_t", FiniteOrNull(c.reject_time)},
                       {"x", Decimeters(c.x)},
                       {"y", Decimeters(c.y)},
                       {"costs", Costs(c.costs)}});
@@ -129,14 +128,14 @@ nlohmann::json PlanJson(plan::PlanStatus status, const plan::PlanSummary& s, dou
           {"candidates_feasible", s.candidates_feasible},
           {"rejections", rejections},
           {"winner_costs", Costs(s.winner_costs)},
-          {"winner_total_cost", Finite(s.winner_total_cost)},
+          {"winner_total_cost", FiniteOrNull(s.winner_total_cost)},
           {"winner_lane", s.winner_lane},
-          {"winner_end_speed", Finite(s.winner_end_speed)},
-          {"winner_duration", Finite(s.winner_duration)},
+          {"winner_end_speed", FiniteOrNull(s.winner_end_speed)},
+          {"winner_duration", FiniteOrNull(s.winner_duration)},
           {"refine_iterations", s.refine_iterations},
           {"deadline_stage", plan::ToString(s.deadline_stage)},
-          {"refine_cost_before", Finite(s.refine_cost_before)},
-          {"refine_cost_after", Finite(s.refine_cost_after)},
+          {"refine_cost_before", FiniteOrNull(s.refine_cost_before)},
+          {"refine_cost_after", FiniteOrNull(s.refine_cost_after)},
           {"points_kept", s.points_kept},
           {"candidates", traced}};
 }

@@ -12,7 +12,6 @@ namespace {
 // m: a car that moves from ahead to behind (or back) by less than this in one tick was passed;
 // a larger jump is a respawn or the s wrap.
 constexpr double kPassReach = 50.0;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 int LaneOfD(double d) { return d >= 0 && d < 12 ? static_cast<int>(d / 4.0) : -1; }
 
@@ -79,6 +78,7 @@ void DriveBreakdown::Update(double dt, const EgoView& ego, int ego_lane, bool la
 
   // Per lane: whether a car blocks moving in, and the nearest car ahead beyond that (its speed).
   bool occupied[3] = {false, false, false};
+  constexpr double kInf = std::numeric_limits<double>::infinity();
   double ahead_ds[3] = {kInf, kInf, kInf}, ahead_v[3] = {kInf, kInf, kInf};
   if (seen_.size() < cars.size()) seen_.resize(cars.size());
   for (size_t i = 0; i < cars.size(); ++i) {

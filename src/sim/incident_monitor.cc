@@ -8,7 +8,6 @@
 namespace frenetic::sim {
 namespace {
 
-constexpr double kTick = 0.02;
 // The simulator's own miles conversion (§7.6).
 constexpr double kCounterMetersPerMile = 1609.34;
 
@@ -113,7 +112,7 @@ void IncidentMonitor::Update(const TickSample& sample, double t) {
   block_v_[block_n_] = speed;
   block_x_[block_n_] = sample.x;
   block_y_[block_n_] = sample.y;
-  if (++block_n_ == 10) {
+  if (++block_n_ == kBlockTicks) {
     block_n_ = 0;
     double vbar = 0;
     for (double v : block_v_) vbar += v;

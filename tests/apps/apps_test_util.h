@@ -23,7 +23,7 @@ struct CommandResult {
 // Runs `frenetic ARGS` through the shell and captures stdout.
 inline CommandResult RunFrenetic(const std::string& args) {
   CommandResult r;
-  const std::string cmd = std::string(FRENETIC_BINARY) + " " + args;
+  const std::string cmd = std::string(FRENETIC_BINARY " ") + args;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buf;

@@ -40,7 +40,7 @@ TEST(DriveCli, BadInputGivesOneLineAndExitOne) {
   }
 }
 
-std::vector<std::string> Lines(const std::string& path) {
+std::vector<std::string> FileLines(const std::string& path) {
   std::ifstream in(path);
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -58,7 +58,7 @@ TEST(DriveCli, ProgressOfManyEpisodesGoesToStderr) {
   ASSERT_EQ(quiet.exit_code, 0);
   ASSERT_EQ(shown.exit_code, 0);
   EXPECT_EQ(shown.out, quiet.out);
-  const std::vector<std::string> lines = Lines(err);
+  const std::vector<std::string> lines = FileLines(err);
   ASSERT_FALSE(lines.empty());
   EXPECT_LE(lines.size(), 3u);  // one per episode at most, not a flood
   const std::regex format(

@@ -42,7 +42,7 @@ std::string ReadFile(const fs::path& p) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-std::string Smoke() { return std::string(FRENETIC_SOURCE_DIR) + "/config/tune/smoke.yaml"; }
+std::string Smoke() { return std::string(FRENETIC_SOURCE_DIR "/config/tune/smoke.yaml"); }
 
 class TuneCliTest : public ::testing::Test {
  protected:
@@ -93,7 +93,7 @@ TEST_F(TuneCliTest, UnknownSuiteKeyFailsNamingIt) {
   const fs::path suite = dir_ / "bad.yaml";
   std::ofstream(suite) << "scenarios: [udacity]\ntrain_seeds: [1]\nholdout_seeds: [2]\n"
                           "params: {weights.efficiency: {lo: 0.1, hi: 10}}\nbudgets: 3\n";
-  const ShellResult run = Shell(std::string(FRENETIC_BINARY) + " tune --suite " + suite.string() +
+  const ShellResult run = Shell(std::string(FRENETIC_BINARY " tune --suite ") + suite.string() +
                         " 2>&1");
   EXPECT_NE(run.exit_code, 0);
   EXPECT_THAT(run.out, HasSubstr("bad.yaml"));
@@ -101,7 +101,7 @@ TEST_F(TuneCliTest, UnknownSuiteKeyFailsNamingIt) {
 
   std::ofstream(suite) << "scenarios: [udacity]\ntrain_seeds: [1]\nholdout_seeds: [2]\n"
                           "params: {weights.warp: {lo: 0.1, hi: 10}}\n";
-  const ShellResult run2 = Shell(std::string(FRENETIC_BINARY) + " tune --suite " + suite.string() +
+  const ShellResult run2 = Shell(std::string(FRENETIC_BINARY " tune --suite ") + suite.string() +
                          " 2>&1");
   EXPECT_NE(run2.exit_code, 0);
   EXPECT_THAT(run2.out, HasSubstr("params.weights.warp"));

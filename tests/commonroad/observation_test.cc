@@ -17,14 +17,9 @@ namespace {
 
 using testing::AddStraightRoad;
 using testing::GoalTimeOnlyXml;
+using testing::Parse;
 using testing::ScenarioXml;
 using testing::StateXml;
-
-Scenario Parse(const ScenarioXml& xml) {
-  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
-  EXPECT_TRUE(s.ok()) << s.message();
-  return s.ok() ? std::move(s).value() : Scenario{};
-}
 
 // A reference line along y = 0 from x = -50 to 400.
 const map::ReferenceLine& Line() {
@@ -174,7 +169,7 @@ TEST(ObserveTest, FootprintIsTheShapesBoxPlacedAtTheState) {
 
 // A car 4 x 2 m at (20, 1.75), 10 m/s at step 0, predicted as regions along the left lane that
 // grow 1 m longer and 0.2 m wider each step, their centres 1.5 m apart; none at step 5.
-ScenarioXml SetBasedXml() {
+ScenarioXml GrowingSetBasedXml() {
   ScenarioXml xml;
   AddStraightRoad(xml);
   std::vector<testing::OccupancyXml> occupancies;
@@ -188,7 +183,7 @@ ScenarioXml SetBasedXml() {
 }
 
 TEST(ObserveTest, ASetBasedObstacleIsItsOccupancysBox) {
-  const Scenario s = Parse(SetBasedXml());
+  const Scenario s = Parse(GrowingSetBasedXml());
   plan::Telemetry t;
   // Step 0: its own shape at its initial state, its stated speed.
   Observe(s, 0, Line(), 10, PredictionMode::kConstantVelocity, &t);
@@ -219,7 +214,7 @@ TEST(ObserveTest, ASetBasedObstacleIsItsOccupancysBox) {
 }
 
 TEST(ObserveTest, ASetBasedObstaclesFutureIsItsOccupanciesCentres) {
-  const Scenario s = Parse(SetBasedXml());
+  const Scenario s = Parse(GrowingSetBasedXml());
   plan::Telemetry t;
   Observe(s, 1, Line(), 10, PredictionMode::kRecorded, &t);
   const plan::CarFuture* f = Future(t, 40);

@@ -18,17 +18,12 @@ using testing::AddStraightRoad;
 using testing::AddStraightRoadAt;
 using testing::CircleXml;
 using testing::GoalTimeOnlyXml;
-using ::testing::HasSubstr;
 using testing::OccupancyXml;
+using testing::Parse;
 using testing::PolygonXml;
 using testing::RectangleXml;
 using testing::ScenarioXml;
-
-Scenario Parse(const ScenarioXml& xml) {
-  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
-  EXPECT_TRUE(s.ok()) << s.message();
-  return s.ok() ? std::move(s).value() : Scenario{};
-}
+using ::testing::HasSubstr;
 
 // The corners of a length x width rectangle along +x centred on `c`, as a polygon.
 std::vector<Vec2> Box(Vec2 c, double length, double width) {

@@ -21,7 +21,7 @@
 namespace frenetic::commonroad {
 namespace {
 
-constexpr double kDt = 0.1;
+constexpr double kStep = 0.1;
 constexpr double kLane0 = -1.75, kLane1 = -5.25;  // y of the lanes' centres (d 1.75, 5.25)
 
 std::shared_ptr<const map::Road> TwoLanes() {
@@ -70,7 +70,7 @@ void Straight(double x0, double y, double v, int n, std::vector<double>* x, std:
 
 TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
+  Rescue rescue(*road, VehicleParams(), kStep);
   const plan::Telemetry t = Scene(10, {Row(1, 60, kLane0, 0.0)});
   rescue.Predict(t);
   std::vector<double> x, y;
@@ -87,7 +87,7 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
 
 TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {
   const auto road = TwoLanes();  // edges at y 0 and -7
-  Rescue rescue(*road, VehicleParams(), kDt);
+  Rescue rescue(*road, VehicleParams(), kStep);
   const plan::Telemetry t = Scene(10);
   rescue.Predict(t);
   // Along lane 0, then drifting left at 1 m/s from x = 30 (step 10): the box (1.8 m wide, the
@@ -143,7 +143,7 @@ TEST(RescueTest, TheSearchsStrataKeepATurnOutOfTheLaneApartFromGoingStraight) {
 TEST(RescueTest, LateralReachBoundsTheVehiclesHardestSwerve) {
   const auto road = TwoLanes();
   const VehicleParams vp;
-  Rescue rescue(*road, vp, kDt);
+  Rescue rescue(*road, vp, kStep);
   // From lane 1 toward lane 0 (y grows, d shrinks: toward -1) at 20 m/s, the steering turned at
   // its full rate (past the friction circle, which the bound also lets through at the lowest
   // speed reachable): at every step the bound holds the centre's lateral move (the rear axle's,
@@ -152,8 +152,8 @@ TEST(RescueTest, LateralReachBoundsTheVehiclesHardestSwerve) {
   const KsState ego = Ego(50, kLane1, 20);
   KsState s = ego;
   for (int k = 1; k <= 10; ++k) {
-    s = SimulateKs(s, {vp.steering_rate_max, 0.0}, kDt, vp);
-    const double moved = s.y - kLane1, bound = rescue.LateralReach(50, ego, -1, k * kDt);
+    s = SimulateKs(s, {vp.steering_rate_max, 0.0}, kStep, vp);
+    const double moved = s.y - kLane1, bound = rescue.LateralReach(50, ego, -1, k * kStep);
     EXPECT_LE(moved, bound) << k;
     EXPECT_LE(bound, 2.5 * moved + 0.05) << k;
   }
@@ -172,7 +172,7 @@ TEST(RescueTest, LateralReachBoundsTheVehiclesHardestSwerve) {
 
 TEST(RescueTest, APredictedCarWhoseFootprintGrowsIsCheckedAtEachSamplesSize) {
   const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
+  Rescue rescue(*road, VehicleParams(), kStep);
   // A car standing 40 m ahead in the ego's lane, known by its future (a set-based prediction's
   // bounding boxes): 4.5 m long now, 2 m longer every step.
   plan::Telemetry t = Scene(10, {Row(1, 50, kLane0, 0.0)});
@@ -206,7 +206,7 @@ std::vector<KsState> StepsOf(const Rescue& rescue, const KsState& ego) {
   std::vector<double> x, y;
   rescue.Points(ego, &x, &y);
   std::vector<KsState> out;
-  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
   for (std::size_t j = ticks - 1; j + 1 < x.size(); j += ticks) {
     KsState s;
     s.x = x[j];
@@ -219,7 +219,7 @@ std::vector<KsState> StepsOf(const Rescue& rescue, const KsState& ego) {
 
 TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
+  Rescue rescue(*road, VehicleParams(), kStep);
   plan::Telemetry t = Scene(50, {Row(1, 20, kLane0, 40.0)});  // 30 m behind, 20 m/s faster
   rescue.Predict(t);
   std::vector<double> x, y;
@@ -234,7 +234,7 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   const std::vector<KsState> steps = StepsOf(rescue, ego);
   ASSERT_GE(steps.size(), 39u);  // the whole 4 s
   for (std::size_t k = 0; k < steps.size(); ++k) {
-    const double car_x = 20 + 40.0 * kDt * (k + 1);
+    const double car_x = 20 + 40.0 * kStep * (k + 1);
     const KsState& s = steps[k];
     // Apart along x by two half lengths, or across by two half widths (boxes near the axis).
     const bool apart = std::abs(s.x - car_x) > 4.5 || std::abs(s.y - kLane0) > 1.8 + 0.05;
@@ -245,7 +245,7 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   // Driven again next cycle from where the first input leads: the rest of the same way is kept
   // (no new search).
   const int searches = rescue.searches();
-  const KsState next = SimulateKs(ego, *u, kDt, vp);
+  const KsState next = SimulateKs(ego, *u, kStep, vp);
   t.sensor_fusion = {Row(1, 24, kLane0, 40.0)};
   rescue.Predict(t);
   ASSERT_TRUE(rescue.Next(next, {}).has_value());
@@ -257,7 +257,7 @@ class RescueOnAnEmptyRoad : public ::testing::Test {
  protected:
   RescueOnAnEmptyRoad() { rescue_.Predict(t_); }
   std::shared_ptr<const map::Road> road_ = TwoLanes();
-  Rescue rescue_{*road_, VehicleParams(), kDt};
+  Rescue rescue_{*road_, VehicleParams(), kStep};
   plan::Telemetry t_ = Scene(50);
 };
 
@@ -289,7 +289,7 @@ TEST(RescueTest, NoWayWhenCarsOfBothLanesCloseInSideBySide) {
   const auto searches = [&](int retry_states, std::int64_t* checked) {
     RescueOptions options;
     options.retry_states = retry_states;
-    Rescue rescue(*road, VehicleParams(), kDt, options);
+    Rescue rescue(*road, VehicleParams(), kStep, options);
     rescue.Predict(t);
     EXPECT_FALSE(rescue.Next(Ego(50, kLane0, 20), {}).has_value()) << retry_states;
     *checked = rescue.checked();
@@ -313,7 +313,7 @@ cost::GoalRegion Lane0Goal(double t_lo, double t_hi, double s_hi = 400) {
 
 TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
   const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kDt);
+  Rescue rescue(*road, VehicleParams(), kStep);
   std::vector<double> lane0_x, lane0_y, lane1_x, lane1_y;
   Straight(50, kLane0, 20, 100, &lane0_x, &lane0_y);  // 2 s, as the planner sends
   Straight(50, kLane1, 20, 100, &lane1_x, &lane1_y);
@@ -343,7 +343,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) 
   // in lane 0's part of it.
   std::vector<double> x, y;
   rescue_.Points(ego, &x, &y);
-  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
   const int steps = static_cast<int>(x.size()) / ticks;
   EXPECT_GE(steps, 15);
   EXPECT_LE(steps, 20);
@@ -351,10 +351,10 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) 
   EXPECT_GE(y.back(), -3.0);
   EXPECT_LE(y.back(), -0.5);
   // A step on, with the window a step nearer: the rest of the way is kept, no new search.
-  const KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  const KsState next = SimulateKs(ego, *u, kStep, VehicleParams());
   for (cost::GoalRegion& g : goals) {
-    g.t_lo -= kDt;
-    g.t_hi -= kDt;
+    g.t_lo -= kStep;
+    g.t_hi -= kStep;
   }
   ASSERT_TRUE(rescue_.Next(next, goals, true).has_value());
   EXPECT_EQ(rescue_.searches(), 1);
@@ -398,7 +398,7 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   EXPECT_EQ(rescue_.searches(), 1);
   std::vector<double> x, y;
   rescue_.Points(ego, &x, &y);
-  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
   EXPECT_LE(static_cast<int>(x.size()) / ticks, 16);  // it ends where it meets the region
   ASSERT_FALSE(y.empty());
   EXPECT_GE(y.back(), -3.0);
@@ -406,7 +406,7 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   // A closing goal no way can meet (lane 0 from s 60 to 72 within 1.0-1.5 s, where a car
   // stands at x 70, and the ego at 20 m/s is past s 64 by 1 s): the goal searches come first
   // and find nothing, then a way that lasts is searched for and driven.
-  Rescue blocked{*road_, VehicleParams(), kDt};
+  Rescue blocked{*road_, VehicleParams(), kStep};
   const plan::Telemetry with_car = Scene(50, {Row(1, 70, kLane0, 0.0)});
   blocked.Predict(with_car);
   ASSERT_TRUE(blocked.Next(ego, {Lane0Goal(1.0, 1.5, 72)}).has_value());
@@ -414,7 +414,7 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   blocked.Points(ego, &x, &y);
   EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
   // A window open past the horizon: a way that lasts the whole 4 s, as without a goal.
-  Rescue open{*road_, VehicleParams(), kDt};
+  Rescue open{*road_, VehicleParams(), kStep};
   open.Predict(t_);
   ASSERT_TRUE(open.Next(ego, {Lane0Goal(1.0, 10.0, 60.5)}).has_value());
   open.Points(ego, &x, &y);
@@ -429,10 +429,10 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNe
   std::vector<double> x0, y0;
   rescue_.Points(ego, &x0, &y0);
   // A step on, the window a step nearer: the rest of the way still meets the goal.
-  KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  KsState next = SimulateKs(ego, *u, kStep, VehicleParams());
   for (cost::GoalRegion& g : goals) {
-    g.t_lo -= kDt;
-    g.t_hi -= kDt;
+    g.t_lo -= kStep;
+    g.t_hi -= kStep;
   }
   rescue_.Predict(t_);
   EXPECT_TRUE(rescue_.Holds(next, goals));
@@ -443,7 +443,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNe
   // It is the same way, a step on: its points from the new state are the first ones' rest.
   std::vector<double> x1, y1;
   rescue_.Points(next, &x1, &y1);
-  const int ticks = static_cast<int>(std::lround(kDt / plan::kTickSeconds));
+  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
   ASSERT_EQ(x1.size() + ticks, x0.size());
   for (std::size_t i = 0; i < x1.size(); ++i) {
     EXPECT_NEAR(x1[i], x0[i + ticks], 1e-3) << i;  // one step of 0.1 s against 5 ticks
@@ -451,7 +451,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNe
   }
   // A goal whose window now closes before the way gets there: it no longer holds, and Continue
   // drives nothing and forgets the way.
-  next = SimulateKs(next, *step.input, kDt, VehicleParams());
+  next = SimulateKs(next, *step.input, kStep, VehicleParams());
   goals = {Lane0Goal(0.1, 0.2, 62)};
   EXPECT_FALSE(rescue_.Holds(next, goals));
   const RescueStep none = rescue_.Continue();
@@ -468,7 +468,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayThatOnlyLastsDoesNotHold) {
   const KsState ego = Ego(50, kLane1, 20);
   const std::optional<KsInput> u = rescue_.Next(ego, {});
   ASSERT_TRUE(u.has_value());
-  const KsState next = SimulateKs(ego, *u, kDt, VehicleParams());
+  const KsState next = SimulateKs(ego, *u, kStep, VehicleParams());
   rescue_.Predict(t_);
   EXPECT_FALSE(rescue_.Holds(next, {}));
   EXPECT_FALSE(rescue_.Continue().input.has_value());

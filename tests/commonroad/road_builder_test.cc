@@ -26,13 +26,8 @@ using testing::GoalTimeOnlyXml;
 using testing::Lane;
 using testing::LaneletXml;
 using testing::Line;
+using testing::Parse;
 using testing::ScenarioXml;
-
-Scenario Parse(const ScenarioXml& xml) {
-  auto sc = ParseScenario(xml.Str(), "test.xml");
-  EXPECT_TRUE(sc.ok()) << sc.message();
-  return sc.ok() ? *sc : Scenario{};
-}
 
 BuiltRoad Build(const Scenario& sc, int problem = 0) {
   auto r = BuildRoad(sc, sc.problems.at(problem));

@@ -13,7 +13,10 @@
 #include <string_view>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/scenario.h"
 
 namespace frenetic::commonroad::testing {
 
@@ -342,6 +345,13 @@ inline int LineOf(std::string_view text, std::string_view needle) {
   int line = 1;
   for (size_t i = 0; i < at; ++i) line += text[i] == '\n';
   return line;
+}
+
+// The scenario of `xml`; a test failure, and an empty scenario, when it does not parse.
+inline Scenario Parse(const ScenarioXml& xml) {
+  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
+  EXPECT_TRUE(s.ok()) << s.message();
+  return s.ok() ? std::move(s).value() : Scenario{};
 }
 
 }  // namespace frenetic::commonroad::testing

@@ -23,6 +23,7 @@ using testing::IntervalXml;
 using testing::Lane;
 using testing::LaneletXml;
 using testing::Line;
+using testing::Parse;
 using testing::ScenarioXml;
 
 constexpr double kDt = 0.1;
@@ -33,12 +34,6 @@ std::vector<KsState> Simulate(const KsState& start, const std::vector<KsInput>& 
   std::vector<KsState> out{start};
   for (const KsInput& u : inputs) out.push_back(SimulateKs(out.back(), u, dt, p, 20));
   return out;
-}
-
-Scenario Parse(const ScenarioXml& xml) {
-  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
-  EXPECT_TRUE(s.ok()) << s.message();
-  return s.ok() ? std::move(s).value() : Scenario{};
 }
 
 KsState Start(double x, double y, double v, double psi = 0, double delta = 0) {

@@ -13,7 +13,7 @@
 namespace frenetic::cost {
 namespace {
 
-constexpr int kN = 25;  // 6 s at 0.25 s
+constexpr int kSamples = 25;  // 6 s at 0.25 s
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // A candidate at constant speed v along d = 2 from s = 0, with `goals`.
@@ -23,7 +23,7 @@ struct Case {
   CostContext ctx;
   CostInput in;
   explicit Case(double v, std::vector<GoalRegion> g, double a = 0) : goals(std::move(g)) {
-    for (int k = 0; k < kN; ++k) {
+    for (int k = 0; k < kSamples; ++k) {
       const double t = 0.25 * k;
       s.push_back(v * t + 0.5 * a * t * t);
       s_d.push_back(v + a * t);
@@ -32,7 +32,7 @@ struct Case {
       d_d.push_back(0);
       d_dd.push_back(0);
     }
-    ctx.num_samples = kN;
+    ctx.num_samples = kSamples;
     ctx.dt = 0.25;
     ctx.num_goals = static_cast<int>(goals.size());
     ctx.goals = goals.data();
@@ -147,12 +147,12 @@ TEST_F(GoalCostTest, ARegionCrossedTurnedCreditsPassingAlongTheSideItIsEnteredFr
   EXPECT_NEAR(Eval(left), 1 + 1, 1e-9) << "in the side band: miss and approach only";
   // Crossing it: at a tangent of 0.04, a miss; at 0.2, nothing.
   Case swerve(20, {g});
-  for (int k = 0; k < kN; ++k) {
+  for (int k = 0; k < kSamples; ++k) {
     swerve.d[k] = -3 + 0.25 * k * 0.8;
     swerve.d_d[k] = 0.8;
   }
   EXPECT_GT(Eval(swerve), 0.0);
-  for (int k = 0; k < kN; ++k) {
+  for (int k = 0; k < kSamples; ++k) {
     swerve.d[k] = -20 + 0.25 * k * 4;  // d = 0 at 5 s (s = 100), tangent 0.2
     swerve.d_d[k] = 4;
   }
@@ -226,7 +226,7 @@ TEST_F(GoalCostTest, PassingBesideARegionStaysAMissAndASlowerCandidateHasLongerT
 // at its last speed after them.
 double DenseMiss(const Case& c, const GoalRegion& g) {
   const auto out = [](double x, double lo, double hi) { return std::max({lo - x, 0.0, x - hi}); };
-  const double t_end = (kN - 1) * 0.25, t0 = std::max(g.t_lo, 0.0);
+  const double t_end = (kSamples - 1) * 0.25, t0 = std::max(g.t_lo, 0.0);
   const double t1 = std::isfinite(g.t_hi) ? g.t_hi : t_end + 60.0;
   double best = kInf;
   const int steps = static_cast<int>(std::ceil((t1 - t0) / 0.001));
@@ -234,8 +234,8 @@ double DenseMiss(const Case& c, const GoalRegion& g) {
     const double t = t0 + (t1 - t0) * i / std::max(steps, 1);
     double s, v;
     if (t >= t_end) {
-      v = c.s_d[kN - 1];
-      s = c.s[kN - 1] + v * (t - t_end);
+      v = c.s_d[kSamples - 1];
+      s = c.s[kSamples - 1] + v * (t - t_end);
     } else {
       const int k = static_cast<int>(t / 0.25);
       const double f = t / 0.25 - k;
@@ -332,7 +332,7 @@ TEST_F(GoalCostTest, TheLastSampleCountsWhenTheWindowGoesOnPastIt) {
   // them (straight on, farther from the region), so the least lies at the last sample:
   // 12.4 / 10 + 1 / 1.75, and 1 more for missing.
   Case c(0.4, {});
-  for (int k = 0; k < kN; ++k) {
+  for (int k = 0; k < kSamples; ++k) {
     c.d[k] = 11 - 0.25 * k;
     c.d_d[k] = -1;
   }

@@ -20,7 +20,7 @@ namespace {
 
 constexpr double kLane = 3.5;
 
-PlannerConfig Config() {
+PlannerConfig RoadConfig() {
   auto c = PlannerConfig::LoadDefault();
   EXPECT_TRUE(c.ok()) << c.message();
   PlannerConfig config = c.ok() ? *c : PlannerConfig::Defaults();
@@ -52,7 +52,7 @@ std::shared_ptr<const map::Road> Road(double length, int lanes, int drop = -1,
   return *road;
 }
 
-struct Car {
+struct RoadCar {
   int id;
   double s, d, v, length, width;
   double vd = 0, d_end = 0;  // moves across at vd (m/s, right positive) until d reaches d_end
@@ -69,7 +69,7 @@ class OpenLoop {
  public:
   OpenLoop(std::shared_ptr<const map::Road> road, double s0, double d0, double v0)
       : road_(std::move(road)) {
-    auto p = MakePlanner("search", Config(), road_);
+    auto p = MakePlanner("search", RoadConfig(), road_);
     EXPECT_TRUE(p.ok()) << p.message();
     planner_ = std::move(p.value());
     const map::CartesianPose pose = road_->line().ToCartesian(s0, d0);
@@ -79,7 +79,7 @@ class OpenLoop {
     speed_ = v0;
   }
 
-  std::vector<Car> cars;
+  std::vector<RoadCar> cars;
   bool record_futures = false;  // hand the planner every car's future (constant velocity)
   double min_gap = 1e9;         // smallest distance between the ego's box and a car's, m
   double min_gap_first = 1e9;   // the same for cars[0] alone
@@ -94,7 +94,7 @@ class OpenLoop {
     t.speed = speed_;
     t.previous_path_x = path_x_;
     t.previous_path_y = path_y_;
-    for (const Car& c : cars) {
+    for (const RoadCar& c : cars) {
       const map::CartesianPose p = road_->line().ToCartesian(c.s, c.d);
       SensorCar row{c.id, p.x, p.y, c.v * std::cos(p.heading), c.v * std::sin(p.heading), c.s, c.d};
       row.length = c.length;
@@ -134,7 +134,7 @@ class OpenLoop {
       yaw_ = std::atan2(path_y_[1] - y_, path_x_[1] - x_);
       path_x_.erase(path_x_.begin());
       path_y_.erase(path_y_.begin());
-      for (Car& c : cars) {
+      for (RoadCar& c : cars) {
         c.s += c.v * kTickSeconds;
         c.v = std::max(0.0, c.v + c.a * kTickSeconds);
         c.d = c.DAt(kTickSeconds);
@@ -152,7 +152,7 @@ class OpenLoop {
     ego_d = f.d;
     const double c = std::abs(std::cos(yaw_)), sn = std::abs(std::sin(yaw_));
     const double half_s = 0.5 * (4.5 * c + 1.6 * sn), half_d = 0.5 * (4.5 * sn + 1.6 * c);
-    for (const Car& car : cars) {
+    for (const RoadCar& car : cars) {
       const double gap = std::max(std::abs(car.s - f.s) - 0.5 * car.length - half_s,
                                   std::abs(car.d - f.d) - 0.5 * car.width - half_d);
       min_gap = std::min(min_gap, gap);
@@ -327,9 +327,9 @@ TEST(RoadPlannerTest, RecordedFuturesPredictAsFreshWhenTheRecordingMovesOn) {
   auto road = map::Road::Make(*line, profiles, "bend");
   ASSERT_TRUE(road.ok()) << road.message();
   const map::ReferenceLine& ln = (*road)->line();
-  const Car cars[] = {{1, 60, 0.5 * kLane, 20, 4.8, 2.0, 1.2, 1.5 * kLane},
-                      {2, 90, 1.5 * kLane, 18, 4.8, 2.0, 0, 0, -3},
-                      {3, 40, 2.5 * kLane, 25, 12, 2.5}};
+  const RoadCar cars[] = {{1, 60, 0.5 * kLane, 20, 4.8, 2.0, 1.2, 1.5 * kLane},
+                          {2, 90, 1.5 * kLane, 18, 4.8, 2.0, 0, 0, -3},
+                          {3, 40, 2.5 * kLane, 25, 12, 2.5}};
   for (const double dt : {0.1, 0.2}) {
     SCOPED_TRACE(dt);
     PredictorOptions o;
@@ -339,7 +339,7 @@ TEST(RoadPlannerTest, RecordedFuturesPredictAsFreshWhenTheRecordingMovesOn) {
     for (int step = 0; step < 12; ++step) {
       std::vector<SensorCar> rows;
       std::vector<CarFuture> futures;
-      for (const Car& c : cars) {
+      for (const RoadCar& c : cars) {
         CarFuture f;
         f.id = c.id;
         f.dt = dt;
@@ -384,7 +384,7 @@ TEST(RoadPlannerTest, AvoidsACutInItIsToldAbout) {
   // sees it keep its lane and speed). With its recorded future the planner keeps clear of it.
   OpenLoop loop(Road(800, 2), 10, 1.5 * kLane, 20);
   loop.record_futures = true;
-  Car cutter{3, 18, 0.5 * kLane, 20, 4.8, 2.0};
+  RoadCar cutter{3, 18, 0.5 * kLane, 20, 4.8, 2.0};
   cutter.vd = kLane / 1.5;
   cutter.d_end = 1.5 * kLane;
   cutter.a = -5;

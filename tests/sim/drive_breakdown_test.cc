@@ -12,7 +12,6 @@
 namespace frenetic::sim {
 namespace {
 
-constexpr double kDt = 0.02;
 constexpr double kNone = std::numeric_limits<double>::infinity();
 
 // A spawned car at `ds` m from the ego along s, in `lane` (centre d), at `v` m/s.
@@ -40,15 +39,15 @@ struct Drive {
     ego.speed = v;
     ego.d = 2.0 + 4.0 * lane;
     for (int i = 0; i < ticks; ++i) {
-      ego.s = line.WrapS(ego.s + v * kDt);
-      distance += v * kDt;
+      ego.s = line.WrapS(ego.s + v * kTick);
+      distance += v * kTick;
       double gap = kNone;
       for (TrafficCar& c : cars) {
-        c.s = line.WrapS(c.s + c.v * kDt);
+        c.s = line.WrapS(c.s + c.v * kTick);
         const double ds = line.DiffS(c.s, ego.s);
         if (static_cast<int>(c.d / 4.0) == lane && ds > 0) gap = std::min(gap, ds - 4.6);
       }
-      b.Update(kDt, ego, lane, false, distance, gap, cars, line);
+      b.Update(kTick, ego, lane, false, distance, gap, cars, line);
     }
   }
 };
@@ -127,15 +126,15 @@ TEST(DriveBreakdown, SplitsByLapAndSums) {
   FRENETIC_REQUIRE_UDACITY(world);
   const map::ReferenceLine& line = *world->line;
   Drive d;
-  const int ticks = static_cast<int>(line.length() / (22.0 * kDt)) + 100;
+  const int ticks = static_cast<int>(line.length() / (22.0 * kTick)) + 100;
   d.Run(line, 22.0, ticks);  // a little more than one lap
   ASSERT_EQ(d.b.laps().size(), 2u);
-  EXPECT_NEAR(d.b.laps()[0].distance_m, line.length(), 22.0 * kDt);
-  EXPECT_NEAR(d.b.laps()[1].seconds, 100 * kDt, 2 * kDt);
+  EXPECT_NEAR(d.b.laps()[0].distance_m, line.length(), 22.0 * kTick);
+  EXPECT_NEAR(d.b.laps()[1].seconds, 100 * kTick, 2 * kTick);
   const LapBreakdown t = d.b.Total();
   EXPECT_EQ(t.lap, 2);
-  EXPECT_NEAR(t.seconds, ticks * kDt, 1e-6);
-  EXPECT_NEAR(t.distance_m, ticks * 22.0 * kDt, 1e-6);
+  EXPECT_NEAR(t.seconds, ticks * kTick, 1e-6);
+  EXPECT_NEAR(t.distance_m, ticks * 22.0 * kTick, 1e-6);
 }
 
 }  // namespace

@@ -10,7 +10,6 @@
 namespace frenetic::sim {
 namespace {
 
-constexpr double kDt = 0.02;
 constexpr double kDeg = std::numbers::pi / 180;
 
 // Drives a synthetic ego through the monitor: per tick a heading change and a speed.
@@ -20,8 +19,8 @@ class Driver {
 
   void Tick(double speed, double turn = 0, double d = 6.0, int collision = -1) {
     heading_ += turn;
-    x_ += speed * kDt * std::cos(heading_);
-    y_ += speed * kDt * std::sin(heading_);
+    x_ += speed * kTick * std::cos(heading_);
+    y_ += speed * kTick * std::sin(heading_);
     TickSample s;
     s.x = x_;
     s.y = y_;
@@ -29,7 +28,7 @@ class Driver {
     s.s = 100;
     s.d = d;
     s.collision_with = collision;
-    t_ += kDt;
+    t_ += kTick;
     ++ticks_;
     monitor_.Update(s, t_);
   }
@@ -38,7 +37,7 @@ class Driver {
   void WarmUp(double speed) {
     double v = 0;
     while (v < speed) {
-      v = std::min(speed, v + 2.0 * kDt);
+      v = std::min(speed, v + 2.0 * kTick);
       Tick(v);
     }
     for (int i = 0; i < 100; ++i) Tick(speed);
@@ -94,7 +93,7 @@ TEST(IncidentMonitor, KinkRaisesAccelerationAndSmoothRampDoesNot) {
   EXPECT_EQ(hidden.monitor().total(), 0);
   Driver ramp;
   double v = 0;
-  for (int i = 0; i < 200; ++i) ramp.Tick(v = std::min(20.0, v + 5.0 * kDt));
+  for (int i = 0; i < 200; ++i) ramp.Tick(v = std::min(20.0, v + 5.0 * kTick));
   for (int i = 0; i < 100; ++i) ramp.Tick(20);
   EXPECT_EQ(ramp.monitor().total(), 0);
   EXPECT_NEAR(ramp.monitor().max_acc(), 5.0, 0.01);
@@ -104,7 +103,7 @@ TEST(IncidentMonitor, SuddenCircleRaisesJerkGentleOneDoesNot) {
   for (double radius : {30.0, 100.0}) {
     Driver drv;
     drv.WarmUp(20);
-    for (int i = 0; i < 150; ++i) drv.Tick(20, 20 * kDt / radius);
+    for (int i = 0; i < 150; ++i) drv.Tick(20, 20 * kTick / radius);
     const bool hard = radius < 50;  // 20^2 / 30 = 13.3 m/s^2 vs 4 m/s^2
     EXPECT_EQ(drv.count(IncidentKind::kJerk), hard ? 1 : 0) << radius;
     EXPECT_EQ(drv.count(IncidentKind::kAcceleration), hard ? 1 : 0) << radius;

@@ -119,7 +119,7 @@ objective: {cost: JB1, cost_scale: 5}
 
 TEST_F(CommonRoadSuiteTest, BundledExampleSuitesParse) {
   for (const char* name : {"commonroad", "commonroad-families"}) {
-    auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR) + "/config/tune/" + name + ".yaml");
+    auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR "/config/tune/") + name + ".yaml");
     ASSERT_TRUE(suite.ok()) << suite.message();
     EXPECT_EQ(suite->kind, SuiteKind::kCommonRoad);
     ASSERT_FALSE(suite->commonroad.train.empty());
@@ -138,7 +138,7 @@ TEST_F(CommonRoadSuiteTest, StartConfigIsPlannerYamlWithTheCommonRoadOverlay) {
   ASSERT_TRUE(planner.ok());
   auto overlay = plan::PlannerConfig::LoadDefault();
   ASSERT_TRUE(
-      overlay->OverlayFile(std::string(FRENETIC_SOURCE_DIR) + "/config/commonroad.yaml").ok());
+      overlay->OverlayFile(std::string(FRENETIC_SOURCE_DIR "/config/commonroad.yaml")).ok());
   EXPECT_NE(planner->value("weights.goal"), overlay->value("weights.goal"));
   EXPECT_EQ(start->value("weights.goal"), overlay->value("weights.goal"));
   EXPECT_EQ(start->value("limits.max_accel"), overlay->value("limits.max_accel"));

@@ -24,7 +24,7 @@ params:
 
 TEST(SuiteTest, BundledSuitesLoadAndValidate) {
   for (const char* name : {"smoke", "default"}) {
-    const std::string path = std::string(FRENETIC_SOURCE_DIR) + "/config/tune/" + name + ".yaml";
+    const std::string path = std::string(FRENETIC_SOURCE_DIR "/config/tune/") + name + ".yaml";
     auto suite = LoadSuite(path);
     ASSERT_TRUE(suite.ok()) << suite.message();
     EXPECT_FALSE(suite->scenarios.empty());
@@ -32,7 +32,7 @@ TEST(SuiteTest, BundledSuitesLoadAndValidate) {
     auto config = LoadStartConfig(*suite);
     ASSERT_TRUE(config.ok()) << config.message();
   }
-  auto smoke = LoadSuite(std::string(FRENETIC_SOURCE_DIR) + "/config/tune/smoke.yaml");
+  auto smoke = LoadSuite(std::string(FRENETIC_SOURCE_DIR "/config/tune/smoke.yaml"));
   ASSERT_TRUE(smoke.ok());
   auto start = LoadStartConfig(*smoke);
   ASSERT_TRUE(start.ok());
@@ -92,12 +92,12 @@ search: {global: GN_CRS2_LM, local: LN_SBPLX, budget: 9, global_fraction: 0.5, s
   EXPECT_EQ(suite->search.seed, 7u);
 }
 
-struct BadCase {
+struct BadSuiteCase {
   const char* yaml;
   const char* expected;  // must appear in the message, next to the file name
 };
 
-class BadSuiteTest : public ::testing::TestWithParam<BadCase> {};
+class BadSuiteTest : public ::testing::TestWithParam<BadSuiteCase> {};
 
 TEST_P(BadSuiteTest, FailsNamingTheKeyAndFile) {
   auto suite = ParseSuite(std::string(kMinimal) + GetParam().yaml, "bad_suite.yaml", "");
@@ -117,15 +117,15 @@ TEST_P(BadSuiteTest, FailsNamingTheKeyAndFile) {
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadSuiteTest,
     ::testing::Values(
-        BadCase{"budgett: 3\n", "budgett"},
-        BadCase{"objective: {speed: 1, sped: 2}\n", "objective.sped"},
-        BadCase{"objective: {incidents_per_mile: {colision: 1}}\n", "colision"},
-        BadCase{"search: {global: GN_DIRECT_L, budgte: 3}\n", "search.budgte"},
-        BadCase{"search: {global: LN_SBPLX}\n", "search.global"},
-        BadCase{"search: {budget: 1}\n", "search.budget"},
-        BadCase{"search: {global_fraction: 1.5}\n", "global_fraction"},
-        BadCase{"start_set: {weights.nonsense: 1}\n", "weights.nonsense"},
-        BadCase{"latency: sometimes\n", "latency"}),
+        BadSuiteCase{"budgett: 3\n", "budgett"},
+        BadSuiteCase{"objective: {speed: 1, sped: 2}\n", "objective.sped"},
+        BadSuiteCase{"objective: {incidents_per_mile: {colision: 1}}\n", "colision"},
+        BadSuiteCase{"search: {global: GN_DIRECT_L, budgte: 3}\n", "search.budgte"},
+        BadSuiteCase{"search: {global: LN_SBPLX}\n", "search.global"},
+        BadSuiteCase{"search: {budget: 1}\n", "search.budget"},
+        BadSuiteCase{"search: {global_fraction: 1.5}\n", "global_fraction"},
+        BadSuiteCase{"start_set: {weights.nonsense: 1}\n", "weights.nonsense"},
+        BadSuiteCase{"latency: sometimes\n", "latency"}),
     [](const auto& info) { return "Case" + std::to_string(info.index); });
 
 TEST(SuiteTest, UnknownParameterIsNamed) {

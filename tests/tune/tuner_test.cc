@@ -35,7 +35,7 @@ class TunerTest : public ::testing::Test {
       skip_ = "the bundled track " + map::DefaultTrackPath() + " is absent";
       return;
     }
-    auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR) + "/config/tune/smoke.yaml");
+    auto suite = LoadSuite(std::string(FRENETIC_SOURCE_DIR "/config/tune/smoke.yaml"));
     ASSERT_TRUE(suite.ok()) << suite.message();
     suite_ = new Suite(*suite);
     dir_ = fs::temp_directory_path() / ("frenetic_tune_test_" + std::to_string(::getpid()));

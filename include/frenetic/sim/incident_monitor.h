@@ -18,6 +18,8 @@ enum class IncidentKind : std::uint8_t {
   kCollision, kSpeed, kAcceleration, kJerk, kLane, kOffRoad, kCount
 };
 inline constexpr int kIncidentKinds = static_cast<int>(IncidentKind::kCount);
+// Ticks of one acceleration block (0.2 s): the monitor measures acceleration block by block.
+inline constexpr int kBlockTicks = 10;
 // "collision", "speed", "acceleration", "jerk", "lane", "off_road".
 const char* ToString(IncidentKind kind);
 
@@ -77,7 +79,7 @@ class IncidentMonitor {
 
   IncidentOptions options_;
   // 10-tick block of speeds and positions.
-  std::array<double, 10> block_v_{}, block_x_{}, block_y_{};
+  std::array<double, kBlockTicks> block_v_{}, block_x_{}, block_y_{};
   int block_n_ = 0;
   double prev_block_v_ = 0;
   std::array<double, 5> acc_samples_{};

@@ -14,6 +14,8 @@
 
 namespace frenetic::sim {
 
+inline constexpr double kTick = 0.02;  // s, the physics step
+
 // How replies meet the simulator's ticks (§2). Per exchange the simulator sends telemetry,
 // advances `l_old` ticks on the old path while the reply is "in flight", applies the new path
 // (closest-point trimming) and advances `l_new` >= 1 ticks before the next telemetry.

@@ -18,8 +18,6 @@
 
 namespace frenetic::sim {
 
-inline constexpr double kTick = 0.02;          // s, the physics step
-
 // The car ahead of the ego in its lane (smooth-line lanes), if any within 200 m.
 struct LeaderGap {
   int id = -1;          // -1: none

@@ -15,8 +15,7 @@ namespace frenetic::plan::search {
 namespace {
 
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 // StepsOf's reach masks bit by bit as FirstCollision's reach tests read (a car is kept unless
 // it is farther than the reach along s or 5 m along d; NaN is kept), over a whole lattice in

@@ -10,8 +10,7 @@ namespace frenetic::plan::search {
 namespace {
 
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 // A stored plan from a search without kept points: steady 20 m/s in the middle lane.
 PlanResult StorePlan(Stages& st) {

@@ -17,7 +17,7 @@ using testing::SceneCar;
 using testing::Stages;
 
 // A straight-ish stretch of the Udacity loop; the middle lane, 20 m/s.
-constexpr double kS = 800;
+using testing::kS;
 
 // Centred in the middle lane as this cycle's context moves it (the lane centres depend on s and
 // speed only, so a second context build keeps them).

@@ -14,8 +14,7 @@ namespace {
 
 using testing::SceneCar;
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 // Candidates by hand: velocity keeping to (end speed, T) in the middle lane, at the given costs.
 struct Option {

@@ -15,8 +15,7 @@ namespace frenetic::plan::search {
 namespace {
 
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 TEST(LimitCheckerTest, SteadyDrivingIsFeasible) {
   REQUIRE_UDACITY_MAP();

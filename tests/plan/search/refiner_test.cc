@@ -9,8 +9,7 @@ namespace {
 
 using testing::SceneCar;
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 PlannerConfig Pinned() {
   PlannerConfig config = testing::DefaultConfig();

@@ -13,8 +13,7 @@ namespace frenetic::plan::search {
 namespace {
 
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 void Scene(Stages& st) {
   st.Prepare({kS, 18, 0, 6.0, 0, 0},

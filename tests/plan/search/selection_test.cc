@@ -14,8 +14,7 @@ namespace {
 
 using testing::SceneCar;
 using testing::Stages;
-
-constexpr double kS = 800;
+using testing::kS;
 
 // Told that nothing passed last cycle, with check.clear_enough set (the least-harm choice
 // then wants every candidate's contact on bare boxes), the selection tests the bare boxes

@@ -28,6 +28,9 @@
 
 namespace frenetic::plan::search::testing {
 
+// m: the ego's s on the Udacity track in the stage tests.
+inline constexpr double kS = 800;
+
 inline std::shared_ptr<const map::ReferenceLine> UdacityLine() {
   static std::shared_ptr<const map::ReferenceLine> line = [] {
     std::shared_ptr<const map::ReferenceLine> l;
