@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/sanitizers.h"
 #include "commonroad/scenario_xml.h"
 
 namespace frenetic::commonroad {
@@ -17,6 +18,7 @@ namespace {
 using testing::AddStraightRoad;
 using testing::GoalRectangleXml;
 using testing::GoalTimeOnlyXml;
+using testing::Parse;
 using testing::ScenarioXml;
 using testing::StateXml;
 
@@ -25,12 +27,6 @@ std::vector<StateXml> Car(double x0, double y, double v, int steps) {
   std::vector<StateXml> out;
   for (int k = 0; k <= steps; ++k) out.push_back({k, {x0 + v * 0.1 * k, y}, 0.0, v});
   return out;
-}
-
-Scenario Parse(const ScenarioXml& xml) {
-  StatusOr<Scenario> s = ParseScenario(xml.Str(), "test.xml");
-  EXPECT_TRUE(s.ok()) << s.message();
-  return s.ok() ? std::move(s).value() : Scenario{};
 }
 
 // At most 2000 states a step: enough for these scenes, and quick under the sanitizers.
@@ -206,9 +202,8 @@ TEST(WayThroughTest, SharedHighDProblems) {
   for (const Case c : {Case{"DEU_LocationAUpper26-1_262481_T-2556.cr.xml", true},
                        Case{"DEU_LocationALower26-1_261504_T-1579.cr.xml", false}}) {
     if (!std::filesystem::exists(dir + c.file)) GTEST_SKIP() << "no " << dir << c.file;
-#if defined(__SANITIZE_ADDRESS__)
-    if (c.found) continue;  // 75 steps of 4000 states: seconds here, a minute under ASan
-#endif
+    // 75 steps of 4000 states: seconds here, a minute under ASan.
+    if (c.found && testing_util::kUnderSanitizer) continue;
     StatusOr<Scenario> s = LoadScenario(dir + c.file);
     ASSERT_TRUE(s.ok()) << s.message();
     const PlanningProblem& problem = s->problems.at(0);

@@ -21,6 +21,7 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/net/client.h"
+#include "common/sanitizers.h"
 #include "frenetic/net/server.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/wire/protocol.h"
@@ -117,7 +118,7 @@ TEST(AbuseTest, ClientsUpToTheCapEachGetEveryReplyRight) {
 // A planner for the scheduling tests: telemetry at x = kBlockX blocks until Release(), at
 // x = kBusyX takes kBusyMs; every call is logged (x, in order) and a planner used by two threads
 // at once is noted.
-struct Gate {
+struct PlannerGate {
   static constexpr double kBlockX = 666, kBusyX = 777;
   static constexpr int kBusyMs = 60;
   std::mutex mutex;
@@ -136,18 +137,20 @@ struct Gate {
 
 class GatedPlanner : public FakePlanner {
  public:
-  explicit GatedPlanner(Gate* gate) : gate_(gate) {}
+  explicit GatedPlanner(PlannerGate* gate) : gate_(gate) {}
   const plan::PlanResult& Plan(const plan::Telemetry& t) override {
     if (in_plan_.fetch_add(1) > 0) ++gate_->overlaps;
     {
       std::unique_lock lock(gate_->mutex);
       gate_->calls.push_back(t.x);
-      if (t.x == Gate::kBlockX) {
+      if (t.x == PlannerGate::kBlockX) {
         gate_->blocked = true;
         gate_->cv.wait(lock, [this] { return gate_->released; });
       }
     }
-    if (t.x == Gate::kBusyX) std::this_thread::sleep_for(std::chrono::milliseconds(Gate::kBusyMs));
+    if (t.x == PlannerGate::kBusyX) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(PlannerGate::kBusyMs));
+    }
     std::this_thread::sleep_for(std::chrono::microseconds(200));  // room for an overlap
     const plan::PlanResult& r = FakePlanner::Plan(t);
     --in_plan_;
@@ -155,25 +158,25 @@ class GatedPlanner : public FakePlanner {
   }
 
  private:
-  Gate* gate_;
+  PlannerGate* gate_;
   std::atomic<int> in_plan_{0};
 };
 
 // Releases the gate when it goes: declared after the server, it goes first, so a failed test
 // does not leave a planning thread blocked while the server waits for it to stop.
 struct ReleaseAtEnd {
-  Gate* gate;
+  PlannerGate* gate;
   ~ReleaseAtEnd() { gate->Release(); }
 };
 
-PlannerFactory GatedFactory(Gate* gate) {
+PlannerFactory GatedFactory(PlannerGate* gate) {
   return
       [gate]() -> std::unique_ptr<plan::Planner> { return std::make_unique<GatedPlanner>(gate); };
 }
 
 // A planner that never returns (until released) holds one planning thread, not the server.
 TEST(AbuseTest, NoConnectionWaitsForAnothersPlanner) {
-  Gate gate;
+  PlannerGate gate;
   ServerOptions options;
   options.planning_threads = 2;
   TestServer server(options, GatedFactory(&gate));
@@ -183,21 +186,21 @@ TEST(AbuseTest, NoConnectionWaitsForAnothersPlanner) {
   for (int k = 1; k <= 12; ++k) {  // an established connection...
     ASSERT_TRUE(IsControlFor(stuck.Exchange(TelemetryFrameAt(5, 0)), 5, 0, k));
   }
-  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(Gate::kBlockX, 0)));  // ...whose planner stalls
+  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(PlannerGate::kBlockX, 0)));  // ...whose planner stalls
   ASSERT_TRUE(Eventually([&] {
     std::lock_guard lock(gate.mutex);
     return gate.blocked;
   }));
   EXPECT_EQ(WellBehavedRun(server.port(), 30, 10), 30) << "answered while the other is stuck";
   gate.Release();
-  EXPECT_TRUE(IsControlFor(stuck.Receive(), Gate::kBlockX, 0, 13));
+  EXPECT_TRUE(IsControlFor(stuck.Receive(), PlannerGate::kBlockX, 0, 13));
 }
 
 // Heavy work (building planners, a connection's first plans, a connection that uses more than
 // a quarter of a core) never takes the last planning thread: connections that come, plan and
 // go, or flood, cannot hold up an established one, even when their work stalls.
 TEST(AbuseTest, HeavyWorkLeavesAThreadForEstablishedConnections) {
-  Gate gate;
+  PlannerGate gate;
   ServerOptions options;
   options.planning_threads = 2;
   TestServer server(options, GatedFactory(&gate));
@@ -208,7 +211,7 @@ TEST(AbuseTest, HeavyWorkLeavesAThreadForEstablishedConnections) {
   for (int k = 1; k <= 12; ++k) {
     ASSERT_TRUE(IsControlFor(established.Exchange(TelemetryFrameAt(3, 0)), 3, 0, k));
   }
-  ASSERT_FALSE(young.Send(TelemetryFrameAt(Gate::kBlockX, 0)));  // its first plan stalls
+  ASSERT_FALSE(young.Send(TelemetryFrameAt(PlannerGate::kBlockX, 0)));  // its first plan stalls
   ASSERT_TRUE(Eventually([&] {
     std::lock_guard lock(gate.mutex);
     return gate.blocked;
@@ -220,14 +223,14 @@ TEST(AbuseTest, HeavyWorkLeavesAThreadForEstablishedConnections) {
   }
   EXPECT_EQ(server.server().stats().waiting_frames, 1) << "...but not a young one";
   gate.Release();
-  EXPECT_TRUE(IsControlFor(young.Receive(), Gate::kBlockX, 0, 1));
+  EXPECT_TRUE(IsControlFor(young.Receive(), PlannerGate::kBlockX, 0, 1));
   EXPECT_TRUE(IsControlFor(younger.Receive(), 8, 0, 1));
 }
 
 // With every planning thread taken, the waiting connection that has planned least lately goes
 // first: a connection that keeps the pool busy cannot push a well-paced one behind its work.
 TEST(AbuseTest, ThePoolServesTheLeastBusyConnectionFirst) {
-  Gate gate;
+  PlannerGate gate;
   ServerOptions options;
   options.planning_threads = 1;
   TestServer server(options, GatedFactory(&gate));
@@ -235,8 +238,9 @@ TEST(AbuseTest, ThePoolServesTheLeastBusyConnectionFirst) {
   TestClient busy, stuck, fresh;
   ASSERT_TRUE(busy.Connect(server.port()) && stuck.Connect(server.port()) &&
               fresh.Connect(server.port()));
-  EXPECT_TRUE(IsControlFor(busy.Exchange(TelemetryFrameAt(Gate::kBusyX, 0)), Gate::kBusyX, 0, 1));
-  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(Gate::kBlockX, 0)));  // takes the only thread
+  EXPECT_TRUE(IsControlFor(busy.Exchange(TelemetryFrameAt(PlannerGate::kBusyX, 0)),
+                           PlannerGate::kBusyX, 0, 1));
+  ASSERT_FALSE(stuck.Send(TelemetryFrameAt(PlannerGate::kBlockX, 0)));  // takes the only thread
   ASSERT_TRUE(Eventually([&] {
     std::lock_guard lock(gate.mutex);
     return gate.blocked;
@@ -249,13 +253,13 @@ TEST(AbuseTest, ThePoolServesTheLeastBusyConnectionFirst) {
   EXPECT_TRUE(IsControlFor(busy.Receive(), 1, 0, 2));
   EXPECT_TRUE(IsControlFor(fresh.Receive(), 2, 0, 1));
   std::lock_guard lock(gate.mutex);
-  EXPECT_EQ(gate.calls, (std::vector<double>{Gate::kBusyX, Gate::kBlockX, 2, 1}));
+  EXPECT_EQ(gate.calls, (std::vector<double>{PlannerGate::kBusyX, PlannerGate::kBlockX, 2, 1}));
 }
 
 // Frames sent back to back without reading are answered one each, in order, and the
 // connection's planner is never used by two threads at once, however many the pool has.
 TEST(AbuseTest, PipelinedFramesAreAnsweredOneEachInOrder) {
-  Gate gate;
+  PlannerGate gate;
   ServerOptions options;
   options.planning_threads = 4;
   TestServer server(options, GatedFactory(&gate));
@@ -544,10 +548,10 @@ double ResidentBytes() {
 // once and go, at most max_connections at a time. Their memory is given back: the resident set
 // ends near where one connection's left it, not at the high-water mark of a full server.
 TEST(AbuseTest, MemoryComesBackAfterChurnWithRealPlanners) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "the sanitizer's allocator keeps freed memory (its quarantine): RSS is not "
-                  "the server's";
-#endif
+  if (testing_util::kUnderSanitizer) {
+    GTEST_SKIP() << "the sanitizer's allocator keeps freed memory (its quarantine): RSS is not "
+                    "the server's";
+  }
   auto track = map::LoadTrack(map::DefaultTrackPath());
   ASSERT_TRUE(track.ok()) << track.message();
   auto line = map::ReferenceLine::Fit(*track);

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "common/sanitizers.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/units.h"
@@ -89,7 +90,8 @@ class FuzzTest : public testing::TestWithParam<std::string> {};
 TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
   REQUIRE_MAP(line);
   // Robustness does not need the full lattice: a small grid and a short refinement keep the
-  // 10,000 cycles within a few seconds (the defaults are exercised by the scenario tests).
+  // 10,000 cycles within a few seconds (the defaults are exercised by the scenario tests). Under
+  // the sanitizers, which run the same code several times slower, 2,500 cycles.
   PlannerConfig config = Config();
   for (const auto& [key, value] : {std::pair<const char*, double>{"grid.speeds", 8},
                                    {"grid.durations", 4},
@@ -106,7 +108,8 @@ TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
   loop.cars.push_back({0, 3040, 6.0, 12.0});
   loop.cars.push_back({1, 3020, 2.0, 22.0});
   int invalid = 0;
-  for (int i = 0; i < 10000; ++i) {
+  const int cycles = testing_util::kUnderSanitizer ? 2500 : 10000;
+  for (int i = 0; i < cycles; ++i) {
     if (i % 50 == 0) loop.Cycle();  // keep a live state now and then
     ASSERT_FALSE(HasFatalFailure());
     const Telemetry t = Corrupt(loop.Make(), rng);
