@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/sanitizers.h"
 #include "frenetic/drive/episode.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/sim/scenario.h"
@@ -56,7 +57,8 @@ std::unique_ptr<plan::Planner> SearchPlanner(const std::shared_ptr<const World>&
 }
 
 // A 12 s drive of the search planner with dense traffic (so cycles have rejected candidates),
-// recorded to `path` with timing off; with a replica, the driving planner does not trace.
+// recorded to `path` with timing off; with a replica, the driving planner does not trace. Under
+// the sanitizers, which run it ten times slower, 6 s.
 std::string Record(const std::shared_ptr<const World>& world, const std::string& path,
                    std::unique_ptr<plan::Planner> replica = nullptr) {
   auto writer = RecordWriter::Open(path);
@@ -73,7 +75,9 @@ std::string Record(const std::shared_ptr<const World>& world, const std::string&
   EXPECT_TRUE(scenario.ok()) << scenario.message();
   // Seed 5: dense traffic whose candidates run into cars in most exchanges (the rejection
   // traces below need some).
-  auto report = RunEpisode(world, *scenario, 5, EpisodeLimits{0, 0, 12, 60}, *planner, options);
+  const double seconds = testing_util::kUnderSanitizer ? 6 : 12;
+  auto report =
+      RunEpisode(world, *scenario, 5, EpisodeLimits{0, 0, seconds, 60}, *planner, options);
   EXPECT_TRUE(report.ok()) << report.message();
   EXPECT_TRUE((*writer)->status().ok());
   writer->reset();
