@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "common/sanitizers.h"
 #include "commonroad/scenario_xml.h"
+#include "frenetic/sanitizers.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -203,7 +203,7 @@ TEST(WayThroughTest, SharedHighDProblems) {
                        Case{"DEU_LocationALower26-1_261504_T-1579.cr.xml", false}}) {
     if (!std::filesystem::exists(dir + c.file)) GTEST_SKIP() << "no " << dir << c.file;
     // 75 steps of 4000 states: seconds here, a minute under ASan.
-    if (c.found && testing_util::kUnderSanitizer) continue;
+    if (c.found && kUnderSanitizer) continue;
     StatusOr<Scenario> s = LoadScenario(dir + c.file);
     ASSERT_TRUE(s.ok()) << s.message();
     const PlanningProblem& problem = s->problems.at(0);

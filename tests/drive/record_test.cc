@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "common/sanitizers.h"
 #include "frenetic/drive/episode.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/sanitizers.h"
 #include "frenetic/sim/scenario.h"
 #include "sim/sim_test_util.h"
 
@@ -75,7 +75,7 @@ std::string Record(const std::shared_ptr<const World>& world, const std::string&
   EXPECT_TRUE(scenario.ok()) << scenario.message();
   // Seed 5: dense traffic whose candidates run into cars in most exchanges (the rejection
   // traces below need some).
-  const double seconds = testing_util::kUnderSanitizer ? 6 : 12;
+  const double seconds = kUnderSanitizer ? 6 : 12;
   auto report =
       RunEpisode(world, *scenario, 5, EpisodeLimits{0, 0, seconds, 60}, *planner, options);
   EXPECT_TRUE(report.ok()) << report.message();

@@ -21,9 +21,9 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/track.h"
 #include "frenetic/net/client.h"
-#include "common/sanitizers.h"
 #include "frenetic/net/server.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/sanitizers.h"
 #include "frenetic/wire/protocol.h"
 #include "net/net_test_util.h"
 #include "net/raw_websocket.h"
@@ -548,7 +548,7 @@ double ResidentBytes() {
 // once and go, at most max_connections at a time. Their memory is given back: the resident set
 // ends near where one connection's left it, not at the high-water mark of a full server.
 TEST(AbuseTest, MemoryComesBackAfterChurnWithRealPlanners) {
-  if (testing_util::kUnderSanitizer) {
+  if (kUnderSanitizer) {
     GTEST_SKIP() << "the sanitizer's allocator keeps freed memory (its quarantine): RSS is not "
                     "the server's";
   }

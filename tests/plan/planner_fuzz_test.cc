@@ -9,9 +9,9 @@
 #include <string>
 #include <utility>
 
-#include "common/sanitizers.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
+#include "frenetic/sanitizers.h"
 #include "frenetic/units.h"
 #include "plan/closed_loop_testing.h"
 
@@ -108,7 +108,7 @@ TEST_P(FuzzTest, NeverThrowsAndAlwaysReturnsFiftyFinitePoints) {
   loop.cars.push_back({0, 3040, 6.0, 12.0});
   loop.cars.push_back({1, 3020, 2.0, 22.0});
   int invalid = 0;
-  const int cycles = testing_util::kUnderSanitizer ? 2500 : 10000;
+  const int cycles = kUnderSanitizer ? 2500 : 10000;
   for (int i = 0; i < cycles; ++i) {
     if (i % 50 == 0) loop.Cycle();  // keep a live state now and then
     ASSERT_FALSE(HasFatalFailure());

@@ -20,20 +20,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "frenetic/sanitizers.h"
+
 // FRENETIC_HEAP_INTERPOSED may be given (CMake sets it to 0 for every sanitizer but UBSan's:
 // LeakSanitizer, for one, defines no macro of its own and owns the aligned allocations).
 #ifndef FRENETIC_HEAP_INTERPOSED
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define FRENETIC_HEAP_INTERPOSED 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer) || __has_feature(leak_sanitizer)
-#define FRENETIC_HEAP_INTERPOSED 0
-#endif
-#endif
-#endif
-#ifndef FRENETIC_HEAP_INTERPOSED
-#define FRENETIC_HEAP_INTERPOSED 1
+#define FRENETIC_HEAP_INTERPOSED (!FRENETIC_HEAP_SANITIZER)
 #endif
 
 namespace frenetic::plan::heap {
