@@ -238,7 +238,7 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
 
 Rescue::PathCheck Rescue::Walk(const std::vector<double>& x, const std::vector<double>& y,
                                const std::vector<cost::GoalRegion>& goals) const {
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / plan::kTickSeconds)));
+  const int ticks = plan::TicksIn(dt_);
   PathCheck c;
   PathPoint p;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
@@ -599,7 +599,7 @@ std::uint64_t Rescue::StratumAcross(const KsState& q, double across) {
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {
   x->clear();
   y->clear();
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt_ / plan::kTickSeconds)));
+  const int ticks = plan::TicksIn(dt_);
   const double h = dt_ / ticks;
   KsState s = ego;
   for (const KsInput& u : way_) {

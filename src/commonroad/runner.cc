@@ -65,7 +65,7 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
   constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
   constexpr double kMinSpan = 0.5;      // m: the shortest chord the path's direction is taken on
-  const int ticks = std::max(1, static_cast<int>(std::lround(dt / plan::kTickSeconds)));
+  const int ticks = plan::TicksIn(dt);
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
   const int j = ticks - 1;  // the point dt in
@@ -365,7 +365,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       cyc.checked = res.summary.candidates_checked;
       cyc.status = res.status;
       // The ego drives dt along the plan.
-      const int ticks = std::max(1, static_cast<int>(std::lround(dt / plan::kTickSeconds)));
+      const int ticks = plan::TicksIn(dt);
       if (rescue_input) {
         // The way's input, exactly (the search simulated it); the planner gets the rest of the
         // way as its previous path.

@@ -20,7 +20,7 @@ namespace frenetic::sim {
 namespace judge {
 namespace {
 
-constexpr double kDt = 0.02;
+constexpr double kDt = kTick;  // s
 constexpr double kBlockSeconds = kBlockTicks * kDt;
 // Along-lane speed cap, m/s: 49.88 mph, under the simulator's 50 mph with room for the float32
 // jitter of positions (a speed still measured over 50 mph is caught by the monitor anyway).

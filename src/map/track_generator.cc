@@ -13,6 +13,7 @@
 namespace frenetic::map {
 namespace {
 
+using std::numbers::pi;
 constexpr int kFirstHarmonic = 2;
 constexpr int kLastHarmonic = 5;
 constexpr int kHarmonics = kLastHarmonic - kFirstHarmonic + 1;
@@ -21,7 +22,6 @@ constexpr double kMaxAlpha = 0.75;  // keeps r(phi) >= 0.25 R0 since the amplitu
 constexpr double kRadiusMargin = 1.02;
 constexpr double kSpacingJitter = 0.12;
 constexpr double kClearanceSeparation = 300.0;  // m of arc: nearer parts are neighbours
-
 
 // std::uniform_real_distribution is implementation-defined; this is not.
 double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
@@ -45,7 +45,7 @@ struct Shape {
     *r1 = r0 * b;
     *r2 = r0 * c;
   }
-  double Phi(int i) const { return -0.5 * std::numbers::pi + 2 * std::numbers::pi * i / kGrid; }
+  double Phi(int i) const { return -0.5 * pi + 2 * pi * i / kGrid; }
 };
 
 struct ShapeStats {
@@ -63,7 +63,7 @@ ShapeStats Measure(const Shape& sh) {
     st.length += std::sqrt(q);
     max_k = std::max(max_k, std::abs(r * r + 2 * r1 * r1 - r * r2) / (q * std::sqrt(q)));
   }
-  st.length *= 2 * std::numbers::pi / kGrid;  // periodic trapezoid rule: spectrally accurate
+  st.length *= 2 * pi / kGrid;  // periodic trapezoid rule: spectrally accurate
   st.min_radius = max_k > 0 ? 1.0 / max_k : INFINITY;
   return st;
 }
@@ -113,10 +113,10 @@ Status TrackGeneratorOptions::Validate() const {
         "track generator: spacing must be in [5, 200] m and at most length/8, got {:.6g}",
         spacing));
   }
-  if (!(min_radius >= 20 && min_radius < length / (2 * std::numbers::pi))) {
+  if (!(min_radius >= 20 && min_radius < length / (2 * pi))) {
     return Status::Error(fmt::format(
         "track generator: min_radius must be in [20, length/(2 pi) = {:.6g}) m, got {:.6g}",
-        length / (2 * std::numbers::pi), min_radius));
+        length / (2 * pi), min_radius));
   }
   if (!std::isfinite(centre_x) || !std::isfinite(centre_y)) {
     return Status::Error("track generator: centre must be finite");
@@ -137,7 +137,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
     const double k = kFirstHarmonic + i;
     // Lower harmonics dominate: an elongated, gently bent loop rather than a flower.
     sh.amp[i] = (0.3 + 0.7 * Uniform(rng)) / (k * k);
-    sh.phase[i] = 2 * std::numbers::pi * Uniform(rng);
+    sh.phase[i] = 2 * pi * Uniform(rng);
     total += sh.amp[i];
   }
   for (double& a : sh.amp) a /= total;
@@ -174,7 +174,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
     for (int i = 1; i <= kGrid; ++i) {
       sh.Radius(sh.Phi(i), &r, &r1, &r2);
       const double cur = std::hypot(r, r1);
-      arc[i] = arc[i - 1] + 0.5 * (prev + cur) * 2 * std::numbers::pi / kGrid;
+      arc[i] = arc[i - 1] + 0.5 * (prev + cur) * 2 * pi / kGrid;
       prev = cur;
     }
   }
@@ -197,7 +197,7 @@ StatusOr<Track> GenerateTrack(const TrackGeneratorOptions& o) {
   for (int k = 0; k < n; ++k) {
     while (cell + 1 < kGrid && arc[cell + 1] <= a) ++cell;
     const double f = (a - arc[cell]) / (arc[cell + 1] - arc[cell]);
-    const double phi = sh.Phi(cell) + f * 2 * std::numbers::pi / kGrid;
+    const double phi = sh.Phi(cell) + f * 2 * pi / kGrid;
     double r, r1, r2;
     sh.Radius(phi, &r, &r1, &r2);
     const double c = std::cos(phi), s = std::sin(phi);

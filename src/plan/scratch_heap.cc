@@ -102,7 +102,6 @@ namespace frenetic::plan::heap {
 namespace {
 
 // The interposer's own helpers (compiled only with it).
-
 constexpr std::size_t kHeader = 16;  // bytes before each block: its size
 
 bool InRegion(const void* p) {

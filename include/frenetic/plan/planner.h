@@ -3,7 +3,9 @@
 // kMinPathPoints points; after warm-up it does not allocate.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -19,6 +21,10 @@ namespace frenetic::plan {
 
 inline constexpr int kMinPathPoints = 50;
 inline constexpr double kTickSeconds = 0.02;  // the simulator's physics step
+// The whole ticks in `seconds`, at least one.
+inline int TicksIn(double seconds) {
+  return std::max(1, static_cast<int>(std::lround(seconds / kTickSeconds)));
+}
 
 enum class PlanStatus : std::uint8_t {
   kOk,             // the search found a feasible, collision-free trajectory

@@ -55,8 +55,7 @@ Workspace::Workspace(const Settings& cfg) {
   abs_kappa.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
-  collision_step =
-      std::max(1, static_cast<int>(std::lround(cfg.check.collision_dt / kTickSeconds)));
+  collision_step = TicksIn(cfg.check.collision_dt);
   n_steps = n_ticks / collision_step;
   for (auto* v : {&step_s, &step_d, &step_v, &step_vd, &step_dir_s, &step_dir_d})
     v->assign(kMaxCars * (n_steps + 1), 0.0);
