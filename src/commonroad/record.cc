@@ -214,9 +214,9 @@ void RunRecorder::OnPlan(const CycleInput& in, const plan::PlanResult& result) {
                   cars = std::move(cars), path_x = result.x, path_y = result.y,
                   status = result.status, summary = result.summary, scale,
                   candidates = std::vector<plan::CandidateTrace>(), telemetry = t,
-                  replica = replica_](std::string* line) mutable {
+                  least_harm = in.least_harm, replica = replica_](std::string* line) mutable {
     // The candidates, traced by the replica; its counts with the driving planner's times.
-    replica->Trace(&telemetry, path_x, path_y, i, &summary, &candidates);
+    replica->Trace(&telemetry, path_x, path_y, i, &summary, &candidates, least_harm);
     json rows = json::array();
     for (const CarRow& r : cars) {
       const plan::SensorCar& c = r.car;

@@ -16,11 +16,12 @@ Replica::Replica(std::unique_ptr<plan::Planner> planner, int max_candidates, std
 
 bool Replica::Trace(const plan::Telemetry* telemetry, const std::vector<double>& path_x,
                     const std::vector<double>& path_y, int cycle, plan::PlanSummary* summary,
-                    std::vector<plan::CandidateTrace>* candidates) {
+                    std::vector<plan::CandidateTrace>* candidates, bool least_harm) {
   if (!planner_) return false;
   const plan::PlanResult* r = nullptr;
   if (telemetry != nullptr) {
     trace_.candidates.clear();
+    planner_->set_least_harm(least_harm);
     r = &planner_->Plan(*telemetry);
   }
   if (r == nullptr || r->x != path_x || r->y != path_y) {

@@ -24,10 +24,12 @@ class Replica {
   // Plans `telemetry` (null: it could not be read) again. When the replica sends the path the
   // planner that drove sent (path_x, path_y), *summary takes the replica's counts, keeping its
   // own times and deadline stage, *candidates the traced candidates, and it returns true.
-  // Otherwise it warns, naming `cycle`, and stays inactive: false from then on.
+  // Otherwise it warns, naming `cycle`, and stays inactive: false from then on. `least_harm`:
+  // whether the planner that drove had its least-harm choice on this cycle
+  // (plan::Planner::set_least_harm; the CommonRoad loop turns it off while the rescue holds a way).
   bool Trace(const plan::Telemetry* telemetry, const std::vector<double>& path_x,
              const std::vector<double>& path_y, int cycle, plan::PlanSummary* summary,
-             std::vector<plan::CandidateTrace>* candidates);
+             std::vector<plan::CandidateTrace>* candidates, bool least_harm = true);
   bool active() const { return planner_ != nullptr; }
 
  private:
