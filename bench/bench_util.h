@@ -26,6 +26,7 @@
 #include "frenetic/map/reference_line.h"
 #include "frenetic/map/road.h"
 #include "frenetic/map/track.h"
+#include "frenetic/percentile.h"
 #include "frenetic/plan/planner.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/status.h"
@@ -312,12 +313,12 @@ inline double ThreadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// p in [0, 1] of a sample (sorts it).
-inline double Percentile(std::vector<double>* v, double p) {
+// The percentile p in [0, 1] of a sample, frenetic::Percentile's nearest rank; sorts it (the
+// callers read its largest last).
+inline double SortAndPercentile(std::vector<double>* v, double p) {
   if (v->empty()) return 0;
   std::sort(v->begin(), v->end());
-  const std::size_t i = static_cast<std::size_t>(std::ceil(p * v->size())) - (p > 0 ? 1 : 0);
-  return (*v)[std::min(i, v->size() - 1)];
+  return (*v)[NearestRankIndex(v->size(), p)];
 }
 
 }  // namespace frenetic::bench

@@ -5,18 +5,11 @@
 #include <cstdio>
 
 #include "commonroad/xml_source.h"
+#include "frenetic/percentile.h"
 
 namespace frenetic::apps::commonroad_cli {
 
 using nlohmann::json;
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const size_t i =
-      std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
-  return values[i];
-}
 
 double Max(const std::vector<double>& values) {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());

@@ -72,10 +72,6 @@ struct FileReport {
   std::string record_error;    // why a --record record could not be written
 };
 
-// The element of the sorted values at q (0..1) of their range, rounded to the nearest index; 0
-// for none.
-double Percentile(std::vector<double> values, double q);
-
 // The largest of the values; 0 for none.
 double Max(const std::vector<double>& values);
 

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "commonroad/xml_source.h"
+#include "frenetic/percentile.h"
 
 namespace frenetic::apps::commonroad_cli {
 

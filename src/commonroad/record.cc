@@ -13,6 +13,7 @@
 #include "frenetic/commonroad/solution.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/json_text.h"
+#include "frenetic/percentile.h"
 #include "frenetic/record/plan_json.h"
 #include "frenetic/record/replica.h"
 #include "frenetic/record/schema.h"
@@ -115,12 +116,6 @@ struct CarRow {
   plan::SensorCar car;
   double heading = 0;  // rad
 };
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
-}
 
 }  // namespace
 

@@ -13,6 +13,7 @@
 
 #include "frenetic/drive/evaluators.h"
 #include "frenetic/drive/record.h"
+#include "frenetic/percentile.h"
 #include "frenetic/units.h"
 #include "frenetic/wire/precision.h"
 
@@ -20,13 +21,6 @@ namespace frenetic::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t i = static_cast<std::size_t>(std::ceil(q * v.size())) - (q > 0 ? 1 : 0);
-  return v[std::min(i, v.size() - 1)];
-}
 
 // RunOptions::progress as an observer: after every exchange.
 class ProgressObserver final : public EpisodeObserver {

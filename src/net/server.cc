@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "frenetic/percentile.h"
 #include "frenetic/units.h"
 #include "net/refusal.h"
 #include "net/server_impl.h"
@@ -69,13 +70,6 @@ Status ServerOptions::Validate() const {
 }
 
 namespace {
-
-double Percentile(std::vector<double>* v, double q) {
-  if (v->empty()) return 0;
-  const std::size_t k = std::min(v->size() - 1, static_cast<std::size_t>(q * v->size()));
-  std::nth_element(v->begin(), v->begin() + k, v->end());
-  return (*v)[k];
-}
 
 // Refusals in progress at once, as a multiple of max_connections; beyond, a connection is closed
 // at once without an answer.
@@ -157,8 +151,8 @@ void Server::Impl::LogStatus() { spdlog::info("{}", StatusLine()); }
 std::string Server::Impl::StatusLine() {
   std::lock_guard lock(mutex);
   Interval& iv = interval;
-  const double p50 = Percentile(&iv.plan_ms, 0.50);
-  const double p99 = Percentile(&iv.plan_ms, 0.99);
+  const double p50 = PercentileInPlace(&iv.plan_ms, 0.50);
+  const double p99 = PercentileInPlace(&iv.plan_ms, 0.99);
   std::string ego = "no telemetry yet";
   if (iv.have_ego) {
     const int lane = iv.d >= 0 && iv.d < 12 ? static_cast<int>(iv.d / 4.0) : -1;
