@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
+#include <string>
 #include <utility>
 
 #include "commonroad/xml_source.h"
@@ -46,6 +48,14 @@ using pugi::xml_node;
 // far from int overflow.
 constexpr int kMaxTimeStep = 100'000'000;
 
+// A lanelet's two bounds run side by side: their ends lie at most kMaxBoundGap apart, and their
+// lengths differ by at most that (a lane 15 m wide turning a full circle: 94 m). A point off by a
+// misplaced digit breaks one of these; a bound stretched that way would make the road's
+// samples (every 2 m of it) run out of memory and time. Nor is a bound longer than
+// kMaxBoundLength: CommonRoad's maps are local, a few kilometres across.
+constexpr double kMaxBoundGap = 100.0;       // m
+constexpr double kMaxBoundLength = 100'000;  // m
+
 bool Named(const xml_node& n, const char* name) {
   return n.type() == pugi::node_element && std::string_view(n.name()) == name;
 }
@@ -72,6 +82,7 @@ class Reader {
   Status ReadPoint(const xml_node& node, Vec2* out);
   Status ReadBound(const xml_node& node, std::vector<Vec2>* points, LineMarking* marking);
   Status ReadLanelet(const xml_node& node, Lanelet* out);
+  Status CheckSideBySide(const xml_node& node, const Lanelet& l);
   Status ReadSign(const xml_node& node, TrafficSign* out);
   Status ReadShapeElement(const xml_node& node, Shape* out);
   Status ReadShapeGroup(const xml_node& node, ShapeGroup* out);
@@ -203,6 +214,31 @@ Status Reader::ReadLanelet(const xml_node& node, Lanelet* out) {
   }
   if (!left) return src_.Error(node, "missing <leftBound>");
   if (!right) return src_.Error(node, "missing <rightBound>");
+  return CheckSideBySide(node, *out);
+}
+
+Status Reader::CheckSideBySide(const xml_node& node, const Lanelet& l) {
+  const auto m = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.6g m", v);
+    return std::string(text);
+  };
+  const double left = PolylineLength(l.left), right = PolylineLength(l.right);
+  for (const double len : {left, right}) {
+    if (!(len <= kMaxBoundLength)) {
+      return src_.Error(node, "a bound " + m(len) + " long (at most " + m(kMaxBoundLength) +
+                                  "; a point far off its line?)");
+    }
+  }
+  const double start = Distance(l.left.front(), l.right.front());
+  const double end = Distance(l.left.back(), l.right.back());
+  if (!(start <= kMaxBoundGap && end <= kMaxBoundGap &&
+        std::abs(left - right) <= kMaxBoundGap)) {
+    return src_.Error(node, "its bounds do not run side by side (left " + m(left) +
+                                " long, right " + m(right) + ", " + m(start) + " apart at the start, " +
+                                m(end) + " at the end; at most " + m(kMaxBoundGap) +
+                                " for each): a point far off its line?");
+  }
   return Status::Ok();
 }
 

@@ -314,6 +314,13 @@ std::vector<MalformedCase> MalformedCases() {
                 "<rightBound>\n<point><x>0</x><y>5</y></point>\n<point><x>9</x><y>5</y></point>\n"
                 "</rightBound>\n</lanelet>\n"),
        "<leftBound>\n<point><x>0</x><y>9</y>", "lanelet 3/leftBound", "at least two <point>s"},
+      // A misplaced digit in one point: the bound runs 10,000 km out and back, or away from
+      // its partner (the road's samples every 2 m would take minutes and gigabytes).
+      {"BoundPointFarOff", Replace(valid, "<x>10</x>", "<x>10000000</x>"), "<lanelet id=\"1\">",
+       "lanelet 1", "a bound 2.00003e+07 m long (at most 100000 m; a point far off its line?)"},
+      {"BoundsApart", Replace(valid, "<y>-3.5</y>", "<y>-350</y>"), "<lanelet id=\"1\">",
+       "lanelet 1", "its bounds do not run side by side (left 300 m long, right 636.644 m, 350 m apart at "
+       "the start"},
       {"SecondRightBound",
        Replace(valid, "<laneletType>",
                "<rightBound>\n<point><x>0</x><y>-3.5</y></point>\n<point><x>9</x><y>-3.5</y>"

@@ -6,7 +6,8 @@
 //   - an obstacle's trajectory runs at consecutive steps after its initial state's; an occupancy's
 //     steps lie after the initial step; StateAt and OccupancyAt answer at its first, second and
 //     last steps without failing, and a state they give is finite;
-//   - a lanelet's centre line and polygon are built from its bounds;
+//   - a lanelet's bounds run side by side (ends at most 100 m apart, at most 100 km long), and
+//     its centre line and polygon are built from them;
 //   - a solution that parses writes back (WriteSolution) to text that parses to the same states.
 // Build: scripts/fuzz.sh (clang, -DFRENETIC_BUILD_FUZZERS=ON).
 #include <cmath>
@@ -18,6 +19,7 @@
 #include <string>
 #include <string_view>
 
+#include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/scenario.h"
 #include "frenetic/commonroad/solution.h"
 
@@ -79,6 +81,12 @@ void CheckScenario(const cr::Scenario& sc) {
     Check(l.left.size() >= 2 && l.right.size() >= 2, "a bound has two points");
     for (const cr::Vec2& p : l.left) Check(Finite(p), "a left bound is finite");
     for (const cr::Vec2& p : l.right) Check(Finite(p), "a right bound is finite");
+    // Side by side (a point far off its line is refused): the road's 2 m samples stay bounded.
+    Check(cr::PolylineLength(l.left) <= 100e3 && cr::PolylineLength(l.right) <= 100e3,
+          "a bound is at most 100 km long");
+    Check(cr::Distance(l.left.front(), l.right.front()) <= 100 &&
+              cr::Distance(l.left.back(), l.right.back()) <= 100,
+          "a lanelet's bounds end side by side");
     (void)l.CenterLine();
     (void)l.Polygon();
   }
