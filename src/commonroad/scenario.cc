@@ -49,11 +49,13 @@ using pugi::xml_node;
 constexpr int kMaxTimeStep = 100'000'000;
 
 // A lanelet's two bounds run side by side: their ends lie at most kMaxBoundGap apart, and their
-// lengths differ by at most that (a lane 15 m wide turning a full circle: 94 m). A point off by a
-// misplaced digit breaks one of these; a bound stretched that way would make the road's
-// samples (every 2 m of it) run out of memory and time. Nor is a bound longer than
+// lengths differ by at most that (a lane 15 m wide turning a full circle: 94 m) plus
+// kBoundLengthSlack of the longer (the jitter of points sampled from a recording's map). A point
+// off by a misplaced digit breaks one of these; a bound stretched that way would make the
+// road's samples (every 2 m of it) run out of memory and time. Nor is a bound longer than
 // kMaxBoundLength: CommonRoad's maps are local, a few kilometres across.
 constexpr double kMaxBoundGap = 100.0;       // m
+constexpr double kBoundLengthSlack = 0.1;    // of the longer bound's length
 constexpr double kMaxBoundLength = 100'000;  // m
 
 bool Named(const xml_node& n, const char* name) {
@@ -232,12 +234,12 @@ Status Reader::CheckSideBySide(const xml_node& node, const Lanelet& l) {
   }
   const double start = Distance(l.left.front(), l.right.front());
   const double end = Distance(l.left.back(), l.right.back());
-  if (!(start <= kMaxBoundGap && end <= kMaxBoundGap &&
-        std::abs(left - right) <= kMaxBoundGap)) {
+  const double slack = kMaxBoundGap + kBoundLengthSlack * std::max(left, right);
+  if (!(start <= kMaxBoundGap && end <= kMaxBoundGap && std::abs(left - right) <= slack)) {
     return src_.Error(node, "its bounds do not run side by side (left " + m(left) +
-                                " long, right " + m(right) + ", " + m(start) + " apart at the start, " +
-                                m(end) + " at the end; at most " + m(kMaxBoundGap) +
-                                " for each): a point far off its line?");
+                                " long, right " + m(right) + ", at most " + m(slack) +
+                                " apart; their ends " + m(start) + " and " + m(end) +
+                                " apart, at most " + m(kMaxBoundGap) + "): a point far off its line?");
   }
   return Status::Ok();
 }

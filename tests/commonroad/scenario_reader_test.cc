@@ -319,8 +319,12 @@ std::vector<MalformedCase> MalformedCases() {
       {"BoundPointFarOff", Replace(valid, "<x>10</x>", "<x>10000000</x>"), "<lanelet id=\"1\">",
        "lanelet 1", "a bound 2.00003e+07 m long (at most 100000 m; a point far off its line?)"},
       {"BoundsApart", Replace(valid, "<y>-3.5</y>", "<y>-350</y>"), "<lanelet id=\"1\">",
-       "lanelet 1", "its bounds do not run side by side (left 300 m long, right 636.644 m, 350 m apart at "
-       "the start"},
+       "lanelet 1", "its bounds do not run side by side (left 300 m long, right 636.644 m, at most "
+       "163.664 m apart; their ends 350 m and 3.5 m apart, at most 100 m)"},
+      {"BoundSpikeMidway",
+       Replace(valid, "<point><x>150</x><y>-3.5</y></point>",
+               "<point><x>150</x><y>-203.5</y></point>"),
+       "<lanelet id=\"1\">", "lanelet 1", "(left 300 m long, right 680.5 m, at most 168.05 m apart"},
       {"SecondRightBound",
        Replace(valid, "<laneletType>",
                "<rightBound>\n<point><x>0</x><y>-3.5</y></point>\n<point><x>9</x><y>-3.5</y>"
