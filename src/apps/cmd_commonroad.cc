@@ -100,6 +100,7 @@ ProblemReport ReportProblem(const cr::ProblemRun& run, const cr::PlanningProblem
   p.route = run.route;
   for (const cr::RunCycle& c : run.cycles) {
     p.plan_ms.push_back(c.plan_ms);
+    p.rescue_ms.push_back(c.rescue_ms);
     p.candidates += c.candidates;
     p.tracking_error_max_m = std::max(p.tracking_error_max_m, c.tracking_error);
     p.not_ok_cycles += c.status != plan::PlanStatus::kOk;
@@ -363,7 +364,8 @@ void RegisterCommonRoad(CLI::App& app) {
       "dropped: DEU_LocationALower26 -> DEU_LocationALower; a road's number kept: USA_US101) the "
       "problems, solved, unsolved by their first failure (the earliest by step, a missed goal "
       "only when nothing else failed) and planning "
-      "time per cycle (ms). Under `mpirun -n N` the files are split across the ranks (file i on "
+      "time per cycle (ms; with --json also the rescue's part of it, rescue_ms, per problem and "
+      "family). Under `mpirun -n N` the files are split across the ranks (file i on "
       "rank i mod N, each with --jobs threads) and rank 0 prints what a single process prints. "
       "Unsolved problems are results: the exit status is 0 unless a file could not be read (1).");
   sub->add_option("paths", args->paths, "Scenario files (.xml) or directories of them")

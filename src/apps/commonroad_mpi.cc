@@ -154,6 +154,7 @@ json ProblemWire(const ProblemReport& p) {
           {"road_length_m", Num(p.road_length_m)},
           {"route", p.route},
           {"plan_ms", Nums(p.plan_ms)},
+          {"rescue_ms", Nums(p.rescue_ms)},
           {"candidates", Num(p.candidates)},
           {"not_ok_cycles", p.not_ok_cycles},
           {"rescued_cycles", p.rescued_cycles},
@@ -175,6 +176,7 @@ ProblemReport ProblemFrom(const json& j) {
   p.road_length_m = NumFrom(j.at("road_length_m"));
   p.route = j.at("route").get<std::vector<int>>();
   for (const json& v : j.at("plan_ms")) p.plan_ms.push_back(NumFrom(v));
+  for (const json& v : j.at("rescue_ms")) p.rescue_ms.push_back(NumFrom(v));
   p.candidates = NumFrom(j.at("candidates"));
   p.not_ok_cycles = j.at("not_ok_cycles").get<int>();
   p.rescued_cycles = j.at("rescued_cycles").get<int>();

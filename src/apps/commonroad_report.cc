@@ -191,6 +191,9 @@ json ProblemJson(const ProblemReport& p, double dt) {
   j["plan_ms"] = {{"p50", Percentile(p.plan_ms, 0.5)},
                   {"p99", Percentile(p.plan_ms, 0.99)},
                   {"max", Max(p.plan_ms)}};
+  j["rescue_ms"] = {{"p50", Percentile(p.rescue_ms, 0.5)},
+                    {"p99", Percentile(p.rescue_ms, 0.99)},
+                    {"max", Max(p.rescue_ms)}};
   j["candidates_mean"] = p.plan_ms.empty() ? 0.0 : p.candidates / p.plan_ms.size();
   j["not_ok_cycles"] = p.not_ok_cycles;
   j["rescued_cycles"] = p.rescued_cycles;

@@ -48,6 +48,7 @@ struct ProblemReport {
   double road_length_m = 0;
   std::vector<int> route;  // lanelet ids
   std::vector<double> plan_ms;  // per cycle (0 without timing)
+  std::vector<double> rescue_ms;  // per cycle, the rescue's part of plan_ms
   double candidates = 0;        // summed over the cycles
   int not_ok_cycles = 0;        // cycles whose plan status was not kOk
   int rescued_cycles = 0;       // cycles that drove the rescue's way (rescue.h)

@@ -47,6 +47,7 @@ std::string Format(const char* format, auto... args) {
 void Count(const ProblemReport& p, Counts* c) {
   ++c->problems;
   c->plan_ms.insert(c->plan_ms.end(), p.plan_ms.begin(), p.plan_ms.end());
+  c->rescue_ms.insert(c->rescue_ms.end(), p.rescue_ms.begin(), p.rescue_ms.end());
   if (p.verdict.infeasible_at_start) {
     ++c->infeasible_at_start;
   } else if (p.verdict.solved) {
@@ -123,7 +124,8 @@ json CountsJson(const Counts& c) {
           {"solved_share", Share(c.solved, c.problems - c.infeasible_at_start)},
           {"unsolved", c.unsolved},
           {"cycles", static_cast<int>(c.plan_ms.size())},
-          {"plan_ms", PlanMsJson(c.plan_ms)}};
+          {"plan_ms", PlanMsJson(c.plan_ms)},
+          {"rescue_ms", PlanMsJson(c.rescue_ms)}};
 }
 
 json ComparisonJson(const Comparison& c) {
@@ -203,6 +205,7 @@ json SummaryJson(const Summary& s, const SummarySettings& settings) {
             {"failures", s.failures},
             {"cycles", static_cast<int>(cycles)},
             {"plan_ms", PlanMsJson(a.plan_ms)},
+            {"rescue_ms", PlanMsJson(a.rescue_ms)},
             {"candidates_mean", cycles ? s.candidates / cycles : 0.0},
             {"families", families}};
   if (s.comparison.solution_files > 0) j["comparison"] = ComparisonJson(s.comparison);
@@ -234,6 +237,8 @@ std::string SummaryText(const Summary& s, const SummarySettings& settings) {
   text += Format("planning per cycle: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %d cycles\n",
                  Percentile(a.plan_ms, 0.5), Percentile(a.plan_ms, 0.99), Max(a.plan_ms),
                  static_cast<int>(cycles));
+  text += Format("  of it the rescue's checks and searches: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
+                 Percentile(a.rescue_ms, 0.5), Percentile(a.rescue_ms, 0.99), Max(a.rescue_ms));
   text += Format("candidates per cycle: mean %.0f\n", cycles ? s.candidates / cycles : 0.0);
   text += FamilyTable(s);
   if (s.comparison.solution_files > 0) text += ComparisonText(s.comparison);

@@ -40,6 +40,7 @@ struct Counts {
   int solved = 0;               // of the problems - infeasible_at_start others
   std::map<std::string, int> unsolved;  // by FirstFailure: sums to the unsolved problems
   std::vector<double> plan_ms;          // every cycle's planning time
+  std::vector<double> rescue_ms;        // every cycle's rescue time (part of plan_ms)
 };
 
 // Ours against the references (ReferenceReport), over the problems that have one.

@@ -330,6 +330,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       // one lasts longer; when it misses the goal for good, the rescue's way to it if there is
       // one.
       std::optional<KsInput> rescue_input;
+      double rescue_ms = holds_ms;
       if (rescue) {
         const auto r0 = std::chrono::steady_clock::now();
         const RescueStep step =
@@ -339,6 +340,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
                 .count();
         rescue_input = step.input;
+        rescue_ms = r_ms;
         if (step.why == RescueStep::Why::kNoPath) {
           spdlog::debug("{} #{} step {}: no candidate passes; the rescue's way stands in "
                         "({:.3f} ms)",
@@ -361,6 +363,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       RunCycle cyc;
       cyc.step = k;
       cyc.plan_ms = options.timing ? ms : 0.0;
+      cyc.rescue_ms = options.timing ? rescue_ms : 0.0;
       cyc.candidates = res.summary.candidates_generated;
       cyc.checked = res.summary.candidates_checked;
       cyc.status = res.status;

@@ -93,6 +93,24 @@ TEST(CommonRoadSummaryTest, FirstFailureIsTheEarliestThenTheVerdictsOrderTheGoal
   EXPECT_EQ(FirstFailure(no_road), "road");
 }
 
+TEST(CommonRoadSummaryTest, TheRescuesPartOfThePlanningTimeIsReportedApart) {
+  ProblemReport a = Solved(40, {1, 5, 9});
+  a.rescue_ms = {0.5, 4, 0.5};
+  ProblemReport b = Solved(20, {2});
+  b.rescue_ms = {0.25};
+  const Summary s = Summarise({File("DEU_LocationALower26-1_1_T-1", {a}),
+                               File("USA_US101-15_2_T-1", {b})});
+  EXPECT_EQ(s.all.rescue_ms, (std::vector<double>{0.5, 4, 0.5, 0.25}));
+  const json j = SummaryJson(s, {"recorded", 2});
+  EXPECT_EQ(j.at("rescue_ms"), json({{"p50", 0.5}, {"p99", 4.0}, {"max", 4.0}}));
+  EXPECT_EQ(j.at("plan_ms"), json({{"p50", 2.0}, {"p99", 9.0}, {"max", 9.0}}));
+  EXPECT_EQ(j.at("families").at("USA_US101").at("rescue_ms"),
+            json({{"p50", 0.25}, {"p99", 0.25}, {"max", 0.25}}));
+  EXPECT_THAT(SummaryText(s, {"recorded", 2}),
+              HasSubstr("\n  of it the rescue's checks and searches: p50 0.50 ms, p99 4.00 ms, "
+                        "max 4.00 ms\n"));
+}
+
 TEST(CommonRoadSummaryTest, InfeasibleAtStartIsCountedApartPerFamilyAndOverall) {
   using K = cr::FailureKind;
   const std::vector<FileReport> files = {

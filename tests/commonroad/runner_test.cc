@@ -80,6 +80,39 @@ TEST(RunnerTest, ReachesARectangleAheadInTime) {
   EXPECT_EQ(p.trajectory.size(), p.cycles.size() + 1);
 }
 
+// Each cycle's planning time holds the rescue's checks (it checks every path, and searches when
+// one hits): a part of it, measured apart; without timing both read 0.
+TEST(RunnerTest, EachCycleTimesTheRescueAsAPartOfItsPlanningTime) {
+  ScenarioXml xml;
+  AddStraightRoad(xml, 400)
+      .DynamicObstacle(5, 4.8, 2, Drive(40, -1.75, 8, 80))
+      .Problem(1, {10, -1.75}, 0, 20, {GoalRectangleXml({150, -1.75}, 10, 3, 0, 50, 90)});
+  auto sc = ParseScenario(xml.Str(), "test.xml");
+  ASSERT_TRUE(sc.ok()) << sc.message();
+  for (const bool timing : {true, false}) {
+    RunOptions o;
+    o.timing = timing;
+    const ScenarioRun run = RunScenario(*sc, Config(PredictionMode::kRecorded), o);
+    ASSERT_EQ(run.problems.size(), 1u);
+    const std::vector<RunCycle>& cycles = run.problems[0].cycles;
+    ASSERT_GT(cycles.size(), 20u);
+    int rescue_timed = 0;
+    for (const RunCycle& c : cycles) {
+      EXPECT_GE(c.rescue_ms, 0) << c.step;
+      EXPECT_LE(c.rescue_ms, c.plan_ms) << c.step;
+      rescue_timed += c.rescue_ms > 0;
+      if (!timing) {
+        EXPECT_EQ(c.plan_ms, 0) << c.step;
+      }
+    }
+    if (timing) {
+      EXPECT_EQ(rescue_timed, static_cast<int>(cycles.size()));
+    } else {
+      EXPECT_EQ(rescue_timed, 0);
+    }
+  }
+}
+
 TEST(RunnerTest, ReachesARectangleInAFileFarFromItsOrigin) {
   // ReachesARectangleAheadInTime with every position in map-projection coordinates: read into
   // a local frame (the planner's input bounds and the reference line's fit would not take

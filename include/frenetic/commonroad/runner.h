@@ -89,6 +89,7 @@ struct RunOptions {
 struct RunCycle {
   int step = 0;
   double plan_ms = 0;
+  double rescue_ms = 0;  // the rescue's part of plan_ms (its checks and searches)
   int candidates = 0, checked = 0;
   plan::PlanStatus status = plan::PlanStatus::kOk;
   double tracking_error = 0;  // m: the ego's centre after the step from the planned one
