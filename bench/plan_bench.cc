@@ -96,7 +96,7 @@ struct CycleStats {
     }
     c["p50_us"] = SortAndPercentile(&us, 0.50);
     c["p99_us"] = SortAndPercentile(&us, 0.99);
-    c["max_us"] = us.back();  // sorted by Percentile
+    c["max_us"] = us.back();  // sorted by SortAndPercentile
     c["p50_cpu_us"] = SortAndPercentile(&cpu_us, 0.50);
     c["p99_cpu_us"] = SortAndPercentile(&cpu_us, 0.99);
   }

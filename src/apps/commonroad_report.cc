@@ -15,6 +15,10 @@ double Max(const std::vector<double>& values) {
   return values.empty() ? 0.0 : *std::max_element(values.begin(), values.end());
 }
 
+json TimesJson(const std::vector<double>& ms) {
+  return {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)}, {"max", Max(ms)}};
+}
+
 Outcome CompareOutcome(const ProblemReport& p) {
   if (p.verdict.infeasible_at_start) return Outcome::kInfeasibleAtStart;
   const bool ours = p.verdict.solved;
@@ -188,12 +192,8 @@ json ProblemJson(const ProblemReport& p, double dt) {
   j["lanes"] = p.lanes;
   j["road_length_m"] = p.road_length_m;
   j["route"] = p.route;
-  j["plan_ms"] = {{"p50", Percentile(p.plan_ms, 0.5)},
-                  {"p99", Percentile(p.plan_ms, 0.99)},
-                  {"max", Max(p.plan_ms)}};
-  j["rescue_ms"] = {{"p50", Percentile(p.rescue_ms, 0.5)},
-                    {"p99", Percentile(p.rescue_ms, 0.99)},
-                    {"max", Max(p.rescue_ms)}};
+  j["plan_ms"] = TimesJson(p.plan_ms);
+  j["rescue_ms"] = TimesJson(p.rescue_ms);
   j["candidates_mean"] = p.plan_ms.empty() ? 0.0 : p.candidates / p.plan_ms.size();
   j["not_ok_cycles"] = p.not_ok_cycles;
   j["rescued_cycles"] = p.rescued_cycles;

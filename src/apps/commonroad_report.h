@@ -76,6 +76,9 @@ struct FileReport {
 // The largest of the values; 0 for none.
 double Max(const std::vector<double>& values);
 
+// Per-cycle times (ms) as {"p50", "p99", "max"}: Percentile's nearest ranks and the largest.
+nlohmann::json TimesJson(const std::vector<double>& ms);
+
 // How a problem with a reference compares. Ours reaches the goal when its verdict says solved;
 // the reference when one of its states meets a goal state (its verdict is not asked: recorded
 // trajectories fail the start and dynamics checks for reasons of the recording, see

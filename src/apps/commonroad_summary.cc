@@ -113,10 +113,6 @@ namespace {
 
 double Share(int part, int whole) { return whole > 0 ? static_cast<double>(part) / whole : 0.0; }
 
-json PlanMsJson(const std::vector<double>& ms) {
-  return {{"p50", Percentile(ms, 0.5)}, {"p99", Percentile(ms, 0.99)}, {"max", Max(ms)}};
-}
-
 json CountsJson(const Counts& c) {
   return {{"problems", c.problems},
           {"infeasible_at_start", c.infeasible_at_start},
@@ -124,8 +120,8 @@ json CountsJson(const Counts& c) {
           {"solved_share", Share(c.solved, c.problems - c.infeasible_at_start)},
           {"unsolved", c.unsolved},
           {"cycles", static_cast<int>(c.plan_ms.size())},
-          {"plan_ms", PlanMsJson(c.plan_ms)},
-          {"rescue_ms", PlanMsJson(c.rescue_ms)}};
+          {"plan_ms", TimesJson(c.plan_ms)},
+          {"rescue_ms", TimesJson(c.rescue_ms)}};
 }
 
 json ComparisonJson(const Comparison& c) {
@@ -204,8 +200,8 @@ json SummaryJson(const Summary& s, const SummarySettings& settings) {
             {"unreadable_files", s.unreadable_files},
             {"failures", s.failures},
             {"cycles", static_cast<int>(cycles)},
-            {"plan_ms", PlanMsJson(a.plan_ms)},
-            {"rescue_ms", PlanMsJson(a.rescue_ms)},
+            {"plan_ms", TimesJson(a.plan_ms)},
+            {"rescue_ms", TimesJson(a.rescue_ms)},
             {"candidates_mean", cycles ? s.candidates / cycles : 0.0},
             {"families", families}};
   if (s.comparison.solution_files > 0) j["comparison"] = ComparisonJson(s.comparison);

@@ -335,25 +335,23 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         const auto r0 = std::chrono::steady_clock::now();
         const RescueStep step =
             rescue->Answer(t, res.x, res.y, ego, res.status == plan::PlanStatus::kFallbackUsed);
-        const double r_ms =
-            holds_ms +
+        rescue_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
                 .count();
         rescue_input = step.input;
-        rescue_ms = r_ms;
         if (step.why == RescueStep::Why::kNoPath) {
           spdlog::debug("{} #{} step {}: no candidate passes; the rescue's way stands in "
                         "({:.3f} ms)",
-                        sc.benchmark_id, problem.id, k, r_ms);
+                        sc.benchmark_id, problem.id, k, rescue_ms);
         } else if (step.why == RescueStep::Why::kHit) {
           spdlog::debug("{} #{} step {}: the planner's path hits a car at step {}; rescue "
                         "({:.3f} ms) {}",
-                        sc.benchmark_id, problem.id, k, step.hit, r_ms,
+                        sc.benchmark_id, problem.id, k, step.hit, rescue_ms,
                         rescue_input ? "drives its way" : "found no way");
         } else if (step.why == RescueStep::Why::kGoal) {
           spdlog::debug("{} #{} step {}: the planner's path misses a closing goal; rescue "
                         "({:.3f} ms) {}",
-                        sc.benchmark_id, problem.id, k, r_ms,
+                        sc.benchmark_id, problem.id, k, rescue_ms,
                         rescue_input ? "drives a way to it" : "found no way to it");
         }
       }
