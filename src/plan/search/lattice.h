@@ -80,6 +80,9 @@ class Lattice {
   void AddGapTargets(int lane, double T);
   void AddAccelerating(const bool reachable[], double vmax);
   void AddLimitRamps(double vgrid);
+  // Astride a lane line with the lane-line timer nearly out: moves off it in time
+  // (AddLineExits in lattice.cc says how long).
+  void AddLineExits(const bool reachable[]);
   void AddSwerves();
   void AddSwerveUnderWay();
   void AddPasses();

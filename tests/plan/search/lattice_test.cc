@@ -237,6 +237,57 @@ TEST(SearchLatticeTest, MovingLaterallyGetsEveryDurationAndNoDelayedStart) {
   }
 }
 
+TEST(SearchLatticeTest, AstrideALineWithTheTimerNearlyOutMovesOffInTimeAndNeverWaits) {
+  REQUIRE_UDACITY_MAP();
+  // The ego at rest across, 0.7 m past the line between the middle and the right lane (d 8:
+  // udacity seed 837's state), with 108 of the lane-line timer's 135 ticks gone (0.54 s left).
+  Stages st;
+  PrepareCentred(st, 20);
+  auto generate = [&](int straddle, double d = 8.7) {
+    st.Prepare({kS, 20, 0, d, 0, 0});
+    st.ws.straddle_at_start = straddle;
+    st.lattice.Generate();
+  };
+  // How many candidates of lateral moves shorter than the grid's shortest keep every limit,
+  // the timer's included, and how many of the grid's own durations do.
+  auto passing = [&](bool shorter) {
+    int n = 0;
+    for (int c = 0; c < static_cast<int>(st.ws.cand_lon.size()); ++c) {
+      const LatTraj& l = st.ws.lat[st.ws.cand_lat[c]];
+      if ((l.traj.duration < st.cfg.lat.min_duration - 1e-9) != shorter) continue;
+      st.ws.FillTicks(st.ws.Candidate(c));
+      n += st.limits.Violation(nullptr, true) <= 0;
+    }
+    return n;
+  };
+  generate(108);
+  int exits = 0;
+  for (const LatTraj& l : st.ws.lat) {
+    EXPECT_EQ(l.traj.delay, 0) << "a move that waits holds the ego astride";
+    if (l.traj.duration < st.cfg.lat.min_duration - 1e-9) {
+      ++exits;
+      EXPECT_TRUE(l.lane == 1 || l.lane == 2) << l.lane;
+      EXPECT_GE(l.traj.duration, 0.6);
+    }
+  }
+  EXPECT_EQ(exits, 2) << "one to each lane beside the line";
+  EXPECT_EQ(passing(false), 0) << "the grid's moves leave the line too late";
+  EXPECT_GT(passing(true), 0) << "a move off the line in time";
+  // With the timer just started: the grid's moves do, and no shorter one is added; a lane
+  // change that waits is still never offered astride a line.
+  generate(1);
+  for (const LatTraj& l : st.ws.lat) {
+    EXPECT_GE(l.traj.duration, st.cfg.lat.min_duration - 1e-9);
+    EXPECT_EQ(l.traj.delay, 0);
+  }
+  EXPECT_GT(passing(false), 0);
+  // Within a lane the lane changes that wait are there as before.
+  generate(0, st.ws.lane_center[1]);
+  int waits = 0;
+  for (const LatTraj& l : st.ws.lat) waits += l.traj.delay > 0;
+  EXPECT_GT(waits, 0);
+}
+
 TEST(SearchLatticeTest, FollowsTheLeaderInItsLaneOnlyWithTheTimeGapLaw) {
   REQUIRE_UDACITY_MAP();
   Stages st(GridOnly());
