@@ -171,13 +171,14 @@ LonTraj Lattice::MakeLon(cost::LonKind kind, int lane, double param, double T, i
 
 // Astride a lane line, with less of the simulator's lane-line timer left than the grid's
 // shortest lateral move needs to leave the line's band: to the centre of each lane beside the
-// line, a move that leaves the band (and the chords' reading of d past it) with a fifth of the
-// time left to spare, or, when that would ask more than 80% of the acceleration limit across
-// (a rest-to-rest quintic peaks at 10 / sqrt(3) span / T^2), the quickest move within it. The
-// grid's durations start at 2 s; a change that ran late (replanned, or slowed by a car braking
-// in the lane it moved into) then had none that left in time, and every candidate failed the
-// timer or hit a car: udacity seed 837 stayed astride for 3 s where a move over 0.83 s was
-// clear. The limit checks still judge each move.
+// line, a move that leaves the band (and the chords' reading of d past it, 0.3 m) with a fifth
+// of the time left to spare, over 0.6 s at least. The time is a rest-to-rest move's (the
+// stalled move of the case below); MakeLat starts from the ego's motion across, and the limit
+// checks judge the move it makes (one too quick for the acceleration limit across fails them).
+// The grid's durations start at 2 s; a change that ran late (replanned, or slowed by a car
+// braking in the lane it moved into) then had none that left in time, and every candidate
+// failed the timer or hit a car: udacity seed 837 stayed astride for 3 s where a move over
+// 0.83 s was clear.
 void Lattice::AddLineExits(const bool reachable[]) {
   if (ws_.straddle_at_start <= 0) return;
   const traj::FrenetState& start = ws_.start;
@@ -185,20 +186,20 @@ void Lattice::AddLineExits(const bool reachable[]) {
   const int line = static_cast<int>(std::lround(start.d / w));
   if (line < 1 || line >= cfg_.road.num_lanes) return;
   const double left = (kMaxStraddleTicks - ws_.straddle_at_start) * kTickSeconds;
-  constexpr double kSpare = 0.8, kChordSlack = 0.2, kQuinticPeak = 5.773502691896258;
+  constexpr double kSpare = 0.8, kChordSlack = 0.3, kShortest = 0.6;
   for (const int l : {line - 1, line}) {
     if (!reachable[l]) continue;
     const double span = ws_.lane_center[l] - start.d;
-    const double f = (line * w + (l < line ? -1 : 1) * (kStraddle + kChordSlack) - start.d) / span;
-    if (!(f > 0 && f < 1)) continue;
+    const double edge = line * w + (l < line ? -1 : 1) * (kStraddle + kChordSlack);
+    const double f = (edge - start.d) / span;  // the share of the move that leaves the band
+    if (std::abs(span) < 1e-6 || !(f > 0 && f < 1)) continue;
     // The share u of a rest-to-rest quintic's time at which it has covered f of its span.
     double lo = 0, hi = 1;
     for (int it = 0; it < 40; ++it) {
       const double u = 0.5 * (lo + hi);
       ((10 - 15 * u + 6 * u * u) * u * u * u < f ? lo : hi) = u;
     }
-    const double quickest = std::sqrt(kQuinticPeak * std::abs(span) / (0.8 * cfg_.limits.max_accel));
-    const double T = std::max(quickest, kSpare * left / hi);
+    const double T = std::max(kShortest, kSpare * left / hi);
     if (T < cfg_.lat.min_duration) AddLat(MakeLat(l, 0.0, T));
   }
 }
@@ -616,9 +617,10 @@ void Lattice::Generate() {
     if (crawl_hold) {
       AddLat(MakeLat(l, start.d - ws_.lane_center[l], cfg_.lat.max_duration));
     }
-    // A lane change that waits holds d where it is: never while astride a line, where the
-    // simulator's lane-line timer runs on (the least harm, which may drop that check, took one
-    // every cycle and held the ego astride for over 3 s: udacity seed 837).
+    // A lane change that waits holds d where it is: none is offered anew while astride a line,
+    // where the simulator's lane-line timer runs on (the least harm, which may drop that check,
+    // took one every cycle and held the ego astride for over 3 s: udacity seed 837). One under
+    // way (below) goes on.
     if (!own && at_rest && ws_.straddle_at_start == 0) {
       const double T = Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, 3, 1);
       for (int k = 1; k <= cfg_.lat.delays; ++k) {
