@@ -90,7 +90,7 @@ std::string FileNamePart(std::string_view text) {
   std::string name(text);
   for (char& c : name) {
     const bool keep = std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' ||
-                      c == '.' || c == ':';
+                      c == '.' || c == ':' || c == '[' || c == ']' || c == ',';
     if (!keep) c = '_';
   }
   return name;

@@ -97,8 +97,12 @@ TEST(SolutionTest, WriteReadRoundTripIsExact) {
 }
 
 TEST(SolutionTest, SavedUnderItsOwnNameAndLoadedBack) {
-  const std::string dir = ::testing::TempDir() + "/frenetic_solution_test";
-  std::filesystem::create_directories(dir);
+  // A fresh directory: a file left by an earlier run must not stand in for this one's.
+  const std::filesystem::path base =
+      std::filesystem::path(::testing::TempDir()) / "frenetic_solution_test";
+  std::filesystem::remove_all(base);
+  std::filesystem::create_directories(base);
+  const std::string dir = base.string();
   Solution s = Sample();
   s.trajectories.push_back(s.trajectories[0]);
   s.trajectories[1].problem_id = 11;

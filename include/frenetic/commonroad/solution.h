@@ -44,8 +44,9 @@ struct Solution {
 };
 
 // `text` fit to be part of a file name: every byte other than a letter, a digit or one of
-// - _ . : becomes '_' (a scenario's benchmark id, which names the files written for it, may
-// hold anything: a '/' or a control character).
+// - _ . : [ ] , becomes '_' (a scenario's benchmark id, which names the files written for it, may
+// hold anything: a '/' or a control character). The brackets and commas stay: CommonRoad names
+// a solution of several planning problems solution_[KS2,KS2]:[WX1,WX1]:<id>:<version>.xml.
 std::string FileNamePart(std::string_view text);
 
 // The solution as XML text.
