@@ -191,8 +191,10 @@ void Lattice::AddLineExits(const bool reachable[]) {
     if (!reachable[l]) continue;
     const double span = ws_.lane_center[l] - start.d;
     const double edge = line * w + (l < line ? -1 : 1) * (kStraddle + kChordSlack);
-    const double f = (edge - start.d) / span;  // the share of the move that leaves the band
-    if (std::abs(span) < 1e-6 || !(f > 0 && f < 1)) continue;
+    // The share of the move that leaves the band: none when the centre lies inside it or on
+    // the other side (a span of 0 gives inf or NaN, which the test drops too).
+    const double f = (edge - start.d) / span;
+    if (!(f > 0 && f < 1)) continue;
     // The share u of a rest-to-rest quintic's time at which it has covered f of its span.
     double lo = 0, hi = 1;
     for (int it = 0; it < 40; ++it) {
