@@ -158,6 +158,19 @@ void Rescue::Predict(const plan::Telemetry& t) {
     src.y = fe.d;
     src.along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
     src.rel = std::atan2(car.vy, car.vx) - road_heading;
+    // Across the road (d grows to the right): a lane change into the lane that holds the point
+    // half a lane on in its direction, when that lane's centre lies ahead of the car's move.
+    const double across = car.vx * std::sin(road_heading) - car.vy * std::cos(road_heading);
+    if (options_.lateral_threshold > 0 && std::abs(across) > options_.lateral_threshold) {
+      const double ahead = fe.d + std::copysign(0.5 * road_.lane_width() + 0.01, across);
+      int lane = road_.LaneOf(fe.s, ahead);
+      if (lane < 0) lane = road_.LaneOf(fe.s, fe.d);
+      const map::Road::Span span = road_.LaneAt(lane, fe.s);
+      if (span.exists && (span.centre() - fe.d) * across > 0) {
+        src.across = across;
+        src.d_target = span.centre();
+      }
+    }
   }
   for (const plan::CarFuture& f : t.futures) {
     if (f.start <= 0) continue;  // a present car's, above
@@ -186,10 +199,18 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
           radius = std::hypot(half_length, half_width);
         }
       } else if (src.kind == Source::kAlong) {
-        const map::CartesianPose at = road_.line().ToCartesian(src.x + src.along * step * dt_, src.y);
+        double d = src.y, rel = src.rel;
+        if (src.across != 0) {
+          d += src.across * step * dt_;
+          if ((d - src.d_target) * src.across >= 0) {  // in the lane's centre: straight on
+            d = src.d_target;
+            rel = 0;
+          }
+        }
+        const map::CartesianPose at = road_.line().ToCartesian(src.x + src.along * step * dt_, d);
         x = at.x;
         y = at.y;
-        heading = at.heading + src.rel;
+        heading = at.heading + rel;
       }
       Car& c = cars.emplace_back();
       c.box = {x, y, heading, half_length, half_width};

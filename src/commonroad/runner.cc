@@ -253,6 +253,11 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     if (options.rescue) {
       RescueOptions rescue_options;
       rescue_options.retry_states = options.rescue_retry_states;
+      // The lane changes the planner's predictor reads from lateral motion (none without its
+      // manoeuvres).
+      rescue_options.lateral_threshold = config.int_value("prediction.manoeuvres") != 0
+                                             ? config.value("prediction.lateral_threshold")
+                                             : 0.0;
       rescue.emplace(road, vp, dt, rescue_options);
     }
     run.stop_reason = "time";

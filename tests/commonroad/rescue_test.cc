@@ -4,7 +4,8 @@
 // lanes close in side by side; when a planner's path misses a goal that is closing, a way to it
 // (kept while it still meets it), and no search for a goal out of reach, along the road or
 // across it; a bound of the swerve across the road; a predicted car whose footprint grows; a
-// way to a goal held and driven on when the planner sends no path that passes.
+// way to a goal held and driven on when the planner sends no path that passes; a car moving
+// across predicted into the next lane.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -83,6 +84,48 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   // A path that ends before the car: nothing within the steps it covers.
   Straight(10, kLane0, 20, 50, &x, &y);
   EXPECT_EQ(rescue.PathHit(x, y), 0);
+}
+
+// A car moving across faster than the planner's lateral threshold changes lanes in the
+// rescue's predictions as in the planner's: into the next lane's centre, then straight on.
+TEST(RescueTest, ACarMovingAcrossIsPredictedIntoTheNextLaneAndNoFarther) {
+  const std::vector<map::ReferenceLine::Point> pts = {{0, 0}, {600, 0}};
+  auto line = map::ReferenceLine::FitOpen(pts, map::ReferenceLine::Options(), "straight");
+  ASSERT_TRUE(line.ok()) << line.message();
+  const auto road = map::Road::Uniform(*line, 3, 3.5);  // centres at y -1.75, -5.25, -8.75
+  // In lane 0 at 20 m/s along, 1.5 m/s across toward lane 1 (d grows as y falls).
+  plan::SensorCar car = Row(1, 40, kLane0, 20.0);
+  car.vy = -1.5;
+  const plan::Telemetry t = Scene(40, {car});
+  std::vector<double> x, y;
+  {
+    Rescue rescue(*road, VehicleParams(), kStep);  // lateral_threshold 0.7 m/s
+    rescue.Predict(t);
+    // A path alongside in lane 1: the car's box (heading atan(-1.5 / 20), half extent across
+    // 2.25 sin + 1.0 cos = 1.165 m) meets the ego's (0.805 + 0.05 m) when the car's centre is
+    // past 5.25 - 2.020 = 3.230 m: 1.75 + 1.5 t >= 3.230 first at t = 1.0 s, step 10.
+    Straight(40, kLane1, 20, 250, &x, &y);
+    EXPECT_EQ(rescue.PathHit(x, y), 10);
+    // Its move ends at lane 1's centre: a path alongside in lane 2 is never met.
+    Straight(40, -8.75, 20, 250, &x, &y);
+    EXPECT_EQ(rescue.PathHit(x, y), 0);
+  }
+  {
+    RescueOptions options;
+    options.lateral_threshold = 0;  // no lane changes: the car keeps its offset
+    Rescue rescue(*road, VehicleParams(), kStep, options);
+    rescue.Predict(t);
+    Straight(40, kLane1, 20, 250, &x, &y);
+    EXPECT_EQ(rescue.PathHit(x, y), 0);
+  }
+  {
+    // Slower across than the threshold: wander, not a lane change.
+    car.vy = -0.5;
+    Rescue rescue(*road, VehicleParams(), kStep);
+    rescue.Predict(Scene(40, {car}));
+    Straight(40, kLane1, 20, 250, &x, &y);
+    EXPECT_EQ(rescue.PathHit(x, y), 0);
+  }
 }
 
 TEST(RescueTest, PathHitIsAlsoTheStepAPathLeavesTheRoadShortOfItsGoal) {

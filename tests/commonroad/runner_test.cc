@@ -509,7 +509,8 @@ TEST(RunnerTest, ConstantVelocityPredictionsSeeTheOtherHalfOfAZipperMergeMergeIn
   // The ego in the left half of a zipper merge (its lane goes on, behind a car 20 m ahead that
   // follows it), a car alongside in the right half, all at 12 m/s; that car drives on straight
   // into the merged lane as its own lane ends. The ego sees only the present: without the merge
-  // predicted, the car seems to drive on beside it, and the ego runs into it at the merge.
+  // predicted, the car seems to drive on beside it, and the ego runs into it at the merge (or,
+  // once the rescue reads the car's turn across the narrowing road, too late, misses the goal).
   for (const double beside : {-2.0, 0.0, 2.0}) {
     ScenarioXml xml;
     AddZipperMerge(xml);
@@ -527,8 +528,7 @@ TEST(RunnerTest, ConstantVelocityPredictionsSeeTheOtherHalfOfAZipperMergeMergeIn
     plan::PlannerConfig no_merge = Config();
     ASSERT_TRUE(no_merge.Set("prediction.merge_time", 0).ok());
     const ProblemRun blind = RunOne(xml, PredictionMode::kConstantVelocity, &no_merge);
-    EXPECT_NE(blind.verdict.Find(FailureKind::kCollision), nullptr)
-        << beside << ": " << blind.verdict.Summary();
+    EXPECT_FALSE(blind.verdict.solved) << beside << ": " << blind.verdict.Summary();
   }
 }
 

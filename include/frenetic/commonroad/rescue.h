@@ -13,7 +13,9 @@
 // while the ego's box (grown by `ego_margin`) is clear of every predicted car's box at that step
 // and lies between the road's edges (the planner's road, its ends closed). It uses what the
 // planner was told and nothing else: the telemetry's futures of the cars (recorded
-// predictions), else each car carried on at its velocity. States share grid cells; above
+// predictions), else each car carried on along the road at its speed, a car moving across it
+// faster than `lateral_threshold` into the next lane's centre as the planner's predictor has it
+// (then straight on). States share grid cells; above
 // `max_states` valid states a step keeps a spread over coarse strata of position and speed.
 //
 // The way kept is the first found to meet a goal region (in its window, with its speed and
@@ -54,6 +56,11 @@ struct RescueOptions {
   double ego_margin = 0.05;   // m added to each side of the ego's box
   double car_length = 5.0;    // m, the footprint of a car whose row gives none
   double car_width = 2.0;
+  // m/s: a car without a future moving across the road faster than this changes lanes: it moves
+  // on across at that speed until it reaches the centre of the lane it moves into (the one
+  // holding the point half a lane on), then straight on; <= 0: every car keeps its offset. The
+  // planner's prediction.lateral_threshold, so that both predict the same lane changes.
+  double lateral_threshold = 0.7;
 };
 
 // What the rescue made of one cycle's path (Rescue::Check, Rescue::Answer).
@@ -100,8 +107,9 @@ class Rescue {
   RescueStep Continue();
 
   // The predicted boxes of the telemetry's cars at steps 1..steps from its instant: a car's
-  // future where it has one (a car to come appears at its start), else its row carried on at
-  // its velocity (a car with no speed is a square of its longer side: its heading is unknown).
+  // future where it has one (a car to come appears at its start), else its row carried on along
+  // the road at its speed and into the next lane as RescueOptions::lateral_threshold says (a car
+  // with no speed is a square of its longer side: its heading is unknown).
   // The boxes are laid out as the checks reach their steps, from t's futures: t must outlive the
   // calls up to the next Predict (the closed loop's telemetry of the cycle does).
   void Predict(const plan::Telemetry& t);
@@ -164,12 +172,14 @@ class Rescue {
   };
   // Where a car's boxes come from (Predict): its future, its row standing (x, y), or its row
   // carried on along the road (x, y: its s and d; along: m/s along the road; rel: its heading
-  // less the road's).
+  // less the road's; across: m/s across it, toward d_target, where the move ends and the car
+  // turns to the road's heading; 0: none).
   struct Source {
     enum Kind { kFuture, kStill, kAlong };
     Kind kind = kStill;
     const plan::CarFuture* future = nullptr;
     double x = 0, y = 0, along = 0, rel = 0;
+    double across = 0, d_target = 0;
     double half_length = 0, half_width = 0, radius = 0;
   };
   // Stratum with the speed across given: the search has its children's sines and cosines at
