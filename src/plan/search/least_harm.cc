@@ -497,9 +497,9 @@ bool LeastHarm::ChooseByRanking(bool* over_budget, bool all_known) {
       const int c = order[r];
       if (lane_line) {
         if (limits_.CandidateBreaksLimits(c)) continue;
-      } else {
-        ws_.FillTicks(ws_.Candidate(c));
-        if (limits_.Violation(nullptr, false) > 0) continue;
+      } else if (limits_.CandidateBreaksLimitsBesidesTheLaneLine(c)) {
+        // (Its bundles' ticks, not ws_.tk_*: the candidates of a bundle share them.)
+        continue;
       }
       ws_.TakeWinner(c);
       return true;

@@ -82,6 +82,20 @@ double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
     if (reason != nullptr) *reason = v->why;
     return v->worst;
   }
+  Reject why = Reject::kCount;
+  const double worst = Measure(&why, true, CandidateTicks(c, tr, ws_.CheckTicks(c)), any);
+  // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
+  const bool partial = any && worst > 0;
+  if (reason != nullptr) *reason = why;
+  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst, partial};
+  return worst;
+}
+
+bool LimitChecker::CandidateBreaksLimitsBesidesTheLaneLine(int c) {
+  return Measure(nullptr, false, CandidateTicks(c, ws_.Candidate(c), 0), true) > 0;
+}
+
+LimitChecker::Ticks LimitChecker::CandidateTicks(int c, const traj::FrenetTrajectory& tr, int n) {
   // FillTicks' values, from the bundles' rows: the candidates of a bundle share its ticks and
   // the centre line there.
   const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
@@ -89,16 +103,7 @@ double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
   if (lon_ticks_.Sample(tr.lon, i, time)) lon_centre_have_[i] = 0;
   lat_ticks_.Sample(tr.lat, k, time);
   const int w = ws_.n_ticks + 1;
-  Reject why = Reject::kCount;
-  const double worst = Measure(&why, true,
-                               {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w],
-                                nullptr, i, ws_.CheckTicks(c)},
-                               any);
-  // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
-  const bool partial = any && worst > 0;
-  if (reason != nullptr) *reason = why;
-  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst, partial};
-  return worst;
+  return {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], nullptr, i, n};
 }
 
 int LimitChecker::BuildXyPath(const Ticks& ticks) {

@@ -65,6 +65,10 @@ class LimitChecker {
   // (optional): a limit it breaks, the first one found (the worst one when a whole verdict
   // was remembered).
   bool CandidateBreaksLimits(int c, Reject* first = nullptr);
+  // Whether candidate c breaks a limit other than the lane-line timer over every tick of the
+  // check horizon (Violation(nullptr, false) > 0 after Workspace::FillTicks of it, the same
+  // answer): measured on its bundles' ticks, not remembered, ws.tk_* left as they are.
+  bool CandidateBreaksLimitsBesidesTheLaneLine(int c);
 
  private:
   // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the
@@ -94,6 +98,8 @@ class LimitChecker {
   double Measure(Reject* reason, bool lane_line, const Ticks& ticks, bool any = false);
   // CandidateViolation's work: Measure of candidate c's bundle ticks, through the verdicts.
   double CandidateMeasure(int c, Reject* reason, bool any);
+  // Its bundles' ticks (sampled anew when the slots hold other trajectories).
+  Ticks CandidateTicks(int c, const traj::FrenetTrajectory& tr, int n);
 
   const Settings& cfg_;
   const map::ReferenceLine& line_;

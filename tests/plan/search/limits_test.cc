@@ -107,11 +107,12 @@ TEST(LimitCheckerTest, LaneLineTimerCountsFromTheStartAndCanBeLeftOut) {
 
 // The least-harm choice asks only whether a candidate breaks a limit, and the Frenet checks
 // stop at the first one found broken: the answer is CandidateViolation's, and a verdict cut
-// short that way is measured in full when the reason is asked for later.
+// short that way is measured in full when the reason is asked for later. Its last resort asks
+// the same leaving the lane-line timer out: the answer is the full Violation's without it.
 TEST(LimitCheckerTest, BreaksLimitsAgreesWithTheFullViolation) {
   REQUIRE_UDACITY_MAP();
   Stages st;
-  int broken = 0, cut_short_then_full = 0, total = 0;
+  int broken = 0, cut_short_then_full = 0, total = 0, lane_line_only = 0;
   // Astride a line and in a lane, slow and fast, with the lane-line count fresh, near and past
   // its limit.
   for (const double d0 : {4.0, 5.2, 6.0, 9.9}) {
@@ -132,6 +133,10 @@ TEST(LimitCheckerTest, BreaksLimitsAgreesWithTheFullViolation) {
           ASSERT_EQ(breaks[c] != 0, worst_ref > 0) << "candidate " << c;
           EXPECT_EQ(worst, worst_ref) << "candidate " << c;
           EXPECT_EQ(why, why_ref) << "candidate " << c;
+          const bool besides = st.limits.CandidateBreaksLimitsBesidesTheLaneLine(c);
+          EXPECT_EQ(besides, st.limits.Violation(nullptr, /*lane_line=*/false) > 0)
+              << "candidate " << c;
+          lane_line_only += breaks[c] && !besides;
           broken += breaks[c];
           cut_short_then_full += breaks[c] && why == Reject::kLaneLine && straddle >= 120;
           ++total;
@@ -142,6 +147,7 @@ TEST(LimitCheckerTest, BreaksLimitsAgreesWithTheFullViolation) {
   EXPECT_GT(broken, total / 10);
   EXPECT_LT(broken, total);
   EXPECT_GT(cut_short_then_full, 0);
+  EXPECT_GT(lane_line_only, 0);  // the timer alone broken: only the last resort takes these
 }
 
 }  // namespace
