@@ -158,17 +158,13 @@ void Rescue::Predict(const plan::Telemetry& t) {
     src.y = fe.d;
     src.along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
     src.rel = std::atan2(car.vy, car.vx) - road_heading;
-    // Across the road (d grows to the right): a lane change into the lane that holds the point
-    // half a lane on in its direction, when that lane's centre lies ahead of the car's move.
+    // Across the road (d grows to the right): a lane change, as the planner's predictor has it.
     const double across = car.vx * std::sin(road_heading) - car.vy * std::cos(road_heading);
     if (options_.lateral_threshold > 0 && std::abs(across) > options_.lateral_threshold) {
-      const double ahead = fe.d + std::copysign(0.5 * road_.lane_width() + 0.01, across);
-      int lane = road_.LaneOf(fe.s, ahead);
-      if (lane < 0) lane = road_.LaneOf(fe.s, fe.d);
-      const map::Road::Span span = road_.LaneAt(lane, fe.s);
-      if (span.exists && (span.centre() - fe.d) * across > 0) {
+      const double centre = road_.CentreToward(fe.s, fe.d, across);
+      if (!std::isnan(centre)) {
         src.across = across;
-        src.d_target = span.centre();
+        src.d_target = centre;
       }
     }
   }

@@ -148,4 +148,12 @@ int Road::LaneOf(double s, double d) const {
   return best;
 }
 
+double Road::CentreToward(double s, double d, double toward) const {
+  const double ahead = d + std::copysign(0.5 * lane_width() + 0.01, toward);
+  int lane = LaneOf(s, ahead);
+  if (lane < 0) lane = LaneOf(s, d);
+  const Span span = LaneAt(lane, s);
+  return span.exists && (span.centre() - d) * toward > 0 ? span.centre() : kNaN;
+}
+
 }  // namespace frenetic::map

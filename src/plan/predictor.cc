@@ -545,13 +545,8 @@ class TrafficPredictor : public Predictor {
   double LateralTarget(double s, double d, double v_d) const {
     if (!(std::abs(v_d) > options_.lateral_threshold)) return d;
     if (!road_->uniform()) {
-      // The lane holding the point half a lane on in the move's direction, or the outermost one.
-      const double ahead = d + std::copysign(0.5 * road_->lane_width() + 0.01, v_d);
-      int lane = road_->LaneOf(s, ahead);
-      if (lane < 0) lane = road_->LaneOf(s, d);
-      const map::Road::Span span = road_->LaneAt(lane, s);
-      if (!span.exists) return d;
-      return (span.centre() - d) * v_d > 0 ? span.centre() : d;
+      const double centre = road_->CentreToward(s, d, v_d);
+      return std::isnan(centre) ? d : centre;
     }
     const double w = options_.lane_width;
     const int last = std::max(options_.num_lanes, 1) - 1;

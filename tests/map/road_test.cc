@@ -68,6 +68,14 @@ TEST(RoadTest, LanesBeginEndAndNarrow) {
   EXPECT_EQ(road.LaneOf(100, 1.0), 0);
   EXPECT_EQ(road.LaneOf(100, 8.0), 2);
   EXPECT_EQ(road.LaneOf(20, 8.0), -1);
+  // A move across ends in the centre of the lane half a lane on in its direction (its own, when
+  // still short of it); none past the edge, and none toward a centre already passed.
+  EXPECT_DOUBLE_EQ(road.CentreToward(100, 2.5, +1.0), 5.25);
+  EXPECT_DOUBLE_EQ(road.CentreToward(100, 1.0, +1.0), 1.75);
+  EXPECT_DOUBLE_EQ(road.CentreToward(100, 4.0, -1.0), 1.75);
+  EXPECT_TRUE(std::isnan(road.CentreToward(20, 6.0, +1.0)));  // no ramp yet; own centre behind
+  EXPECT_DOUBLE_EQ(road.CentreToward(100, 6.0, +1.0), road.LaneAt(2, 100).centre());  // the ramp
+  EXPECT_TRUE(std::isnan(road.CentreToward(100, 1.0, -1.0)));  // own centre behind, no lane left
 }
 
 TEST(RoadTest, BadProfilesFailNamingTheLane) {

@@ -82,6 +82,11 @@ class Road {
   Span EdgesAt(double s) const;
   // The lane whose borders hold (s, d), the nearest centre's when several do; -1 when none.
   int LaneOf(double s, double d) const;
+  // Where a move across from (s, d) in the direction of `toward`'s sign (a car changing lanes)
+  // ends: the centre at s of the lane holding the point half a lane width on (of the lane
+  // holding d when no lane does); NaN when that lane does not exist there or its centre does
+  // not lie in the move's direction.
+  double CentreToward(double s, double d, double toward) const;
 
  private:
   Road() = default;
