@@ -425,7 +425,10 @@ void RegisterCommonRoad(CLI::App& app) {
                 "limits and the friction circle, the ego's box 0.05 m wider, on the road between "
                 "its edges, at most 150 states a step) looks for a way that meets a goal region "
                 "or lasts the 4 s; when the path meets no goal region while every one closes "
-                "within it or lies behind its end, the search looks for a way that meets one. "
+                "within it or lies behind its end, or the planner's whole plan misses every one "
+                "while each closes within 6 s and the path ends outside it, the search looks for "
+                "a way that meets one (up to 6 s ahead; after a search that found none the next "
+                "waits a cycle or two). "
                 "The ego drives its first step, and the rest of it while it stays clear (and "
                 "still meets the goal). Its time counts as planning time. Default: off (the "
                 "rescue runs)");

@@ -88,29 +88,44 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
                const RescueOptions& options)
     : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
   options_.steps = std::max(options_.steps, 1);
+  options_.goal_steps = std::max(options_.goal_steps, options_.steps);
   options_.max_states = std::max(options_.max_states, 1);
   options_.retry_states = std::max(options_.retry_states, 0);
-  cars_.resize(options_.steps);
-  layers_.resize(options_.steps + 1);
+  cars_.resize(options_.goal_steps);
+  layers_.resize(options_.goal_steps + 1);
   half_length_ = 0.5 * vehicle_.length + options_.ego_margin;
   half_width_ = 0.5 * vehicle_.width + options_.ego_margin;
   ego_radius_ = std::hypot(half_length_, half_width_);
 }
 
 RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
-                         const std::vector<double>& y, const KsState& ego) {
+                         const std::vector<double>& y, const KsState& ego, bool plan_misses) {
   RescueStep r;
   const PathCheck path = Walk(x, y, t.goals);
   r.hit = path.hit;
   if (r.hit > 0) {
     r.why = RescueStep::Why::kHit;
     r.input = Next(ego, t.goals);
-  } else if (AtRisk(path, t.goals)) {
+  } else if (AtRisk(path, t.goals, plan_misses)) {
     r.why = RescueStep::Why::kGoal;
+    // At risk only as the planner's plan is (the window closes past the path): after a search
+    // that found no way the next waits a cycle, after two or more in a row two cycles.
+    const bool far = !AtRisk(path, t.goals, false);
+    if (far && !goal_way_ && far_wait_ > 0) {
+      --far_wait_;
+      Drop();
+      return r;
+    }
     r.input = Next(ego, t.goals, true);
-    if (!r.input) Drop();
+    if (!r.input) {
+      Drop();
+      if (far) far_wait_ = std::min(++far_fails_, 2);
+    } else {
+      far_fails_ = 0;
+    }
   } else {
     Drop();
+    far_fails_ = far_wait_ = 0;
   }
   return r;
 }
@@ -280,6 +295,7 @@ Rescue::PathCheck Rescue::Walk(const std::vector<double>& x, const std::vector<d
     c.met = GoalDistance(at.s, at.d, p.speed, p.heading, k * dt_, goals) == 0;
     c.t_end = k * dt_;
     c.s_end = at.s;
+    c.d_end = at.d;
   }
   return c;
 }
@@ -309,14 +325,15 @@ RescueStep Rescue::Continue() {
 }
 
 RescueStep Rescue::Answer(const plan::Telemetry& t, const std::vector<double>& x,
-                          const std::vector<double>& y, const KsState& ego, bool none_passed) {
-  return held_ && none_passed ? Continue() : Check(t, x, y, ego);
+                          const std::vector<double>& y, const KsState& ego, bool none_passed,
+                          bool plan_misses) {
+  return held_ && none_passed ? Continue() : Check(t, x, y, ego, plan_misses);
 }
 
 int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals, int from) {
   KsState s = ego;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
-  const int n = std::min(static_cast<int>(way_.size()) - from, options_.steps);
+  const int n = std::min(static_cast<int>(way_.size()) - from, options_.goal_steps);
   map::FrenetPoint at{};
   for (int k = 1; k <= n; ++k) {
     s = SimulateKs(s, way_[from + k - 1], dt_, vehicle_, 1);
@@ -341,15 +358,21 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   if (!keep) {
     // A way to a goal whose every window closes within the horizon first, also when the path
     // hits a car (a way that only lasts may leave the goal out of reach): a search that ends at
-    // the windows' close, with as many states in all as one over the whole horizon.
+    // the windows' close, with as many states in all as one over the whole horizon. A goal the
+    // path misses may close past the horizon, within goal_steps: the search runs to its close.
     Drop();
-    const int goal_steps = GoalSteps(goals);
+    const int goal_steps = GoalSteps(goals, goal_only ? options_.goal_steps : options_.steps);
     const auto search = [&](bool to_goal) {
+      const int horizon = to_goal && goal_steps > options_.steps ? goal_steps : options_.steps;
       const int scale = to_goal && goal_steps > 0 ? std::max(1, options_.steps / goal_steps) : 1;
-      Search(ego, goals, options_.max_states * scale, to_goal);
+      // Past the horizon, fewer a step: as many in all as over the horizon.
+      const auto states = [&](int n) {
+        return horizon > options_.steps ? std::max(1, n * options_.steps / horizon) : n * scale;
+      };
+      Search(ego, goals, states(options_.max_states), horizon, to_goal);
       // None at the usual size: once more with more states a step (a narrow way through).
       if (way_.empty() && options_.retry_states > options_.max_states) {
-        Search(ego, goals, options_.retry_states * scale, to_goal);
+        Search(ego, goals, states(options_.retry_states), horizon, to_goal);
       }
     };
     if (goal_only || goal_steps > 0) search(true);
@@ -359,14 +382,14 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   return way_.front();
 }
 
-int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals) const {
+int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) const {
   if (goals.empty()) return 0;
   double last = 0;
   for (const cost::GoalRegion& g : goals) last = std::max(last, g.t_hi + kWindowSlack * dt_);
   // Compared before the conversion: a window without an end (+inf) or NaN stays 0.
-  if (!(last < options_.steps * dt_)) return 0;
+  if (!(last < horizon * dt_)) return 0;
   const int steps = static_cast<int>(std::ceil(last / dt_ - 1e-9));
-  return steps >= 1 && steps < options_.steps ? steps : 0;
+  return steps >= 1 && steps < horizon ? steps : 0;
 }
 
 double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
@@ -390,8 +413,8 @@ double Rescue::GoalDistance(double s, double d, double v, double orientation, do
 }
 
 bool Rescue::MayMeetGoal(double s, double d, const KsState& state, double t,
-                         const std::vector<cost::GoalRegion>& goals) const {
-  const double horizon = options_.steps * dt_;
+                         const std::vector<cost::GoalRegion>& goals, int steps) const {
+  const double horizon = steps * dt_;
   const double v = state.velocity, a = vehicle_.a_max;
   // The farthest along the road within `time` s, at full acceleration.
   const auto reach = [v, a](double time) { return v * time + 0.5 * a * time * time; };
@@ -465,24 +488,32 @@ double Rescue::LateralReach(double s, const KsState& state, int toward, double t
 }
 
 bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
-                        const std::vector<cost::GoalRegion>& goals) const {
-  return AtRisk(Walk(x, y, goals), goals);
+                        const std::vector<cost::GoalRegion>& goals, bool plan_misses) const {
+  return AtRisk(Walk(x, y, goals), goals, plan_misses);
 }
 
-bool Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals) {
+bool Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
+                    bool plan_misses) const {
   if (goals.empty() || path.hit > 0 || !path.judged || path.met) return false;
   for (const cost::GoalRegion& g : goals) {
-    if (!(g.t_hi <= path.t_end || path.s_end > g.s_hi)) return false;  // still ahead, and open
+    if (g.t_hi <= path.t_end || path.s_end > g.s_hi) continue;  // closed within it, or passed
+    // Closing within a goal search's horizon while the path ends short of the region or beside
+    // it: whether the rest of the way still gets there is the search's to tell.
+    if (plan_misses && g.t_hi + kWindowSlack * dt_ < options_.goal_steps * dt_ &&
+        RegionGap(g, path.s_end, path.d_end) > 0) {
+      continue;
+    }
+    return false;  // still ahead, and open, or reached where the path ends
   }
   return true;
 }
 
 void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
-                    int max_states, bool goal_only) {
+                    int max_states, int steps, bool goal_only) {
   way_.clear();
   goal_way_ = false;
   const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
-  if (goal_only && !MayMeetGoal(fe0.s, fe0.d, ego, 0.0, goals)) return;  // out of reach
+  if (goal_only && !MayMeetGoal(fe0.s, fe0.d, ego, 0.0, goals, steps)) return;  // out of reach
   ++searches_;
   const VehicleParams& p = vehicle_;
   const double share = options_.limit_share;
@@ -498,7 +529,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
   // Stratum's speed across the start heading, from each child's sine and cosine of its heading.
   const double cos_h0 = std::cos(ego.orientation), sin_h0 = std::sin(ego.orientation);
   int depth = 0, met = -1;
-  for (int k = 1; k <= options_.steps; ++k) {
+  for (int k = 1; k <= steps; ++k) {
     next_.clear();
     seen_.Clear();
     const std::vector<Node>& now = layers_[k - 1];
@@ -569,7 +600,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
       if (Clear(node.state, k, node.s, &at)) {
         node.s = at.s;
         node.d = at.d;
-        if (goal_only && !MayMeetGoal(node.s, node.d, node.state, k * dt_, goals)) continue;
+        if (goal_only && !MayMeetGoal(node.s, node.d, node.state, k * dt_, goals, steps)) continue;
         layer.push_back(node);
         if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
                                                k * dt_, goals) == 0) met = static_cast<int>(layer.size()) - 1;
@@ -579,7 +610,7 @@ void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goa
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && (goal_only || depth < options_.steps)) return;
+  if (met < 0 && (goal_only || depth < steps)) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];

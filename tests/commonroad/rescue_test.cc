@@ -376,6 +376,31 @@ TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
   EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {}));
 }
 
+TEST(RescueTest, AGoalClosingPastThePathIsAtRiskWhenThePlanMissesItAndThePathEndsOutsideIt) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kStep);
+  std::vector<double> lane0_x, lane0_y, lane1_x, lane1_y;
+  Straight(50, kLane0, 20, 100, &lane0_x, &lane0_y);  // 2 s, ending at s 90
+  Straight(50, kLane1, 20, 100, &lane1_x, &lane1_y);
+  // Closing at 5 s, within goal_steps (6 s) and past the path's 2 s.
+  const cost::GoalRegion closing = Lane0Goal(4.5, 5.0);
+  // The planner's plan misses it and the path ends beside it: at risk.
+  EXPECT_TRUE(rescue.GoalAtRisk(lane1_x, lane1_y, {closing}, true));
+  // The plan meets it (the planner knows best), or the path ends inside the region: not.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {closing}, false));
+  EXPECT_FALSE(rescue.GoalAtRisk(lane0_x, lane0_y, {closing}, true));
+  // Short of it along the road (the region from s 120 on): at risk.
+  cost::GoalRegion ahead = closing;
+  ahead.s_lo = 120;
+  EXPECT_TRUE(rescue.GoalAtRisk(lane0_x, lane0_y, {ahead}, true));
+  // Closing past goal_steps (7 s), or a smaller goal_steps: later cycles may still meet it.
+  EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(6.5, 7.0)}, true));
+  RescueOptions four;
+  four.goal_steps = 40;
+  Rescue rescue4(*road, VehicleParams(), kStep, four);
+  EXPECT_FALSE(rescue4.GoalAtRisk(lane1_x, lane1_y, {closing}, true));
+}
+
 TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
   std::vector<cost::GoalRegion> goals = {Lane0Goal(1.5, 2.0)};
   const KsState ego = Ego(50, kLane1, 20);
@@ -405,6 +430,62 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) 
   // there): a new search, and a way to it only if there is one.
   goals = {Lane0Goal(0.1, 0.2, 62)};
   EXPECT_FALSE(rescue_.Next(next, goals, true).has_value());
+}
+
+TEST_F(RescueOnAnEmptyRoad, AWayToAGoalClosingPastTheHorizonIsSearchedUpToItsClose) {
+  // In lane 0 from s 150 on, its window 4.5-5.0 s: past the 4 s horizon, within goal_steps.
+  cost::GoalRegion goal = Lane0Goal(4.5, 5.0);
+  goal.s_lo = 150;
+  const KsState ego = Ego(50, kLane1, 20);
+  ASSERT_TRUE(rescue_.Next(ego, {goal}, true).has_value());
+  std::vector<double> x, y;
+  rescue_.Points(ego, &x, &y);
+  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
+  const int steps = static_cast<int>(x.size()) / ticks;
+  EXPECT_GE(steps, 45);
+  EXPECT_LE(steps, 50);
+  ASSERT_FALSE(y.empty());
+  EXPECT_GE(x.back(), 150.0);
+  EXPECT_GE(y.back(), -3.0);
+  EXPECT_LE(y.back(), -0.5);
+  // With a search no longer than the horizon, none.
+  RescueOptions four;
+  four.goal_steps = 40;
+  Rescue rescue4(*road_, VehicleParams(), kStep, four);
+  rescue4.Predict(t_);
+  EXPECT_FALSE(rescue4.Next(ego, {goal}, true).has_value());
+}
+
+TEST(RescueTest, AFarGoalSearchThatFindsNoWayWaitsBeforeTheNext) {
+  // Two stopped cars side by side at s 100 close both lanes (1.5 m between them); the goal lies
+  // past them, its window 4.5-5.0 s. The planner's 2 s path stops short of the cars.
+  const auto road = TwoLanes();
+  RescueOptions options;
+  options.retry_states = 0;  // one search each time
+  Rescue rescue(*road, VehicleParams(), kStep, options);
+  plan::Telemetry t = Scene(50, {Row(1, 100, kLane0, 0.0), Row(2, 100, kLane1, 0.0)});
+  cost::GoalRegion goal = Lane0Goal(4.5, 5.0);
+  goal.s_lo = 150;
+  t.goals = {goal};
+  std::vector<double> x, y;
+  Straight(50, kLane1, 10, 100, &x, &y);
+  const KsState ego = Ego(50, kLane1, 10);
+  // A cycle's wait after the first search, two after each later one: searches in cycles 1, 3,
+  // 6 and 9.
+  for (int cycle = 1; cycle <= 9; ++cycle) {
+    rescue.Predict(t);
+    const int before = rescue.searches();
+    const RescueStep step = rescue.Check(t, x, y, ego, true);
+    EXPECT_EQ(step.why, RescueStep::Why::kGoal);
+    EXPECT_FALSE(step.input.has_value());
+    const bool expected = cycle == 1 || cycle == 3 || cycle == 6 || cycle == 9;
+    EXPECT_EQ(rescue.searches() - before, expected ? 1 : 0) << "cycle " << cycle;
+  }
+  // With the plan meeting the goal (as the planner sees it), no search and nothing at risk.
+  Rescue quiet(*road, VehicleParams(), kStep, options);
+  quiet.Predict(t);
+  EXPECT_EQ(quiet.Check(t, x, y, ego, false).why, RescueStep::Why::kNone);
+  EXPECT_EQ(quiet.searches(), 0);
 }
 
 TEST_F(RescueOnAnEmptyRoad, NoSearchForAGoalOutOfReachOrPassed) {

@@ -44,7 +44,7 @@ plan::PlannerConfig Config(PredictionMode mode = PredictionMode::kRecorded) {
 }
 
 ProblemRun RunOne(const ScenarioXml& xml, PredictionMode mode = PredictionMode::kRecorded,
-                  const plan::PlannerConfig* config = nullptr) {
+                  const plan::PlannerConfig* config = nullptr, bool rescue = true) {
   if (const char* dump = std::getenv("FRENETIC_TEST_DUMP"); dump != nullptr) {
     std::ofstream(dump) << xml.Str();
   }
@@ -53,6 +53,7 @@ ProblemRun RunOne(const ScenarioXml& xml, PredictionMode mode = PredictionMode::
   RunOptions o;
   o.prediction = mode;
   o.timing = false;
+  o.rescue = rescue;
   const ScenarioRun run = RunScenario(*sc, config != nullptr ? *config : Config(mode), o);
   EXPECT_EQ(run.problems.size(), 1u);
   return run.problems.empty() ? ProblemRun{} : run.problems[0];
@@ -200,17 +201,20 @@ TEST(RunnerTest, PassesAParkedTruckBeforeTheOncomingCarComes) {
   }();
   const ProblemRun p = RunOne(xml);
   ASSERT_TRUE(p.verdict.solved) << p.verdict.Summary();
-  // Without passes the ego waits behind the truck for the car. (The limit ramps off too: with
-  // them it gets there sooner, and by in the oncoming lane before the car without a pass. And
-  // the goal's move across after a path's samples: a lane change into the oncoming lane, short
-  // of the goal, then counts as coming back in time, and serves as a pass.)
+  // Without passes the planner waits behind the truck for the car. (The limit ramps off too:
+  // with them it gets there sooner, and by in the oncoming lane before the car without a pass.
+  // And the goal's move across after a path's samples: a lane change into the oncoming lane,
+  // short of the goal, then counts as coming back in time, and serves as a pass. And the
+  // rescue: its search for a way to the goal, once the planner's plan misses it within 6 s of
+  // its close, finds the pass the planner lacks.)
   plan::PlannerConfig no_passes = Config();
   ASSERT_TRUE(no_passes.Set("grid.passes", 0).ok());
   ASSERT_TRUE(no_passes.Set("grid.limit_ramps", 0).ok());
   ASSERT_TRUE(no_passes.Set("costs.goal.lateral_pace", 0).ok());
-  const ProblemRun waited = RunOne(xml, PredictionMode::kRecorded, &no_passes);
+  const ProblemRun waited = RunOne(xml, PredictionMode::kRecorded, &no_passes, false);
   EXPECT_FALSE(waited.verdict.solved);
   EXPECT_EQ(waited.verdict.Find(FailureKind::kCollision), nullptr) << waited.verdict.Summary();
+  EXPECT_TRUE(RunOne(xml, PredictionMode::kRecorded, &no_passes).verdict.solved);
 }
 
 TEST(RunnerTest, LeavesAnEndingLaneForTheGoal) {
@@ -412,6 +416,35 @@ TEST(RunnerTest, TheRescueMeetsAGoalThePlannersPathMisses) {
   EXPECT_GT(rescued, 0);
   ASSERT_FALSE(p.trajectory.empty());
   EXPECT_GT(p.trajectory.back().y, 0.0);  // its centre in the region's lane
+}
+
+TEST(RunnerTest, TheRescueOvertakesForAGoalPastASlowCarBeforeItsWindowCloses) {
+  // A zipper merge (as ZAM_Zip-9_9 made by scripts/commonroad-zips.py): the ego starts at 6.3
+  // m/s in the left half, a slower car ahead of it in its half (8-9 m/s), two cars at 10.6-10.8
+  // m/s in the right half, one behind the ego and one ahead; the goal is the merged lane at
+  // steps 84-85. Following the slow car the ego is still short of the merge then; the planner's
+  // lattice does not find the way past it (without the goal search past the 2 s path, none of
+  // these is solved). Once its plan misses the goal while the window closes within 6 s, the
+  // rescue's search finds a way through the right half and the ego drives it.
+  for (const double x0 : {-85.0, -75.0}) {
+    const double v0 = x0 < -80 ? 9.0 : 8.0;
+    ScenarioXml xml;
+    AddZipperMerge(xml);
+    std::vector<StateXml> slow;
+    for (int k = 0; k <= 85; ++k) {
+      const double x = x0 + v0 * 0.1 * k;  // into the merged lane as 28 turns, from x = -20
+      slow.push_back({k, {x, 8.75 - 3.5 * std::clamp((x + 20) / 20, 0.0, 1.0)}, 0.0, v0});
+    }
+    xml.DynamicObstacle(4, 4.8, 2, slow)
+        .DynamicObstacle(5, 4.8, 2, Drive(-116, 5.25, 10.8, 85))
+        .DynamicObstacle(6, 4.8, 2, Drive(-59, 5.25, 10.6, 85))
+        .Problem(1, {-123.7, 8.75}, 0, 6.3, {GoalLaneletXml(24, 84, 85)});
+    const ProblemRun p = RunOne(xml);
+    EXPECT_TRUE(p.verdict.solved) << x0 << ": " << p.verdict.Summary();
+    int rescued = 0;
+    for (const RunCycle& c : p.cycles) rescued += c.rescued;
+    EXPECT_GT(rescued, 0);
+  }
 }
 
 TEST(RunnerTest, ARunEndsOnceEveryGoalRegionIsBehind) {

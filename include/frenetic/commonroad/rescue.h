@@ -28,9 +28,11 @@
 // way only stands in for the planner's path while that path still hits a car or misses the goal.
 //
 // For a goal the planner's path misses (GoalAtRisk: every region either closes within the path
-// or lies behind its end), only a way that meets a region will do; the search leaves out the
-// states that can no longer meet one (window closed, region passed, or its start beyond reach at
-// full acceleration), so a goal out of reach costs no search at all.
+// or lies behind its end, or the planner's whole plan misses it too while it closes within
+// `goal_steps` and the path ends outside it), only a way that meets a region will do, searched
+// up to the windows' close (past `steps` with fewer states a step, as many in all); the search
+// leaves out the states that can no longer meet one (window closed, region passed, or its start
+// beyond reach at full acceleration), so a goal out of reach costs no search at all.
 #pragma once
 
 #include <cstdint>
@@ -50,6 +52,9 @@ namespace frenetic::commonroad {
 
 struct RescueOptions {
   int steps = 40;             // steps searched ahead (4 s at the benchmark's 0.1 s)
+  // Steps a search for a way to a goal region the planner's path misses may run, when every
+  // window closes within them (6 s; at least `steps`): see Rescue::GoalAtRisk.
+  int goal_steps = 60;
   int max_states = 150;       // valid states kept per step (a spread when more)
   int retry_states = 300;     // when none is found, once more with this many (0: no retry)
   double limit_share = 0.97;  // of the vehicle's acceleration, steering and steering-rate limits
@@ -83,14 +88,16 @@ class Rescue {
   // The path the planner sends for t (points every plan::kTickSeconds, the first one tick on)
   // checked on the cars of the last Predict (of the same t): a way (Next) when it hits a car,
   // else a way to a goal (Next, goal_only) when GoalAtRisk; else (or when no way to the goal is
-  // found) the way is forgotten. `ego`: the vehicle's state.
+  // found) the way is forgotten. `ego`: the vehicle's state; plan_misses: the planner's own plan
+  // (its winner, continued as its goal term does) meets no goal region (GoalAtRisk).
   RescueStep Check(const plan::Telemetry& t, const std::vector<double>& x,
-                   const std::vector<double>& y, const KsState& ego);
+                   const std::vector<double>& y, const KsState& ego, bool plan_misses = false);
   // The closed loop's answer to the path the planner sent, after Predict(t) and Holds(ego,
   // t.goals) this cycle: when the way held and no candidate passed (none_passed: the planner
   // skipped its least harm), the way driven on (Continue); otherwise Check.
   RescueStep Answer(const plan::Telemetry& t, const std::vector<double>& x,
-                    const std::vector<double>& y, const KsState& ego, bool none_passed);
+                    const std::vector<double>& y, const KsState& ego, bool none_passed,
+                    bool plan_misses = false);
 
   // Whether the rest of the way from `ego` (one step driven since it was found or last kept)
   // is a way to a goal region that still meets it, clear to its end: one Next keeps whatever
@@ -151,9 +158,13 @@ class Rescue {
 
   // Whether a path (as PathHit's, one that neither hits a car nor leaves the road: Check asks
   // only then) meets no goal region of `goals` (in its window, with its speed and heading) while
-  // every region's window closes within the path, or the path runs past the region's end.
+  // every region's window closes within the path, or the path runs past the region's end, or
+  // (plan_misses: the planner's plan beyond the path misses every region too) the window closes
+  // within RescueOptions::goal_steps and the path ends short of the region or beside it. The
+  // path the planner sends is 2 s; a goal a car has to be passed for is lost long before its
+  // window closes within that.
   bool GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
-                  const std::vector<cost::GoalRegion>& goals) const;
+                  const std::vector<cost::GoalRegion>& goals, bool plan_misses = false) const;
 
   // Forget the way (the planner's path is clear again).
   void Drop() {
@@ -206,12 +217,13 @@ class Rescue {
   struct PathCheck {
     int hit = 0;
     bool met = false, judged = true;
-    double t_end = 0, s_end = -std::numeric_limits<double>::infinity();
+    double t_end = 0, s_end = -std::numeric_limits<double>::infinity(), d_end = 0;
   };
   PathCheck Walk(const std::vector<double>& x, const std::vector<double>& y,
                  const std::vector<cost::GoalRegion>& goals) const;
   // GoalAtRisk of a walked path.
-  static bool AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals);
+  bool AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
+              bool plan_misses) const;
   // The predicted cars at step k (1..steps), laid out up to k on first use.
   const std::vector<Car>& CarsAt(int k) const;
   // The same for the cars alone, and for the road alone (the box, the margin's wider, between
@@ -223,13 +235,13 @@ class Rescue {
   // (empty when none), with at most max_states (>= 1) states a step.
   // goal_only: none unless it meets a goal region.
   void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states,
-              bool goal_only = false);
+              int steps, bool goal_only = false);
   // Whether a state at (s, d) in the road's frame, t s from now, may still meet a goal region
   // within the horizon: one whose window is open at t or later, not passed, whose start lies
   // within reach at the vehicle's full acceleration before its window closes, and whose band
   // across the road lies within LateralReach.
   bool MayMeetGoal(double s, double d, const KsState& state, double t,
-                   const std::vector<cost::GoalRegion>& goals) const;
+                   const std::vector<cost::GoalRegion>& goals, int steps) const;
   // The distance (s, d) of a state (speed v, heading) at t s from the nearest goal region whose
   // window holds t (0 inside it with its speed and heading, 1e-3 inside without), +inf when
   // none does.
@@ -237,7 +249,7 @@ class Rescue {
                       const std::vector<cost::GoalRegion>& goals) const;
   // The step (1..steps - 1) by which every window of `goals` has closed; 0 when none are given
   // or one stays open to the horizon or beyond.
-  int GoalSteps(const std::vector<cost::GoalRegion>& goals) const;
+  int GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) const;
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;
@@ -258,6 +270,9 @@ class Rescue {
   std::vector<KsInput> way_;
   bool goal_way_ = false;  // way_ ends in a goal region
   bool held_ = false;      // the last Holds' answer, until Predict or the way changes
+  // Searches for a goal at risk only as the planner's plan is (Check): found no way in a row,
+  // and cycles to wait before the next.
+  int far_fails_ = 0, far_wait_ = 0;
   std::vector<std::vector<Node>> layers_;
   std::vector<std::pair<std::uint64_t, Node>> next_;
   KeyTable seen_;
