@@ -54,14 +54,15 @@ struct Scene {
   std::shared_ptr<const map::Road> road;
   std::shared_ptr<const plan::PlannerConfig> config;
   // CommonRoad scenes, per message: the vehicle's state and the path the planner sent (what the
-  // closed loop's rescue is given, commonroad::Rescue::Step); the scenario's step (s) and the
+  // closed loop's rescue is given, commonroad::Rescue::Answer); the scenario's step (s) and the
   // vehicle.
   std::vector<commonroad::KsState> ego;
   std::vector<std::vector<double>> path_x, path_y;
   // CommonRoad scenes, per message: whether the planner's least-harm choice was on
   // (commonroad::CycleInput::least_harm; the replay sets it), and whether no candidate passed
-  // (status fallback_used: with a way held, the rescue drove it, Rescue::Continue).
-  std::vector<char> least_harm, fallback;
+  // (status fallback_used: with a way held, the rescue drove it, Rescue::Continue), and whether
+  // the planner's plan missed every goal region (commonroad::PlanMissesGoal).
+  std::vector<char> least_harm, fallback, plan_misses;
   double dt = 0;
   commonroad::VehicleParams vehicle;
 };

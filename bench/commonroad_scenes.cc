@@ -60,6 +60,7 @@ StatusOr<Scene> Capture(const std::string& path) {
     scene.path_x.push_back(result.x);
     scene.path_y.push_back(result.y);
     scene.fallback.push_back(result.status == plan::PlanStatus::kFallbackUsed ? 1 : 0);
+    scene.plan_misses.push_back(commonroad::PlanMissesGoal(result) ? 1 : 0);
   };
   scene.dt = scenario->dt;
   scene.vehicle = *vehicle;

@@ -253,7 +253,7 @@ void PlanCommonRoad(benchmark::State& state, const std::vector<std::string>& pat
   state.counters["lanes"] = lanes;
 }
 
-// The closed loop's rescue (commonroad::Rescue::Step) on every cycle of CommonRoad scenes
+// The closed loop's rescue (commonroad::Rescue::Answer) on every cycle of CommonRoad scenes
 // (captured on first use), scene after scene, each cycle in order with one rescue per problem as
 // the runner keeps it: the time it adds to a cycle's Plan(). The same decisions as the run's (the
 // vehicle's states are the run's, which drove them).
@@ -289,7 +289,8 @@ void RescueCommonRoad(benchmark::State& state, const std::vector<std::string>& p
     rescue->Predict(m);
     rescue->Holds(scene.ego[i], m.goals);
     const commonroad::RescueStep r =
-        rescue->Answer(m, scene.path_x[i], scene.path_y[i], scene.ego[i], scene.fallback[i] != 0);
+        rescue->Answer(m, scene.path_x[i], scene.path_y[i], scene.ego[i], scene.fallback[i] != 0,
+                       scene.plan_misses[i] != 0);
     const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
     const double cpu = ThreadCpuSeconds() - cpu0;
     state.PauseTiming();

@@ -57,17 +57,14 @@ double Curvature(double x1, double y1, double x2, double y2, double x3, double y
   return den > 1e-12 ? 2.0 * (ax * by - ay * bx) / den : 0.0;
 }
 
-// Whether the planner's plan, as its goal term sees it (the winner continued past its end),
-// meets no goal region: the term is 0 only when it passes through one in its window. False when
-// the term is not configured (nothing known).
-bool PlanMisses(const plan::PlanResult& res) {
+}  // namespace
+
+bool PlanMissesGoal(const plan::PlanResult& res) {
   for (const plan::CostTermValue& v : res.summary.winner_costs) {
     if (v.name == "goal") return v.weight > 0 && v.value > 0;
   }
   return false;
 }
-
-}  // namespace
 
 KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
                    double dt, const VehicleParams& vp) {
@@ -349,7 +346,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       if (rescue) {
         const auto r0 = std::chrono::steady_clock::now();
         const RescueStep step = rescue->Answer(
-            t, res.x, res.y, ego, res.status == plan::PlanStatus::kFallbackUsed, PlanMisses(res));
+            t, res.x, res.y, ego, res.status == plan::PlanStatus::kFallbackUsed, PlanMissesGoal(res));
         rescue_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r0)
                 .count();

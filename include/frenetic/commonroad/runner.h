@@ -140,6 +140,11 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const V
 KsState FollowPath(const KsState& ego, const std::vector<double>& x,
                    const std::vector<double>& y, double dt, const VehicleParams& vp);
 
+// Whether the planner's plan, as its goal term sees it (the winner continued past its end),
+// meets no goal region: the term is 0 only when it passes through one in its window. False when
+// the term is not configured (nothing known). What the rescue is told (Rescue::Answer).
+bool PlanMissesGoal(const plan::PlanResult& res);
+
 // Runs every planning problem of the scenario. `config` is used as given (see CommonRoadConfig).
 // Never fails: a problem whose road cannot be built reports it in ProblemRun::road.
 ScenarioRun RunScenario(const Scenario& scenario, const plan::PlannerConfig& config,
