@@ -427,8 +427,8 @@ void RegisterCommonRoad(CLI::App& app) {
                 "or lasts the 4 s; when the path meets no goal region while every one closes "
                 "within it or lies behind its end, or the planner's whole plan misses every one "
                 "while each closes within 6 s and the path ends outside it, the search looks for "
-                "a way that meets one (up to 6 s ahead; after a search that found none the next "
-                "waits a cycle or two). "
+                "a way that meets one (in the last case up to 6 s ahead, to the windows' close, "
+                "and after such a search found none the next waits a cycle or two). "
                 "The ego drives its first step, and the rest of it while it stays clear (and "
                 "still meets the goal). Its time counts as planning time. Default: off (the "
                 "rescue runs)");

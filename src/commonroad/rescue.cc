@@ -88,7 +88,7 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
                const RescueOptions& options)
     : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
   options_.steps = std::max(options_.steps, 1);
-  options_.goal_steps = std::max(options_.goal_steps, options_.steps);
+  options_.goal_steps = std::clamp(options_.goal_steps, options_.steps, 10 * options_.steps);
   options_.max_states = std::max(options_.max_states, 1);
   options_.retry_states = std::max(options_.retry_states, 0);
   cars_.resize(options_.goal_steps);
@@ -116,12 +116,12 @@ RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
       Drop();
       return r;
     }
-    r.input = Next(ego, t.goals, true);
+    r.input = Next(ego, t.goals, true, far);
     if (!r.input) {
       Drop();
       if (far) far_wait_ = std::min(++far_fails_, 2);
     } else {
-      far_fails_ = 0;
+      far_fails_ = far_wait_ = 0;
     }
   } else {
     Drop();
@@ -348,7 +348,8 @@ int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals
 }
 
 std::optional<KsInput> Rescue::Next(const KsState& ego,
-                                    const std::vector<cost::GoalRegion>& goals, bool goal_only) {
+                                    const std::vector<cost::GoalRegion>& goals, bool goal_only,
+                                    bool far) {
   held_ = false;
   if (!way_.empty()) way_.erase(way_.begin());  // the step driven since
   const int rest = static_cast<int>(way_.size());
@@ -361,7 +362,9 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
     // the windows' close, with as many states in all as one over the whole horizon. A goal the
     // path misses may close past the horizon, within goal_steps: the search runs to its close.
     Drop();
-    const int goal_steps = GoalSteps(goals, goal_only ? options_.goal_steps : options_.steps);
+    const int goal_steps =
+        far ? FarGoalSteps(goals, road_.line().ToFrenet(ego.x, ego.y).s)
+            : GoalSteps(goals, options_.steps);
     const auto search = [&](bool to_goal) {
       const int horizon = to_goal && goal_steps > options_.steps ? goal_steps : options_.steps;
       const int scale = to_goal && goal_steps > 0 ? std::max(1, options_.steps / goal_steps) : 1;
@@ -390,6 +393,24 @@ int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) c
   if (!(last < horizon * dt_)) return 0;
   const int steps = static_cast<int>(std::ceil(last / dt_ - 1e-9));
   return steps >= 1 && steps < horizon ? steps : 0;
+}
+
+int Rescue::ClosingStep(const cost::GoalRegion& g) const {
+  const double last = g.t_hi + kWindowSlack * dt_;
+  // Compared before the conversion: a window without an end (+inf) or NaN stays 0.
+  if (!(last < options_.goal_steps * dt_)) return 0;
+  return std::max(1, static_cast<int>(std::ceil(last / dt_ - 1e-9)));
+}
+
+int Rescue::FarGoalSteps(const std::vector<cost::GoalRegion>& goals, double s) const {
+  int steps = 0;
+  for (const cost::GoalRegion& g : goals) {
+    if (s > g.s_hi) continue;  // passed: no way meets it, whenever it closes
+    const int k = ClosingStep(g);
+    if (k == 0) return 0;
+    steps = std::max(steps, k);
+  }
+  return std::min(steps, options_.goal_steps);
 }
 
 double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
@@ -499,7 +520,7 @@ bool Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& 
     if (g.t_hi <= path.t_end || path.s_end > g.s_hi) continue;  // closed within it, or passed
     // Closing within a goal search's horizon while the path ends short of the region or beside
     // it: whether the rest of the way still gets there is the search's to tell.
-    if (plan_misses && g.t_hi + kWindowSlack * dt_ < options_.goal_steps * dt_ &&
+    if (plan_misses && path.t_end > 0 && ClosingStep(g) > 0 &&
         RegionGap(g, path.s_end, path.d_end) > 0) {
       continue;
     }

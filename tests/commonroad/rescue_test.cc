@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -399,6 +400,8 @@ TEST(RescueTest, AGoalClosingPastThePathIsAtRiskWhenThePlanMissesItAndThePathEnd
   four.goal_steps = 40;
   Rescue rescue4(*road, VehicleParams(), kStep, four);
   EXPECT_FALSE(rescue4.GoalAtRisk(lane1_x, lane1_y, {closing}, true));
+  // No path to judge: nothing at risk.
+  EXPECT_FALSE(rescue.GoalAtRisk({}, {}, {closing}, true));
 }
 
 TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) {
@@ -437,7 +440,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalClosingPastTheHorizonIsSearchedUpToItsClo
   cost::GoalRegion goal = Lane0Goal(4.5, 5.0);
   goal.s_lo = 150;
   const KsState ego = Ego(50, kLane1, 20);
-  ASSERT_TRUE(rescue_.Next(ego, {goal}, true).has_value());
+  ASSERT_TRUE(rescue_.Next(ego, {goal}, true, true).has_value());
   std::vector<double> x, y;
   rescue_.Points(ego, &x, &y);
   const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
@@ -446,14 +449,32 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalClosingPastTheHorizonIsSearchedUpToItsClo
   EXPECT_LE(steps, 50);
   ASSERT_FALSE(y.empty());
   EXPECT_GE(x.back(), 150.0);
+  // Not far (the path misses it for good): the search keeps to the horizon, and finds none.
+  rescue_.Drop();
+  EXPECT_FALSE(rescue_.Next(ego, {goal}, true).has_value());
   EXPECT_GE(y.back(), -3.0);
   EXPECT_LE(y.back(), -0.5);
+  // Closing at the last step a search may reach (an instant at 5.9 s, the window's slack of
+  // 0.075 s added: step 60): found too, at step 59.
+  goal.t_lo = 5.9;
+  goal.t_hi = 5.9;
+  rescue_.Drop();
+  ASSERT_TRUE(rescue_.Next(ego, {goal}, true, true).has_value());
+  rescue_.Points(ego, &x, &y);
+  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 59);
+  // A region passed long ago whose window never closes does not cut the search short.
+  cost::GoalRegion passed = Lane0Goal(0.0, std::numeric_limits<double>::infinity(), 40);
+  passed.s_lo = 20;
+  rescue_.Drop();
+  EXPECT_TRUE(rescue_.Next(ego, {passed, goal}, true, true).has_value());
+  goal = Lane0Goal(4.5, 5.0);
+  goal.s_lo = 150;
   // With a search no longer than the horizon, none.
   RescueOptions four;
   four.goal_steps = 40;
   Rescue rescue4(*road_, VehicleParams(), kStep, four);
   rescue4.Predict(t_);
-  EXPECT_FALSE(rescue4.Next(ego, {goal}, true).has_value());
+  EXPECT_FALSE(rescue4.Next(ego, {goal}, true, true).has_value());
 }
 
 TEST(RescueTest, AFarGoalSearchThatFindsNoWayWaitsBeforeTheNext) {

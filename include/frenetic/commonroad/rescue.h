@@ -113,7 +113,7 @@ class Rescue {
   // holds; none (and the way forgotten) otherwise.
   RescueStep Continue();
 
-  // The predicted boxes of the telemetry's cars at steps 1..steps from its instant: a car's
+  // The predicted boxes of the telemetry's cars at steps 1..goal_steps from its instant: a car's
   // future where it has one (a car to come appears at its start), else its row carried on along
   // the road at its speed and into the next lane as RescueOptions::lateral_threshold says (a car
   // with no speed is a square of its longer side: its heading is unknown).
@@ -135,8 +135,10 @@ class Rescue {
   // goal_only: only a way that meets a goal region (the planner's path misses a goal). When
   // every goal window closes within the horizon (GoalSteps), a way to a goal is searched for
   // first in either case, up to that step, with steps / GoalSteps times the states a step.
+  // far (with goal_only): the goal is at risk only as the planner's plan is (GoalAtRisk's last
+  // case); the search runs to FarGoalSteps, with fewer states a step past `steps`.
   std::optional<KsInput> Next(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
-                              bool goal_only = false);
+                              bool goal_only = false, bool far = false);
 
   // The stratum of a search's state (its spread keeps states of every stratum, round-robin):
   // cells of 2 m x 2 m, 1 m/s of speed and 0.5 m/s of speed across the search's start heading
@@ -207,7 +209,7 @@ class Rescue {
     KsInput input;
     double across;  // m/s: the speed across the search's start heading (Stratum)
   };
-  // Whether `s` at step k (1..steps) is clear of the predicted cars and on the road; *s_out: its
+  // Whether `s` at step k (1..goal_steps) is clear of the predicted cars and on the road; *s_out: its
   // s along the road (from the hint s_hint).
   bool Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at) const;
   // One walk along a path (PathHit's points and checks) for both of Check's questions: the step
@@ -224,7 +226,7 @@ class Rescue {
   // GoalAtRisk of a walked path.
   bool AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
               bool plan_misses) const;
-  // The predicted cars at step k (1..steps), laid out up to k on first use.
+  // The predicted cars at step k (1..goal_steps), laid out up to k on first use.
   const std::vector<Car>& CarsAt(int k) const;
   // The same for the cars alone, and for the road alone (the box, the margin's wider, between
   // the road's edges at both its ends; *at as Clear's).
@@ -247,9 +249,16 @@ class Rescue {
   // none does.
   double GoalDistance(double s, double d, double v, double orientation, double t,
                       const std::vector<cost::GoalRegion>& goals) const;
-  // The step (1..steps - 1) by which every window of `goals` has closed; 0 when none are given
-  // or one stays open to the horizon or beyond.
+  // The step (1..horizon - 1) by which every window of `goals` has closed; 0 when none are
+  // given or one stays open to the horizon or beyond.
   int GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) const;
+  // The step (1..goal_steps) by which region g's window has closed (its slack added); 0 when it
+  // stays open past goal_steps (or has no end).
+  int ClosingStep(const cost::GoalRegion& g) const;
+  // The step by which the window of every region not yet passed at s (along the road) has
+  // closed, for a search to a goal at risk only as the planner's plan is; 0 when one stays
+  // open past goal_steps.
+  int FarGoalSteps(const std::vector<cost::GoalRegion>& goals, double s) const;
   // A state's distance (m, in s and d) from the nearest goal region whose window is open at the
   // horizon's end (any region when none is; 0 without regions).
   double GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const;
