@@ -106,11 +106,11 @@ RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
   if (r.hit > 0) {
     r.why = RescueStep::Why::kHit;
     r.input = Next(ego, t.goals);
-  } else if (AtRisk(path, t.goals, plan_misses)) {
+  } else if (const Risk risk = AtRisk(path, t.goals, plan_misses); risk != Risk::kNone) {
     r.why = RescueStep::Why::kGoal;
     // At risk only as the planner's plan is (the window closes past the path): after a search
     // that found no way the next waits a cycle, after two or more in a row two cycles.
-    const bool far = !AtRisk(path, t.goals, false);
+    const bool far = risk == Risk::kFar;
     if (far && !goal_way_ && far_wait_ > 0) {
       --far_wait_;
       Drop();
@@ -510,23 +510,25 @@ double Rescue::LateralReach(double s, const KsState& state, int toward, double t
 
 bool Rescue::GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
                         const std::vector<cost::GoalRegion>& goals, bool plan_misses) const {
-  return AtRisk(Walk(x, y, goals), goals, plan_misses);
+  return AtRisk(Walk(x, y, goals), goals, plan_misses) != Risk::kNone;
 }
 
-bool Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
-                    bool plan_misses) const {
-  if (goals.empty() || path.hit > 0 || !path.judged || path.met) return false;
+Rescue::Risk Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
+                            bool plan_misses) const {
+  if (goals.empty() || path.hit > 0 || !path.judged || path.met) return Risk::kNone;
+  Risk risk = Risk::kNear;
   for (const cost::GoalRegion& g : goals) {
     if (g.t_hi <= path.t_end || path.s_end > g.s_hi) continue;  // closed within it, or passed
     // Closing within a goal search's horizon while the path ends short of the region or beside
     // it: whether the rest of the way still gets there is the search's to tell.
     if (plan_misses && path.t_end > 0 && ClosingStep(g) > 0 &&
         RegionGap(g, path.s_end, path.d_end) > 0) {
+      risk = Risk::kFar;
       continue;
     }
-    return false;  // still ahead, and open, or reached where the path ends
+    return Risk::kNone;  // still ahead, and open, or reached where the path ends
   }
-  return true;
+  return risk;
 }
 
 void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,

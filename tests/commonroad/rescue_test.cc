@@ -60,6 +60,13 @@ KsState Ego(double x, double y, double v) {
   return s;
 }
 
+// The way's points from ego (Rescue::Points) in *x, *y, and its length in steps.
+int WaySteps(const Rescue& rescue, const KsState& ego, std::vector<double>* x,
+             std::vector<double>* y) {
+  rescue.Points(ego, x, y);
+  return static_cast<int>(x->size()) / static_cast<int>(std::lround(kStep / plan::kTickSeconds));
+}
+
 // Points every tick along +x at y from x0 at v, the first one tick on.
 void Straight(double x0, double y, double v, int n, std::vector<double>* x, std::vector<double>* y_out) {
   x->clear();
@@ -413,9 +420,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAClosingGoalMeetsItAndIsKeptWhileItStillDoes) 
   // The way ends at the step it meets the region: within its window (1.5-2.0 s, 15-20 steps),
   // in lane 0's part of it.
   std::vector<double> x, y;
-  rescue_.Points(ego, &x, &y);
-  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
-  const int steps = static_cast<int>(x.size()) / ticks;
+  const int steps = WaySteps(rescue_, ego, &x, &y);
   EXPECT_GE(steps, 15);
   EXPECT_LE(steps, 20);
   ASSERT_FALSE(y.empty());
@@ -442,26 +447,23 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalClosingPastTheHorizonIsSearchedUpToItsClo
   const KsState ego = Ego(50, kLane1, 20);
   ASSERT_TRUE(rescue_.Next(ego, {goal}, true, true).has_value());
   std::vector<double> x, y;
-  rescue_.Points(ego, &x, &y);
-  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
-  const int steps = static_cast<int>(x.size()) / ticks;
+  const int steps = WaySteps(rescue_, ego, &x, &y);
   EXPECT_GE(steps, 45);
   EXPECT_LE(steps, 50);
   ASSERT_FALSE(y.empty());
   EXPECT_GE(x.back(), 150.0);
+  EXPECT_GE(y.back(), -3.0);
+  EXPECT_LE(y.back(), -0.5);
   // Not far (the path misses it for good): the search keeps to the horizon, and finds none.
   rescue_.Drop();
   EXPECT_FALSE(rescue_.Next(ego, {goal}, true).has_value());
-  EXPECT_GE(y.back(), -3.0);
-  EXPECT_LE(y.back(), -0.5);
   // Closing at the last step a search may reach (an instant at 5.9 s, the window's slack of
   // 0.075 s added: step 60): found too, at step 59.
   goal.t_lo = 5.9;
   goal.t_hi = 5.9;
   rescue_.Drop();
   ASSERT_TRUE(rescue_.Next(ego, {goal}, true, true).has_value());
-  rescue_.Points(ego, &x, &y);
-  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 59);
+  EXPECT_EQ(WaySteps(rescue_, ego, &x, &y), 59);
   // A region passed long ago whose window never closes does not cut the search short.
   cost::GoalRegion passed = Lane0Goal(0.0, std::numeric_limits<double>::infinity(), 40);
   passed.s_lo = 20;
@@ -542,9 +544,7 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   ASSERT_TRUE(rescue_.Next(ego, {Lane0Goal(1.0, 1.5)}).has_value());
   EXPECT_EQ(rescue_.searches(), 1);
   std::vector<double> x, y;
-  rescue_.Points(ego, &x, &y);
-  const int ticks = static_cast<int>(std::lround(kStep / plan::kTickSeconds));
-  EXPECT_LE(static_cast<int>(x.size()) / ticks, 16);  // it ends where it meets the region
+  EXPECT_LE(WaySteps(rescue_, ego, &x, &y), 16);  // it ends where it meets the region
   ASSERT_FALSE(y.empty());
   EXPECT_GE(y.back(), -3.0);
   EXPECT_LE(y.back(), -0.5);
@@ -556,14 +556,12 @@ TEST_F(RescueOnAnEmptyRoad, AHitWithAGoalClosingWithinTheHorizonSearchesForAWayT
   blocked.Predict(with_car);
   ASSERT_TRUE(blocked.Next(ego, {Lane0Goal(1.0, 1.5, 72)}).has_value());
   EXPECT_GE(blocked.searches(), 2);
-  blocked.Points(ego, &x, &y);
-  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
+  EXPECT_EQ(WaySteps(blocked, ego, &x, &y), 40);
   // A window open past the horizon: a way that lasts the whole 4 s, as without a goal.
   Rescue open{*road_, VehicleParams(), kStep};
   open.Predict(t_);
   ASSERT_TRUE(open.Next(ego, {Lane0Goal(1.0, 10.0, 60.5)}).has_value());
-  open.Points(ego, &x, &y);
-  EXPECT_EQ(static_cast<int>(x.size()) / ticks, 40);
+  EXPECT_EQ(WaySteps(open, ego, &x, &y), 40);
 }
 
 TEST_F(RescueOnAnEmptyRoad, AWayToAGoalHoldsWhileItMeetsItAndContinueDrivesItsNextInput) {

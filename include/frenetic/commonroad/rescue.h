@@ -223,8 +223,10 @@ class Rescue {
   };
   PathCheck Walk(const std::vector<double>& x, const std::vector<double>& y,
                  const std::vector<cost::GoalRegion>& goals) const;
-  // GoalAtRisk of a walked path.
-  bool AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
+  // GoalAtRisk of a walked path: kNear when every region closes within the path or lies behind
+  // its end; kFar when some region is at risk only as the planner's plan is (its last case).
+  enum class Risk { kNone, kNear, kFar };
+  Risk AtRisk(const PathCheck& path, const std::vector<cost::GoalRegion>& goals,
               bool plan_misses) const;
   // The predicted cars at step k (1..goal_steps), laid out up to k on first use.
   const std::vector<Car>& CarsAt(int k) const;
