@@ -362,9 +362,8 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
     // the windows' close, with as many states in all as one over the whole horizon. A goal the
     // path misses may close past the horizon, within goal_steps: the search runs to its close.
     Drop();
-    const int goal_steps =
-        far ? FarGoalSteps(goals, road_.line().ToFrenet(ego.x, ego.y).s)
-            : GoalSteps(goals, options_.steps);
+    const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);  // once for every search
+    const int goal_steps = far ? FarGoalSteps(goals, fe0.s) : GoalSteps(goals, options_.steps);
     const auto search = [&](bool to_goal) {
       const int horizon = to_goal && goal_steps > options_.steps ? goal_steps : options_.steps;
       const int scale = to_goal && goal_steps > 0 ? std::max(1, options_.steps / goal_steps) : 1;
@@ -372,10 +371,10 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
       const auto states = [&](int n) {
         return horizon > options_.steps ? std::max(1, n * options_.steps / horizon) : n * scale;
       };
-      Search(ego, goals, states(options_.max_states), horizon, to_goal);
+      Search(ego, fe0, goals, states(options_.max_states), horizon, to_goal);
       // None at the usual size: once more with more states a step (a narrow way through).
       if (way_.empty() && options_.retry_states > options_.max_states) {
-        Search(ego, goals, states(options_.retry_states), horizon, to_goal);
+        Search(ego, fe0, goals, states(options_.retry_states), horizon, to_goal);
       }
     };
     if (goal_only || goal_steps > 0) search(true);
@@ -531,11 +530,11 @@ Rescue::Risk Rescue::AtRisk(const PathCheck& path, const std::vector<cost::GoalR
   return risk;
 }
 
-void Rescue::Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals,
-                    int max_states, int steps, bool goal_only) {
+void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
+                    const std::vector<cost::GoalRegion>& goals, int max_states, int steps,
+                    bool goal_only) {
   way_.clear();
   goal_way_ = false;
-  const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);
   if (goal_only && !MayMeetGoal(fe0.s, fe0.d, ego, 0.0, goals, steps)) return;  // out of reach
   ++searches_;
   const VehicleParams& p = vehicle_;

@@ -234,12 +234,13 @@ class Rescue {
   // the road's edges at both its ends; *at as Clear's).
   bool ClearOfCars(const KsState& s, int k) const;
   bool OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const;
-  // A way from `ego` that meets a goal region (the first found), else one that lasts the whole
-  // horizon, the nearest a goal region at its end (then the farthest along the road), in way_
-  // (empty when none), with at most max_states (>= 1) states a step.
-  // goal_only: none unless it meets a goal region.
-  void Search(const KsState& ego, const std::vector<cost::GoalRegion>& goals, int max_states,
-              int steps, bool goal_only = false);
+  // A way from `ego` (fe0: its point in the road's frame) that meets a goal region (the first
+  // found), else one that lasts the whole horizon of `steps`, the nearest a goal region at its
+  // end (then the farthest along the road), in way_ (empty when none), with at most max_states
+  // (>= 1) states a step. goal_only: none unless it meets a goal region.
+  void Search(const KsState& ego, const map::FrenetPoint& fe0,
+              const std::vector<cost::GoalRegion>& goals, int max_states, int steps,
+              bool goal_only = false);
   // Whether a state at (s, d) in the road's frame, t s from now, may still meet a goal region
   // within the horizon: one whose window is open at t or later, not passed, whose start lies
   // within reach at the vehicle's full acceleration before its window closes, and whose band
