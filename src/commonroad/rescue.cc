@@ -23,6 +23,17 @@ constexpr double kStrata[5] = {2.0, 2.0, 1.0, 0.5, 1e3};
 // away.
 constexpr double kWindowSlack = 0.75;
 
+// When region g's window has closed, s from now, its slack added.
+double WindowClose(const cost::GoalRegion& g, double dt) { return g.t_hi + kWindowSlack * dt; }
+
+// The step by which a window closing t_close s from now has closed, when that is before step
+// `steps`; -1 when it stays open to then. Compared before the conversion: a window without an
+// end (+inf) or NaN gives -1.
+int StepClosed(double t_close, int steps, double dt) {
+  if (!(t_close < steps * dt)) return -1;
+  return static_cast<int>(std::ceil(t_close / dt - 1e-9));
+}
+
 // A future's centre and heading at t s from its telemetry's instant, and the sample they come
 // from (*sample); false when the car is not there yet. Past its last sample it keeps its last
 // speed and heading.
@@ -387,18 +398,14 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
 int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) const {
   if (goals.empty()) return 0;
   double last = 0;
-  for (const cost::GoalRegion& g : goals) last = std::max(last, g.t_hi + kWindowSlack * dt_);
-  // Compared before the conversion: a window without an end (+inf) or NaN stays 0.
-  if (!(last < horizon * dt_)) return 0;
-  const int steps = static_cast<int>(std::ceil(last / dt_ - 1e-9));
+  for (const cost::GoalRegion& g : goals) last = std::max(last, WindowClose(g, dt_));
+  const int steps = StepClosed(last, horizon, dt_);
   return steps >= 1 && steps < horizon ? steps : 0;
 }
 
 int Rescue::ClosingStep(const cost::GoalRegion& g) const {
-  const double last = g.t_hi + kWindowSlack * dt_;
-  // Compared before the conversion: a window without an end (+inf) or NaN stays 0.
-  if (!(last < options_.goal_steps * dt_)) return 0;
-  return std::max(1, static_cast<int>(std::ceil(last / dt_ - 1e-9)));
+  const int steps = StepClosed(WindowClose(g, dt_), options_.goal_steps, dt_);
+  return steps < 0 ? 0 : std::max(1, steps);
 }
 
 int Rescue::FarGoalSteps(const std::vector<cost::GoalRegion>& goals, double s) const {
@@ -439,7 +446,7 @@ bool Rescue::MayMeetGoal(double s, double d, const KsState& state, double t,
   // The farthest along the road within `time` s, at full acceleration.
   const auto reach = [v, a](double time) { return v * time + 0.5 * a * time * time; };
   for (const cost::GoalRegion& g : goals) {
-    const double t_last = std::min(g.t_hi + kWindowSlack * dt_, horizon);
+    const double t_last = std::min(WindowClose(g, dt_), horizon);
     if (t > t_last || s > g.s_hi) continue;  // closed, or passed (the way never backs up)
     double time = t_last - t;
     if (s + reach(time) < g.s_lo) continue;
