@@ -551,6 +551,13 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   const double steer_max = share * std::min(std::abs(p.steering_min), std::abs(p.steering_max));
   const double rate = share * std::min(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
   const double rates[5] = {-rate, -0.5 * rate, 0.0, 0.5 * rate, rate};
+  // tan of each rate's change of the steering angle to a quarter step, mid-step and the end.
+  double tan_rq[5], tan_rm[5], tan_r1[5];
+  for (int j = 0; j < 5; ++j) {
+    tan_rq[j] = std::tan(rates[j] * 0.25 * dt_);
+    tan_rm[j] = std::tan(rates[j] * 0.5 * dt_);
+    tan_r1[j] = std::tan(rates[j] * dt_);
+  }
   for (std::vector<Node>& layer : layers_) layer.clear();
   KsState start = ego;
   start.time_step = 0;
@@ -577,10 +584,10 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
       const double rx = s.x - p.b * c0, ry = s.y - p.b * s0;
       const double tan0 = std::tan(s.steering_angle);
       double tan_q[5], tan_m[5], tan_1[5];
-      for (int j = 0; j < 5; ++j) {
-        tan_q[j] = std::tan(s.steering_angle + rates[j] * 0.25 * h);
-        tan_m[j] = std::tan(s.steering_angle + rates[j] * 0.5 * h);
-        tan_1[j] = std::tan(s.steering_angle + rates[j] * h);
+      for (int j = 0; j < 5; ++j) {  // tan(delta + b) from tan delta and the rate's tan b
+        tan_q[j] = (tan0 + tan_rq[j]) / (1 - tan0 * tan_rq[j]);
+        tan_m[j] = (tan0 + tan_rm[j]) / (1 - tan0 * tan_rm[j]);
+        tan_1[j] = (tan0 + tan_r1[j]) / (1 - tan0 * tan_r1[j]);
       }
       const double lateral0 = s.velocity * s.velocity * tan0 / wheelbase;
       for (const double a0 : accels) {
@@ -596,10 +603,15 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
           const double vq = s.velocity + a * 0.25 * h, vm = s.velocity + a * 0.5 * h;
           const double w0 = s.velocity * tan0 / wheelbase, wq = vq * tan_q[j] / wheelbase;
           const double wm = vm * tan_m[j] / wheelbase, w1 = v1 * tan_1[j] / wheelbase;
-          const double psi_m = s.orientation + h / 12 * (w0 + 4 * wq + wm);
-          const double psi_1 = s.orientation + h / 6 * (w0 + 4 * wm + w1);
-          const double cm = std::cos(psi_m), sm = std::sin(psi_m);
-          const double c1 = std::cos(psi_1), s1 = std::sin(psi_1);
+          // The turns to mid-step and to the step's end, and their headings' sines and
+          // cosines by the sum of angles from the parent's.
+          const double turn_m = h / 12 * (w0 + 4 * wq + wm), turn_1 = h / 6 * (w0 + 4 * wm + w1);
+          const double psi_1 = s.orientation + turn_1;
+          double sin_tm, cos_tm, sin_t1, cos_t1;
+          reach::SmallSinCos(turn_m, &sin_tm, &cos_tm);
+          reach::SmallSinCos(turn_1, &sin_t1, &cos_t1);
+          const double cm = c0 * cos_tm - s0 * sin_tm, sm = s0 * cos_tm + c0 * sin_tm;
+          const double c1 = c0 * cos_t1 - s0 * sin_t1, s1 = s0 * cos_t1 + c0 * sin_t1;
           KsState q;
           q.time_step = s.time_step + 1;
           q.orientation = psi_1;
