@@ -577,8 +577,8 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
       // The KS model over the step with the input held (the steering angle and the speed
       // linear in time): the yaw rate v tan(delta) / l by Simpson's rule, to mid-step and to
       // the end, and the rear axle's motion by Simpson's rule on those headings; within
-      // micrometres of SimulateKs (RK4) over a step, with two sines and cosines a child instead
-      // of a dozen trigonometric calls. The tangents depend on the rate alone.
+      // micrometres of SimulateKs (RK4) over a step. A parent's state costs one sine, cosine
+      // and tangent; its children none (the sum of angles, reach::SmallSinCos for the turn).
       const double h = dt_;
       const double c0 = std::cos(s.orientation), s0 = std::sin(s.orientation);
       const double rx = s.x - p.b * c0, ry = s.y - p.b * s0;

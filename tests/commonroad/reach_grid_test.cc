@@ -79,7 +79,7 @@ TEST(FloorToIntTest, FloorAsAnInteger) {
 
 TEST(SmallSinCosTest, WithinAFewUlpsOfLibmAndLibmOutsideItsRange) {
   // Across the series' range, both signs and its edge: within 2e-16 of std::sin and std::cos
-  // (a Taylor term left out would show as 1e-15 or more at 0.25).
+  // (the sine's x^11 term left out would show as 6e-15 at 0.25, the cosine's x^10 as 3e-13).
   for (int i = -2500; i <= 2500; ++i) {
     const double x = i * 1e-4;
     double s = 0, c = 0;
