@@ -590,18 +590,19 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
         tan_1[j] = (tan0 + tan_r1[j]) / (1 - tan0 * tan_r1[j]);
       }
       const double lateral0 = s.velocity * s.velocity * tan0 / wheelbase;
+      const double w0 = s.velocity * tan0 / wheelbase;  // the yaw rate at the step's start
       for (const double a0 : accels) {
         const double a = std::max(a0, floor);
         const double v1 = std::max(0.0, s.velocity + a * h);
         if (a * a + lateral0 * lateral0 > a_max * a_max) continue;
+        const double vq = s.velocity + a * 0.25 * h, vm = s.velocity + a * 0.5 * h;
         for (int j = 0; j < 5; ++j) {
           const double r = rates[j];
           const double delta1 = s.steering_angle + r * h;
           if (std::abs(delta1) > steer_max) continue;
           const double lateral1 = v1 * v1 * tan_1[j] / wheelbase;
           if (a * a + lateral1 * lateral1 > a_max * a_max) continue;
-          const double vq = s.velocity + a * 0.25 * h, vm = s.velocity + a * 0.5 * h;
-          const double w0 = s.velocity * tan0 / wheelbase, wq = vq * tan_q[j] / wheelbase;
+          const double wq = vq * tan_q[j] / wheelbase;
           const double wm = vm * tan_m[j] / wheelbase, w1 = v1 * tan_1[j] / wheelbase;
           // The turns to mid-step and to the step's end, and their headings' sines and
           // cosines by the sum of angles from the parent's.
