@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "frenetic/commonroad/geometry.h"
+#include "frenetic/commonroad/path_time.h"
 #include "frenetic/commonroad/reach_grid.h"
 #include "frenetic/plan/planner.h"
 
@@ -64,19 +65,23 @@ double RegionGap(const cost::GoalRegion& g, double s, double d) {
   return std::hypot(ds, dd);
 }
 
-// The point of a path (points every plan::kTickSeconds, the first one tick on) at step k of dt
-// s, its heading (from the points either side) and speed; false when the path ends before it.
+// The point of a path (points every plan::kTickSeconds, the first one tick on, or `phase` s
+// later) at t s, linear between points (path_time.h), its heading (from the points either
+// side) and speed; false when the path ends before it.
 struct PathPoint {
   double x, y, heading, speed;
 };
-bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, int k, int ticks,
-                 PathPoint* p) {
+bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, double t,
+                 double phase, PathPoint* p) {
   const int n = static_cast<int>(std::min(x.size(), y.size()));
-  const int j = k * ticks - 1;
-  if (j + 1 >= n) return false;
-  const int a = std::max(0, j - 1);
-  const double dx = x[j + 1] - x[a], dy = y[j + 1] - y[a];
-  *p = {x[j], y[j], std::atan2(dy, dx), std::hypot(dx, dy) / ((j + 1 - a) * plan::kTickSeconds)};
+  const PathIndex in = PathIndexAt(t - phase);
+  const int j = in.lo, between = in.frac > 0 ? 1 : 0;
+  if (j + 1 + between >= n) return false;
+  const int a = std::max(0, j - 1), b = j + 1 + between;
+  const double dx = x[b] - x[a], dy = y[b] - y[a];
+  const double px = between ? x[j] + in.frac * (x[j + 1] - x[j]) : x[j];
+  const double py = between ? y[j] + in.frac * (y[j + 1] - y[j]) : y[j];
+  *p = {px, py, std::atan2(dy, dx), std::hypot(dx, dy) / ((b - a) * plan::kTickSeconds)};
   return true;
 }
 
@@ -84,7 +89,7 @@ bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, int
 
 double Rescue::GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals) const {
   // Regions whose window is still open at the way's end (all: none is).
-  const double t_end = static_cast<double>(options_.steps) * dt_;
+  const double t_end = static_cast<double>(steps_) * dt_;
   double best = std::numeric_limits<double>::infinity();
   for (int pass = 0; pass < 2 && !std::isfinite(best); ++pass) {
     for (const cost::GoalRegion& g : goals) {
@@ -98,12 +103,19 @@ double Rescue::GoalGap(const Node& n, const std::vector<cost::GoalRegion>& goals
 Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
                const RescueOptions& options)
     : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
-  options_.steps = std::max(options_.steps, 1);
-  options_.goal_steps = std::clamp(options_.goal_steps, options_.steps, 10 * options_.steps);
+  const double step = dt > 0 ? dt : 0.1;
+  const auto steps_in = [step](double seconds) {  // at least one, at most 2000
+    return std::isfinite(seconds) ? static_cast<int>(std::lround(std::clamp(seconds / step, 1.0, 2000.0)))
+                                  : 1;
+  };
+  // A search layer's scenario steps: about 0.1 s (1 at 0.1 s and above, 3 at 0.04 s).
+  sub_ = std::max(1, static_cast<int>(std::lround(std::min(0.1 / step, 100.0))));
+  steps_ = steps_in(options_.horizon);
+  goal_steps_ = std::clamp(steps_in(options_.goal_horizon), steps_, 10 * steps_);
   options_.max_states = std::max(options_.max_states, 1);
   options_.retry_states = std::max(options_.retry_states, 0);
-  cars_.resize(options_.goal_steps);
-  layers_.resize(options_.goal_steps + 1);
+  cars_.resize(goal_steps_);
+  layers_.resize(goal_steps_ + 1);
   half_length_ = 0.5 * vehicle_.length + options_.ego_margin;
   half_width_ = 0.5 * vehicle_.width + options_.ego_margin;
   ego_radius_ = std::hypot(half_length_, half_width_);
@@ -120,7 +132,8 @@ RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
   } else if (const Risk risk = AtRisk(path, t.goals, plan_misses); risk != Risk::kNone) {
     r.why = RescueStep::Why::kGoal;
     // At risk only as the planner's plan is (the window closes past the path): after a search
-    // that found no way the next waits a cycle, after two or more in a row two cycles.
+    // that found no way the next waits a cycle, after two or more in a row two cycles (cycles
+    // of 0.1 s: as many steps as a search layer holds at a shorter step).
     const bool far = risk == Risk::kFar;
     if (far && !goal_way_ && far_wait_ > 0) {
       --far_wait_;
@@ -130,7 +143,7 @@ RescueStep Rescue::Check(const plan::Telemetry& t, const std::vector<double>& x,
     r.input = Next(ego, t.goals, true, far);
     if (!r.input) {
       Drop();
-      if (far) far_wait_ = std::min(++far_fails_, 2);
+      if (far) far_wait_ = std::min(++far_fails_, 2) * sub_;
     } else {
       far_fails_ = far_wait_ = 0;
     }
@@ -281,12 +294,11 @@ bool Rescue::ClearOfCars(const KsState& s, int k) const {
 
 Rescue::PathCheck Rescue::Walk(const std::vector<double>& x, const std::vector<double>& y,
                                const std::vector<cost::GoalRegion>& goals) const {
-  const int ticks = plan::TicksIn(dt_);
   PathCheck c;
   PathPoint p;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
   map::FrenetPoint at{};
-  for (int k = 1; k <= options_.steps && PathPointAt(x, y, k, ticks, &p); ++k) {
+  for (int k = 1; k <= steps_ && PathPointAt(x, y, k * dt_, path_phase_, &p); ++k) {
     KsState st;
     st.x = p.x;
     st.y = p.y;
@@ -344,7 +356,7 @@ RescueStep Rescue::Answer(const plan::Telemetry& t, const std::vector<double>& x
 int Rescue::Lasts(const KsState& ego, const std::vector<cost::GoalRegion>* goals, int from) {
   KsState s = ego;
   double s_hint = std::numeric_limits<double>::quiet_NaN();
-  const int n = std::min(static_cast<int>(way_.size()) - from, options_.goal_steps);
+  const int n = std::min(static_cast<int>(way_.size()) - from, goal_steps_);
   map::FrenetPoint at{};
   for (int k = 1; k <= n; ++k) {
     s = SimulateKs(s, way_[from + k - 1], dt_, vehicle_, 1);
@@ -366,7 +378,7 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
   const int rest = static_cast<int>(way_.size());
   // A way to a goal is kept while it still meets it; another while it lasts long enough.
   const bool keep = goal_way_ ? Lasts(ego, &goals) == rest
-                              : !goal_only && rest >= (options_.steps + 1) / 2 && Lasts(ego) == rest;
+                              : !goal_only && rest >= (steps_ + 1) / 2 && Lasts(ego) == rest;
   if (!keep) {
     // A way to a goal whose every window closes within the horizon first, also when the path
     // hits a car (a way that only lasts may leave the goal out of reach): a search that ends at
@@ -374,13 +386,13 @@ std::optional<KsInput> Rescue::Next(const KsState& ego,
     // path misses may close past the horizon, within goal_steps: the search runs to its close.
     Drop();
     const map::FrenetPoint fe0 = road_.line().ToFrenet(ego.x, ego.y);  // once for every search
-    const int goal_steps = far ? FarGoalSteps(goals, fe0.s) : GoalSteps(goals, options_.steps);
+    const int goal_steps = far ? FarGoalSteps(goals, fe0.s) : GoalSteps(goals, steps_);
     const auto search = [&](bool to_goal) {
-      const int horizon = to_goal && goal_steps > options_.steps ? goal_steps : options_.steps;
-      const int scale = to_goal && goal_steps > 0 ? std::max(1, options_.steps / goal_steps) : 1;
+      const int horizon = to_goal && goal_steps > steps_ ? goal_steps : steps_;
+      const int scale = to_goal && goal_steps > 0 ? std::max(1, steps_ / goal_steps) : 1;
       // Past the horizon, fewer a step: as many in all as over the horizon.
       const auto states = [&](int n) {
-        return horizon > options_.steps ? std::max(1, n * options_.steps / horizon) : n * scale;
+        return horizon > steps_ ? std::max(1, n * steps_ / horizon) : n * scale;
       };
       Search(ego, fe0, goals, states(options_.max_states), horizon, to_goal);
       // None at the usual size: once more with more states a step (a narrow way through).
@@ -404,7 +416,7 @@ int Rescue::GoalSteps(const std::vector<cost::GoalRegion>& goals, int horizon) c
 }
 
 int Rescue::ClosingStep(const cost::GoalRegion& g) const {
-  const int steps = StepClosed(WindowClose(g, dt_), options_.goal_steps, dt_);
+  const int steps = StepClosed(WindowClose(g, dt_), goal_steps_, dt_);
   return steps < 0 ? 0 : std::max(1, steps);
 }
 
@@ -416,7 +428,7 @@ int Rescue::FarGoalSteps(const std::vector<cost::GoalRegion>& goals, double s) c
     if (k == 0) return 0;
     steps = std::max(steps, k);
   }
-  return std::min(steps, options_.goal_steps);
+  return std::min(steps, goal_steps_);
 }
 
 double Rescue::GoalDistance(double s, double d, double v, double orientation, double t,
@@ -551,13 +563,12 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   const double steer_max = share * std::min(std::abs(p.steering_min), std::abs(p.steering_max));
   const double rate = share * std::min(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
   const double rates[5] = {-rate, -0.5 * rate, 0.0, 0.5 * rate, rate};
-  // tan of each rate's change of the steering angle to a quarter step, mid-step and the end.
-  double tan_rq[5], tan_rm[5], tan_r1[5];
-  for (int j = 0; j < 5; ++j) {
-    tan_rq[j] = std::tan(rates[j] * 0.25 * dt_);
-    tan_rm[j] = std::tan(rates[j] * 0.5 * dt_);
-    tan_r1[j] = std::tan(rates[j] * dt_);
-  }
+  // A layer of the search holds its input for sub_ scenario steps (the last one for what is
+  // left of `steps`): about 0.1 s whatever the file's step size.
+  const int layers = (steps + sub_ - 1) / sub_;
+  // tan of each rate's change of the steering angle to a quarter layer, mid-layer and its end.
+  double tan_rq[5] = {}, tan_rm[5] = {}, tan_r1[5] = {};
+  double h = 0;
   for (std::vector<Node>& layer : layers_) layer.clear();
   KsState start = ego;
   start.time_step = 0;
@@ -565,21 +576,30 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   // Stratum's speed across the start heading, from each child's sine and cosine of its heading.
   const double cos_h0 = std::cos(ego.orientation), sin_h0 = std::sin(ego.orientation);
   int depth = 0, met = -1;
-  for (int k = 1; k <= steps; ++k) {
+  for (int k = 1; k <= layers; ++k) {
+    const int k_end = std::min(k * sub_, steps);  // the layer's last scenario step
+    const int n_sub = k_end - (k - 1) * sub_;
+    if (n_sub * dt_ != h) {
+      h = n_sub * dt_;
+      for (int j = 0; j < 5; ++j) {
+        tan_rq[j] = std::tan(rates[j] * 0.25 * h);
+        tan_rm[j] = std::tan(rates[j] * 0.5 * h);
+        tan_r1[j] = std::tan(rates[j] * h);
+      }
+    }
     next_.clear();
     seen_.Clear();
     const std::vector<Node>& now = layers_[k - 1];
     for (int i = 0; i < static_cast<int>(now.size()); ++i) {
       const KsState& s = now[i].state;
       const double up = share * p.MaxAcceleration(s.velocity);
-      const double floor = -s.velocity / dt_;  // never backwards
+      const double floor = -s.velocity / h;  // never backwards
       const double accels[5] = {-a_max, -0.5 * a_max, 0.0, 0.5 * up, up};
       // The KS model over the step with the input held (the steering angle and the speed
       // linear in time): the yaw rate v tan(delta) / l by Simpson's rule, to mid-step and to
       // the end, and the rear axle's motion by Simpson's rule on those headings; within
       // micrometres of SimulateKs (RK4) over a step. A parent's state costs one sine, cosine
       // and tangent; its children none (the sum of angles, reach::SmallSinCos for the turn).
-      const double h = dt_;
       const double c0 = std::cos(s.orientation), s0 = std::sin(s.orientation);
       const double rx = s.x - p.b * c0, ry = s.y - p.b * s0;
       const double tan0 = std::tan(s.steering_angle);
@@ -614,7 +634,7 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
           const double cm = c0 * cos_tm - s0 * sin_tm, sm = s0 * cos_tm + c0 * sin_tm;
           const double c1 = c0 * cos_t1 - s0 * sin_t1, s1 = s0 * cos_t1 + c0 * sin_t1;
           KsState q;
-          q.time_step = s.time_step + 1;
+          q.time_step = k_end;
           q.orientation = psi_1;
           q.steering_angle = delta1;
           q.velocity = v1;
@@ -639,20 +659,25 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
       Node node = next_[rank_[v].second].second;
       map::FrenetPoint at;
-      if (Clear(node.state, k, node.s, &at)) {
+      if (n_sub > 1 && !ClearBetween(now[node.parent].state, node.input, (k - 1) * sub_, n_sub,
+                                     node.s)) {
+        continue;
+      }
+      if (Clear(node.state, k_end, node.s, &at)) {
         node.s = at.s;
         node.d = at.d;
-        if (goal_only && !MayMeetGoal(node.s, node.d, node.state, k * dt_, goals, steps)) continue;
+        const double t = k_end * dt_;
+        if (goal_only && !MayMeetGoal(node.s, node.d, node.state, t, goals, steps)) continue;
         layer.push_back(node);
         if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
-                                               k * dt_, goals) == 0) met = static_cast<int>(layer.size()) - 1;
+                                               t, goals) == 0) met = static_cast<int>(layer.size()) - 1;
       }
     }
     if (layer.empty()) break;
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && (goal_only || depth < steps)) return;
+  if (met < 0 && (goal_only || std::min(depth * sub_, steps) < steps)) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];
@@ -668,12 +693,25 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
     }
   }
   goal_way_ = met >= 0;
-  way_.resize(depth);
+  // Each layer's input for each scenario step it holds.
+  way_.resize(std::min(depth * sub_, steps));
   for (int k = depth, i = best; k >= 1; --k) {
     const Node& node = layers_[k][i];
-    way_[k - 1] = node.input;
+    for (int q = (k - 1) * sub_; q < std::min(k * sub_, steps); ++q) way_[q] = node.input;
     i = node.parent;
   }
+}
+
+bool Rescue::ClearBetween(const KsState& from, const KsInput& input, int k0, int n,
+                          double s_hint) const {
+  KsState q = from;
+  map::FrenetPoint at;
+  for (int j = 1; j < n; ++j) {
+    q = SimulateKs(q, input, dt_, vehicle_, 1);
+    if (!Clear(q, k0 + j, s_hint, &at)) return false;
+    s_hint = at.s;
+  }
+  return true;
 }
 
 std::uint64_t Rescue::Stratum(const KsState& q, double heading0) {
@@ -689,15 +727,36 @@ std::uint64_t Rescue::StratumAcross(const KsState& q, double across) {
 void Rescue::Points(const KsState& ego, std::vector<double>* x, std::vector<double>* y) const {
   x->clear();
   y->clear();
-  const int ticks = plan::TicksIn(dt_);
-  const double h = dt_ / ticks;
+  const double tick = plan::kTickSeconds;
+  const double per_step = dt_ / tick;
   KsState s = ego;
-  for (const KsInput& u : way_) {
-    for (int i = 0; i < ticks; ++i) {
-      s = SimulateKs(s, u, h, vehicle_, 1);
-      x->push_back(s.x);
-      y->push_back(s.y);
+  if (std::abs(per_step - std::round(per_step)) < 1e-9) {  // whole ticks a step
+    const int ticks = plan::TicksIn(dt_);
+    const double h = dt_ / ticks;
+    for (const KsInput& u : way_) {
+      for (int i = 0; i < ticks; ++i) {
+        s = SimulateKs(s, u, h, vehicle_, 1);
+        x->push_back(s.x);
+        y->push_back(s.y);
+      }
     }
+    return;
+  }
+  // A point every tick; a step's input changes between two of them.
+  const double total = static_cast<double>(way_.size()) * dt_;
+  double t = 0;
+  std::size_t u = 0;
+  for (int i = 1; i * tick <= total + 1e-9 && u < way_.size(); ++i) {
+    const double target = std::min(i * tick, total);
+    while (t < target - 1e-12 && u < way_.size()) {
+      const double boundary = static_cast<double>(u + 1) * dt_;
+      const double to = std::min(target, boundary);
+      s = SimulateKs(s, way_[u], to - t, vehicle_, 1);
+      t = to;
+      if (t >= boundary - 1e-12) ++u;
+    }
+    x->push_back(s.x);
+    y->push_back(s.y);
   }
 }
 

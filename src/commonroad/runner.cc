@@ -13,6 +13,7 @@
 #include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/goal_frenet.h"
 #include "frenetic/commonroad/observation.h"
+#include "frenetic/commonroad/path_time.h"
 #include "frenetic/commonroad/road_builder.h"
 #include "frenetic/cost/goal_region.h"
 #include "frenetic/plan/telemetry.h"
@@ -47,7 +48,8 @@ int EndStep(const Scenario& sc, const PlanningProblem& p) {
     }
     end = std::max(end, last);
   }
-  return std::min(end, p.initial.time_step + kMaxSteps);
+  const int most = static_cast<int>(std::lround(std::clamp(kMaxSeconds / sc.dt, 1.0, 1e6)));
+  return std::min(end, p.initial.time_step + most);
 }
 
 // Signed Menger curvature of three points (left positive).
@@ -67,25 +69,29 @@ bool PlanMissesGoal(const plan::PlanResult& res) {
 }
 
 KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
-                   double dt, const VehicleParams& vp) {
+                   double dt, const VehicleParams& vp, double phase) {
   constexpr double kHeadingGain = 0.5;  // of the heading error
   constexpr double kCrossGain = 1.0;    // 1/s: Stanley's k
   constexpr double kAlongGain = 1.0;    // 1/s: speed per m of along-track error
   constexpr double kMinSpan = 0.5;      // m: the shortest chord the path's direction is taken on
-  const int ticks = plan::TicksIn(dt);
+  // The point dt in: point j, or between it and the next (a step that is not a whole number
+  // of ticks, or a path whose points lie a phase off the ticks).
+  const PathIndex in = PathIndexAt(dt - phase);
+  const int j = in.lo, between = in.frac > 0 ? 1 : 0;
   const int n = static_cast<int>(std::min(x.size(), y.size()));
-  if (n < ticks + 2) return SimulateKs(ego, {0, 0}, dt, vp);
-  const int j = ticks - 1;  // the point dt in
+  if (n < j + 3 + between) return SimulateKs(ego, {0, 0}, dt, vp);
+  const double xj = between ? x[j] + in.frac * (x[j + 1] - x[j]) : x[j];
+  const double yj = between ? y[j] + in.frac * (y[j + 1] - y[j]) : y[j];
   // The neighbours the heading and curvature are measured over: the next points, or farther
   // ones at a crawl (points millimetres apart give no direction).
-  int a = std::max(0, j - 1), b = j + 1;
+  int a = std::max(0, j - 1), b = j + 1 + between;
   while (std::hypot(x[b] - x[a], y[b] - y[a]) < kMinSpan && (a > 0 || b + 1 < n)) {
     if (a > 0) --a;
     if (b + 1 < n) ++b;
   }
   const double theta = std::atan2(y[b] - y[a], x[b] - x[a]);
   const double speed = std::hypot(x[b] - x[a], y[b] - y[a]) / ((b - a) * plan::kTickSeconds);
-  const double kappa = Curvature(x[a], y[a], x[j], y[j], x[b], y[b]);
+  const double kappa = Curvature(x[a], y[a], xj, yj, x[b], y[b]);
   const double l_wb = vp.Wheelbase();
   const double delta_ff = std::atan(l_wb * kappa);
   // The centre moves at the slip angle beta off the vehicle's axis.
@@ -106,7 +112,7 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
   const KsState pred = SimulateKs(ego, ff, dt, vp);
   // Errors of the predicted state against the path's point: cross-track (left positive) and
   // along-track (ahead positive) in the path's direction, and the heading's.
-  const double ex = x[j] - pred.x, ey = y[j] - pred.y;
+  const double ex = xj - pred.x, ey = yj - pred.y;
   const double c = std::cos(theta), sn = std::sin(theta);
   const double along = ex * c + ey * sn, cross = -(-ex * sn + ey * c);
   const double heading_err = WrapAngle(psi_ff - pred.orientation);
@@ -256,6 +262,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     run.trajectory.push_back(ego);
     plan::Telemetry t;
     std::vector<double> path_x, path_y;
+    double phase = 0;  // s: path_x[0] lies this much later than a tick on (path_time.h)
     std::optional<Rescue> rescue;
     if (options.rescue) {
       RescueOptions rescue_options;
@@ -310,6 +317,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       if (rescue) {
         const auto p0 = std::chrono::steady_clock::now();
         rescue->Predict(t);
+        rescue->SetPathPhase(phase);
         way_holds = rescue->Holds(ego, t.goals);
         holds_ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0)
@@ -377,24 +385,28 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       cyc.candidates = res.summary.candidates_generated;
       cyc.checked = res.summary.candidates_checked;
       cyc.status = res.status;
-      // The ego drives dt along the plan.
-      const int ticks = plan::TicksIn(dt);
+      // The ego drives dt along the plan; the planner gets the whole points left over (their
+      // phase off the ticks carried to the next step: path_time.h).
       if (rescue_input) {
         // The way's input, exactly (the search simulated it); the planner gets the rest of the
         // way as its previous path.
         cyc.rescued = true;
         rescue->Points(ego, &path_x, &path_y);
-        path_x.erase(path_x.begin(), path_x.begin() + std::min<size_t>(ticks, path_x.size()));
-        path_y.erase(path_y.begin(), path_y.begin() + std::min<size_t>(ticks, path_y.size()));
+        phase = 0;  // the way's points start at the ego
+        const size_t used = static_cast<size_t>(TicksConsumed(dt, &phase));
+        path_x.erase(path_x.begin(), path_x.begin() + std::min(used, path_x.size()));
+        path_y.erase(path_y.begin(), path_y.begin() + std::min(used, path_y.size()));
         ego = SimulateKs(ego, *rescue_input, dt, vp);
         ego.time_step = k + 1;
       } else {
-        ego = FollowPath(ego, res.x, res.y, dt, vp);
+        ego = FollowPath(ego, res.x, res.y, dt, vp, phase);
         ego.time_step = k + 1;
-        const size_t j = std::min<size_t>(ticks - 1, res.x.empty() ? 0 : res.x.size() - 1);
+        const size_t used = static_cast<size_t>(TicksConsumed(dt, &phase));
+        const size_t j = std::min<size_t>(std::max<size_t>(used, 1) - 1,
+                                          res.x.empty() ? 0 : res.x.size() - 1);
         if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);
-        path_x.assign(res.x.begin() + std::min<size_t>(ticks, res.x.size()), res.x.end());
-        path_y.assign(res.y.begin() + std::min<size_t>(ticks, res.y.size()), res.y.end());
+        path_x.assign(res.x.begin() + std::min(used, res.x.size()), res.x.end());
+        path_y.assign(res.y.begin() + std::min(used, res.y.size()), res.y.end());
       }
       run.trajectory.push_back(ego);
       // A collision or a box off the road fails the problem whatever follows: the run ends.

@@ -303,6 +303,46 @@ TEST(RescueTest, FindsAWayPastACarFromBehindClearOfItAndOnTheRoad) {
   EXPECT_EQ(rescue.searches(), searches);
 }
 
+// A file's own step size (0.04 s from a 25 Hz recording, 0.05 s, 0.2 s) changes neither how far
+// the rescue looks (4 s, in as many steps as that takes) nor where on a path a step lies (between
+// two points when the step is not a whole number of ticks), nor the way it finds.
+TEST(RescueTest, AtAnyStepSizeTheRescueLooksFourSecondsAheadAndFindsAWay) {
+  const auto road = TwoLanes();
+  const VehicleParams vp;
+  for (const double dt : {0.1, 0.05, 0.04, 0.2}) {
+    SCOPED_TRACE(dt);
+    Rescue rescue(*road, vp, dt);
+    // A stopped car that a path at 20 m/s from x 10 meets at 3.5 s (its front 2.3 m, the car's
+    // square 2.25 m half side): at the step holding 3.5 s, whatever the step's size.
+    rescue.Predict(Scene(10, {Row(1, 10 + 20 * 3.5 + 4.55, kLane0, 0.0)}));
+    std::vector<double> x, y;
+    Straight(10, kLane0, 20, 300, &x, &y);
+    const int hit = rescue.PathHit(x, y);
+    ASSERT_GT(hit, 0);
+    EXPECT_NEAR(hit * dt, 3.5, dt + 1e-9);
+    // The car from behind of FindsAWayPastACarFromBehindClearOfItAndOnTheRoad: a way of 4 s,
+    // a point every tick, clear of the car at every step.
+    rescue.Predict(Scene(50, {Row(1, 20, kLane0, 40.0)}));
+    Straight(50, kLane0, 20, 300, &x, &y);
+    ASSERT_GT(rescue.PathHit(x, y), 0);
+    const KsState ego = Ego(50, kLane0, 20);
+    ASSERT_TRUE(rescue.Next(ego, {}).has_value());
+    rescue.Points(ego, &x, &y);
+    EXPECT_NEAR(static_cast<double>(x.size()) * plan::kTickSeconds, 4.0, 0.03);
+    for (int k = 1; k * dt <= 4.0 + 1e-9; ++k) {
+      const double ticks = k * dt / plan::kTickSeconds;
+      if (std::abs(ticks - std::round(ticks)) > 1e-9) continue;  // a step between two points
+      const std::size_t j = static_cast<std::size_t>(std::lround(ticks)) - 1;
+      ASSERT_LT(j, x.size());
+      const double car_x = 20 + 40.0 * k * dt;
+      const bool apart = std::abs(x[j] - car_x) > 4.5 || std::abs(y[j] - kLane0) > 1.8 + 0.05;
+      EXPECT_TRUE(apart) << "t " << k * dt << " ego (" << x[j] << ", " << y[j] << ") car x " << car_x;
+      EXPECT_LT(y[j], -0.8) << "t " << k * dt;
+      EXPECT_GT(y[j], -6.2) << "t " << k * dt;
+    }
+  }
+}
+
 // A rescue on the two lanes with no car at all: every way lasts, the goals decide.
 class RescueOnAnEmptyRoad : public ::testing::Test {
  protected:
@@ -404,7 +444,7 @@ TEST(RescueTest, AGoalClosingPastThePathIsAtRiskWhenThePlanMissesItAndThePathEnd
   // Closing past goal_steps (7 s), or a smaller goal_steps: later cycles may still meet it.
   EXPECT_FALSE(rescue.GoalAtRisk(lane1_x, lane1_y, {Lane0Goal(6.5, 7.0)}, true));
   RescueOptions four;
-  four.goal_steps = 40;
+  four.goal_horizon = 4.0;
   Rescue rescue4(*road, VehicleParams(), kStep, four);
   EXPECT_FALSE(rescue4.GoalAtRisk(lane1_x, lane1_y, {closing}, true));
   // No path to judge: nothing at risk.
@@ -473,7 +513,7 @@ TEST_F(RescueOnAnEmptyRoad, AWayToAGoalClosingPastTheHorizonIsSearchedUpToItsClo
   goal.s_lo = 150;
   // With a search no longer than the horizon, none.
   RescueOptions four;
-  four.goal_steps = 40;
+  four.goal_horizon = 4.0;
   Rescue rescue4(*road_, VehicleParams(), kStep, four);
   rescue4.Predict(t_);
   EXPECT_FALSE(rescue4.Next(ego, {goal}, true, true).has_value());

@@ -139,6 +139,44 @@ TEST(RunnerTest, ChangesLanesPastASlowCarIntoAGoalLanelet) {
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
 }
 
+// A file's own step size: the same scene in seconds at 0.1 s, at 0.05 s (2.5 of the planner's
+// 0.02 s ticks: the ego aims between two points and the path left over keeps its phase) and at
+// 0.04 s. Each is solved, at about the same time, at about the same speeds: a step that is not
+// a whole number of ticks neither speeds the ego up nor slows it down.
+TEST(RunnerTest, AFilesOwnStepSizeDrivesTheSameSeconds) {
+  struct Drove {
+    double goal_t = -1;
+    std::vector<double> v;  // at 0.5 s, 1 s, ... 3 s
+  };
+  const auto drive = [](double dt) {
+    ScenarioXml xml("ZAM_Test-1_1_T-1", dt);
+    std::vector<StateXml> slow;
+    const int n = static_cast<int>(std::lround(8.0 / dt));
+    for (int k = 0; k <= n; ++k) slow.push_back({k, {40 + 8.0 * dt * k, -1.75}, 0.0, 8.0});
+    const int lo = static_cast<int>(std::lround(4.0 / dt)), hi = static_cast<int>(std::lround(8.0 / dt));
+    AddStraightRoad(xml, 500)
+        .DynamicObstacle(5, 4.8, 2, slow)
+        .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, lo, hi)});
+    const ProblemRun p = RunOne(xml);
+    EXPECT_TRUE(p.verdict.solved) << dt << ": " << p.verdict.Summary();
+    Drove d;
+    if (p.verdict.goal_step) d.goal_t = *p.verdict.goal_step * dt;
+    for (int i = 1; i <= 6; ++i) {
+      const std::size_t k = static_cast<std::size_t>(std::lround(0.5 * i / dt));
+      d.v.push_back(k < p.trajectory.size() ? p.trajectory[k].velocity : -1);
+    }
+    return d;
+  };
+  const Drove usual = drive(0.1);
+  for (const double dt : {0.05, 0.04}) {
+    const Drove other = drive(dt);
+    EXPECT_NEAR(other.goal_t, usual.goal_t, 0.3) << dt;
+    for (std::size_t i = 0; i < usual.v.size(); ++i) {
+      EXPECT_NEAR(other.v[i], usual.v[i], 1.0) << dt << " at " << 0.5 * (i + 1) << " s";
+    }
+  }
+}
+
 TEST(RunnerTest, PassesACarParkedHalfInTheLane) {
   // A car parked across the right lane's right half, 60 m ahead; a goal past it, time only in
   // the ego's lane, which the other lane's traffic leaves no room to leave.
@@ -673,6 +711,89 @@ TEST(RunnerTest, EverySharedHighDProblemWithASolutionIsSolved) {
   EXPECT_GE(t.problems, 30);
   EXPECT_LE(t.infeasible, 3);
   EXPECT_EQ(t.solved + t.infeasible, t.problems) << t.unsolved;
+}
+
+// The scenario recorded at another step size: every trajectory obstacle's states at the steps of
+// `dt` (linear between the recorded ones, the heading the short way round), the goals' time
+// windows in those steps (the whole steps within them), the problems' initial steps likewise.
+Scenario AtStepSize(Scenario sc, double dt) {
+  const double r = dt / sc.dt;
+  const auto lerp = [](const std::optional<double>& a, const std::optional<double>& b, double w) {
+    return a && b ? std::optional<double>(*a + w * (*b - *a)) : a;
+  };
+  for (Obstacle& o : sc.obstacles) {
+    o.dt = dt;
+    if (o.role != ObstacleRole::kDynamic || o.prediction != ObstaclePrediction::kTrajectory) continue;
+    std::vector<State> old{o.initial};
+    old.insert(old.end(), o.trajectory.begin(), o.trajectory.end());
+    const int a0 = old.front().time_step, a1 = old.back().time_step;
+    std::vector<State> now;
+    for (int j = static_cast<int>(std::ceil(a0 / r - 1e-9)); j * r <= a1 + 1e-9; ++j) {
+      const double u = j * r - a0;
+      const int i = std::min(static_cast<int>(std::floor(u + 1e-9)), a1 - a0);
+      const double w = i < a1 - a0 ? u - i : 0.0;
+      const State& p = old[i];
+      const State& q = old[std::min(i + 1, a1 - a0)];
+      State st = p;
+      st.time_step = j;
+      st.position = p.position + w * (q.position - p.position);
+      st.velocity = lerp(p.velocity, q.velocity, w);
+      st.acceleration = lerp(p.acceleration, q.acceleration, w);
+      if (p.orientation && q.orientation) {
+        st.orientation = *p.orientation + w * WrapAngle(*q.orientation - *p.orientation);
+      }
+      now.push_back(st);
+    }
+    if (now.empty()) continue;
+    o.initial = now.front();
+    o.trajectory.assign(now.begin() + 1, now.end());
+  }
+  for (PlanningProblem& p : sc.problems) {
+    p.initial.time_step = static_cast<int>(std::lround(p.initial.time_step / r));
+    for (GoalState& g : p.goals) {
+      if (!g.time) continue;
+      const int lo = static_cast<int>(std::ceil(g.time->start / r - 1e-9));
+      const int hi = static_cast<int>(std::floor(g.time->end / r + 1e-9));
+      g.time = hi >= lo ? IntervalI{lo, hi} : IntervalI{lo, lo};
+    }
+  }
+  sc.dt = dt;
+  return sc;
+}
+
+// The shared highD files of one site recorded at 0.05 s instead of 0.1 s (2.5 of the planner's
+// 0.02 s ticks a step): the same traffic in seconds, and every problem with a solution is still
+// solved. Before the ego aimed between two points of its path (it drove 3 ticks of path a step,
+// 20% too fast) and the rescue looked 4 s ahead in steps (2 s at 0.05), 5 of 9 were.
+TEST(RunnerTest, TheSharedHighDProblemsOfASiteAreSolvedAtAnotherStepSize) {
+  const std::filesystem::path dir =
+      std::filesystem::path(FRENETIC_SHARED_DIR) / "commonroad" / "highD";
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "no " << dir;
+  RunOptions o;
+  o.timing = false;
+  const plan::PlannerConfig config = Config();
+  int problems = 0, solved = 0, infeasible = 0;
+  std::string unsolved;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with("DEU_LocationAUpper") || !name.ends_with(".cr.xml")) continue;
+    auto sc = LoadScenario(entry.path().string());
+    ASSERT_TRUE(sc.ok()) << sc.message();
+    ASSERT_NEAR(sc->dt, 0.1, 1e-12);
+    for (const ProblemRun& p : RunScenario(AtStepSize(*sc, 0.05), config, o).problems) {
+      ++problems;
+      solved += p.verdict.solved;
+      infeasible += p.verdict.infeasible_at_start.has_value();
+      if (!p.verdict.solved && !p.verdict.infeasible_at_start) {
+        unsolved += " " + sc->benchmark_id + ": " + p.verdict.Summary();
+      }
+      // A step of the trajectory is 0.05 s: the run covers the same seconds in twice the steps.
+      EXPECT_EQ(p.trajectory.size(), p.cycles.size() + 1);
+    }
+  }
+  EXPECT_EQ(problems, 10);
+  EXPECT_LE(infeasible, 1);
+  EXPECT_EQ(solved + infeasible, problems) << unsolved;
 }
 
 }  // namespace

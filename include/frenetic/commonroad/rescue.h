@@ -7,9 +7,11 @@
 // highway traffic the only way through a box-in is sometimes none of them: full acceleration
 // from the first step, a lateral move of a metre and a half in a second, then a hold at the
 // lane's edge while the cars of two lanes pass 0.2 m away. The rescue searches that space
-// directly: breadth first over the KS model's states, step by step (the scenario's dt), at each
-// step five accelerations (from -a_max to the limit at the speed) and five steering rates, all
-// within `limit_share` of the vehicle's limits and within its friction circle; a state is kept
+// directly: breadth first over the KS model's states, step by step (the scenario's dt; at a
+// shorter dt a layer of the search holds its input for as many steps as make about 0.1 s, every
+// step checked), at each step five accelerations (from -a_max to the limit at the speed) and
+// five steering rates, all within `limit_share` of the vehicle's limits and within its friction
+// circle; a state is kept
 // while the ego's box (grown by `ego_margin`) is clear of every predicted car's box at that step
 // and lies between the road's edges (the planner's road, its ends closed). It uses what the
 // planner was told and nothing else: the telemetry's futures of the cars (recorded
@@ -35,6 +37,7 @@
 // beyond reach at full acceleration), so a goal out of reach costs no search at all.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -51,10 +54,12 @@
 namespace frenetic::commonroad {
 
 struct RescueOptions {
-  int steps = 40;             // steps searched ahead (4 s at the benchmark's 0.1 s)
-  // Steps a search for a way to a goal region the planner's path misses may run, when every
-  // window closes within them (6 s; at least `steps`): see Rescue::GoalAtRisk.
-  int goal_steps = 60;
+  // s searched ahead, in the scenario's steps (40 at the benchmark's usual 0.1 s; a file's
+  // own step size, 0.04 s or 0.2 s, keeps the same seconds).
+  double horizon = 4.0;
+  // s a search for a way to a goal region the planner's path misses may run, when every
+  // window closes within them (at least `horizon`): see Rescue::GoalAtRisk.
+  double goal_horizon = 6.0;
   int max_states = 150;       // valid states kept per step (a spread when more)
   int retry_states = 300;     // when none is found, once more with this many (0: no retry)
   double limit_share = 0.97;  // of the vehicle's acceleration, steering and steering-rate limits
@@ -98,6 +103,9 @@ class Rescue {
   RescueStep Answer(const plan::Telemetry& t, const std::vector<double>& x,
                     const std::vector<double>& y, const KsState& ego, bool none_passed,
                     bool plan_misses = false);
+  // s: the paths given from now on have their first point this much later than a tick after
+  // the ego's state (a step that is not a whole number of ticks: path_time.h). Default 0.
+  void SetPathPhase(double phase) { path_phase_ = std::isfinite(phase) ? phase : 0.0; }
 
   // Whether the rest of the way from `ego` (one step driven since it was found or last kept)
   // is a way to a goal region that still meets it, clear to its end: one Next keeps whatever
@@ -162,7 +170,7 @@ class Rescue {
   // only then) meets no goal region of `goals` (in its window, with its speed and heading) while
   // every region's window closes within the path, or the path runs past the region's end, or
   // (plan_misses: the planner's plan beyond the path misses every region too) the window closes
-  // within RescueOptions::goal_steps and the path ends short of the region or beside it. The
+  // within RescueOptions::goal_horizon and the path ends short of the region or beside it. The
   // path the planner sends is 2 s; a goal a car has to be passed for is lost long before its
   // window closes within that.
   bool GoalAtRisk(const std::vector<double>& x, const std::vector<double>& y,
@@ -234,6 +242,10 @@ class Rescue {
   // the road's edges at both its ends; *at as Clear's).
   bool ClearOfCars(const KsState& s, int k) const;
   bool OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const;
+  // Whether the states `input` reaches from `from` at scenario steps k0 + 1 .. k0 + n - 1
+  // (SimulateKs a step at a time) are all Clear: within a search layer that holds its input
+  // for n steps.
+  bool ClearBetween(const KsState& from, const KsInput& input, int k0, int n, double s_hint) const;
   // A way from `ego` (fe0: its point in the road's frame) that meets a goal region (the first
   // found), else one that lasts the whole horizon of `steps`, the nearest a goal region at its
   // end (then the farthest along the road), in way_ (empty when none), with at most max_states
@@ -274,6 +286,10 @@ class Rescue {
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;
+  // The horizons in the scenario's steps (RescueOptions::horizon, goal_horizon).
+  int steps_ = 40, goal_steps_ = 60;
+  int sub_ = 1;  // scenario steps a search layer holds its input for (Search)
+  double path_phase_ = 0;  // SetPathPhase
   double half_length_ = 0, half_width_ = 0;  // m, of the ego's box grown by ego_margin
   double ego_radius_ = 0;                     // m, its circumradius
   std::vector<Source> sources_;

@@ -20,7 +20,7 @@
 // The run ends at the first step that meets a goal state, after the last goal time window (or,
 // for goals without one, the scenario's last recorded step), once the ego has driven past every
 // goal region, at the first step its box overlaps an obstacle or leaves the road (the verdict's
-// own checks: the problem is failed then), or after kMaxSteps.
+// own checks: the problem is failed then), or after kMaxSeconds (in the scenario's steps).
 #pragma once
 
 #include <functional>
@@ -46,7 +46,8 @@ enum class PredictionMode { kRecorded, kConstantVelocity };
 const char* ToString(PredictionMode mode);  // "recorded", "constant-velocity"
 StatusOr<PredictionMode> ParsePredictionMode(std::string_view text);
 
-inline constexpr int kMaxSteps = 3000;
+// s: the longest run (3000 steps at 0.1 s; as long at any other step size).
+inline constexpr double kMaxSeconds = 300.0;
 
 struct ProblemRun;
 
@@ -129,7 +130,8 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const V
                                                PredictionMode prediction);
 
 // The ego after one step of dt s toward a planned path (x, y: 0.02 s points from the step's
-// start, the first one 0.02 s in): a constant KS input for the step, never backwards.
+// start, the first one 0.02 s in, or `phase` s later than that): a constant KS input for the
+// step, never backwards. A step that is not a whole number of ticks aims between two points.
 // Feed-forward from the path at the step's end (the steering angle of its curvature, the rear
 // axle's speed, the slip angle between the centre's path and the axis), corrected as a Stanley
 // controller does (Hoffmann et al., "Autonomous Automobile Trajectory Tracking for Off-Road
@@ -138,7 +140,8 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const V
 // one-step fit of the position instead steers back and forth at speed (the position answers
 // the steering rate only within the step).
 KsState FollowPath(const KsState& ego, const std::vector<double>& x,
-                   const std::vector<double>& y, double dt, const VehicleParams& vp);
+                   const std::vector<double>& y, double dt, const VehicleParams& vp,
+                   double phase = 0.0);
 
 // Whether the planner's plan, as its goal term sees it (the winner continued past its end),
 // meets no goal region: the term is 0 only when it passes through one in its window. False when
