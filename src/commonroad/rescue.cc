@@ -659,11 +659,10 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
     for (std::size_t v = 0; v < rank_.size() && layer.size() < cap; ++v) {
       Node node = next_[rank_[v].second].second;
       map::FrenetPoint at;
-      if (n_sub > 1 && !ClearBetween(now[node.parent].state, node.input, (k - 1) * sub_, n_sub,
-                                     node.s)) {
-        continue;
-      }
-      if (Clear(node.state, k_end, node.s, &at)) {
+      // The layer's end first (most states that fail, fail there), then the steps within it.
+      if (Clear(node.state, k_end, node.s, &at) &&
+          (n_sub == 1 ||
+           ClearBetween(now[node.parent].state, node.input, (k - 1) * sub_, n_sub, node.s))) {
         node.s = at.s;
         node.d = at.d;
         const double t = k_end * dt_;
