@@ -15,9 +15,10 @@ files are test inputs made from the shared data at run time: not part of the tre
 import argparse
 import copy
 import math
-import os
 import sys
 import xml.etree.ElementTree as ET
+
+from scenario_files import rewrite_each, scenario_files
 
 
 def number(node, path):
@@ -105,22 +106,8 @@ def main():
     if not a.dt > 0:
         print("--dt must be positive", file=sys.stderr)
         return 1
-    if os.path.isdir(a.source):
-        files = sorted(os.path.join(a.source, f) for f in os.listdir(a.source) if f.endswith(".xml"))
-    else:
-        files = [a.source]
-    os.makedirs(a.out_dir, exist_ok=True)
-    written = 0
-    for f in files:
-        if "solution" in os.path.basename(f).lower():
-            continue
-        try:
-            written += resample(f, os.path.join(a.out_dir, os.path.basename(f)), a.dt)
-        except (ET.ParseError, ValueError, OSError, AttributeError, TypeError) as e:
-            print(f"{f}: {e}", file=sys.stderr)
-            return 1
-    print(f"{written} files in {a.out_dir}")
-    return 0
+    return rewrite_each(scenario_files(a.source, skip_solutions=True), a.out_dir,
+                        lambda src, dst: resample(src, dst, a.dt))
 
 
 if __name__ == "__main__":

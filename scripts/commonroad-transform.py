@@ -12,9 +12,10 @@ The written files are test inputs made from the shared data at run time: not par
 """
 import argparse
 import math
-import os
 import sys
 import xml.etree.ElementTree as ET
+
+from scenario_files import rewrite_each, scenario_files
 
 
 def transform(src, dst, angle, dx, dy):
@@ -61,19 +62,8 @@ def main():
     ap.add_argument("--dx", type=float, default=0.0, help="m (default 0)")
     ap.add_argument("--dy", type=float, default=0.0, help="m (default 0)")
     a = ap.parse_args()
-    if os.path.isdir(a.source):
-        files = sorted(os.path.join(a.source, f) for f in os.listdir(a.source) if f.endswith(".xml"))
-    else:
-        files = [a.source]
-    os.makedirs(a.out_dir, exist_ok=True)
-    for f in files:
-        try:
-            transform(f, os.path.join(a.out_dir, os.path.basename(f)), a.angle, a.dx, a.dy)
-        except (ET.ParseError, ValueError, OSError) as e:
-            print(f"{f}: {e}", file=sys.stderr)
-            return 1
-    print(f"{len(files)} files in {a.out_dir}")
-    return 0
+    return rewrite_each(scenario_files(a.source), a.out_dir,
+                        lambda src, dst: transform(src, dst, a.angle, a.dx, a.dy))
 
 
 if __name__ == "__main__":
