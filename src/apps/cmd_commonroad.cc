@@ -450,7 +450,7 @@ void RegisterCommonRoad(CLI::App& app) {
                 "(0.25 m, 0.25 m/s, 0.01 rad, 0.002 1/m), at most 10000 per step, to the "
                 "traffic's last step, then on (static obstacles and the road still checked) "
                 "until a kept state meets a goal state or every goal's window has closed (at "
-                "most 200 steps in all). Evidence, "
+                "most 20 s in all: 200 steps at 0.1 s). Evidence, "
                 "not proof: per problem 'found', or the last step any state reached (and whether "
                 "a step was capped), and the step a state met the goal (a way to the goal: the "
                 "problem has a solution); the summary counts them. Takes seconds per problem. "

@@ -36,9 +36,12 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   for (const Obstacle& o : scenario.obstacles) {
     if (o.LastStep() != INT_MAX) traffic_end = std::max(traffic_end, o.LastStep());
   }
+  const double seconds = std::isfinite(options.max_seconds) ? options.max_seconds : 0.0;
+  const int max_steps =
+      static_cast<int>(std::lround(std::clamp(seconds / scenario.dt, 1.0, 100000.0)));
   const int horizon = traffic_end == INT_MIN
-                          ? std::min(options.max_steps, 10)
-                          : std::clamp(traffic_end - first, 0, options.max_steps);
+                          ? std::max(1, max_steps / 20)
+                          : std::clamp(traffic_end - first, 0, max_steps);
   r.last_step = first + horizon;
   r.survived_to = first;
   // Past the traffic, on until a goal's window has closed (a goal without one: max_steps).
@@ -49,7 +52,7 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   const int goal_horizon =
       goal_end == INT_MIN
           ? 0
-          : static_cast<int>(std::clamp<std::int64_t>(goal_end - first, 0, options.max_steps));
+          : static_cast<int>(std::clamp<std::int64_t>(goal_end - first, 0, max_steps));
   const GoalTest goal(scenario, problem.goals);
   const double dt = scenario.dt;
   const auto state = [](const Point& p, int step) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -154,6 +155,25 @@ TEST(WayThroughTest, AWayToTheGoalIsToldWithItsFirstStep) {
     EXPECT_TRUE(w.found);
     EXPECT_EQ(w.goal_step, -1);
     EXPECT_EQ(w.goal_searched_to, 30);
+  }
+}
+
+// Its reach is seconds, not steps: traffic recorded for 12 s is searched through to its last
+// step at 0.05 s (step 240) as at 0.1 s (step 120); 200 steps would have ended it at 10 s.
+TEST(WayThroughTest, AFilesOwnStepSizeSearchesTheSameSeconds) {
+  for (const double dt : {0.1, 0.05}) {
+    const int n = static_cast<int>(std::lround(12.0 / dt));
+    std::vector<StateXml> far;  // a car in the other lane, far ahead at the ego's speed
+    for (int k = 0; k <= n; ++k) far.push_back({k, {300 + 20 * dt * k, 1.75}, 0.0, 20});
+    ScenarioXml xml("ZAM_Test-1_1_T-1", dt);
+    AddStraightRoad(xml, 700).DynamicObstacle(9, 4.5, 1.8, far).Problem(
+        100, {50, -1.75}, 0, 20, {GoalTimeOnlyXml(n, n)});
+    WayThroughOptions few = Small();
+    few.max_states = 100;
+    const WayThrough w = Search(Parse(xml), few);
+    EXPECT_EQ(w.last_step, n) << dt;
+    EXPECT_TRUE(w.found) << dt;
+    EXPECT_EQ(w.survived_to, n) << dt;
   }
 }
 

@@ -14,7 +14,7 @@
 //
 // The search also tells whether a kept state meets one of the problem's goal states
 // (MeetsGoal): it goes on past the last moving car's step (static obstacles and the road still
-// checked) until one does or every goal's window has closed (at most max_steps). A way to the
+// checked) until one does or every goal's window has closed (at most max_seconds). A way to the
 // goal is the stronger evidence: a trajectory that ends in a goal state is a solution (the
 // checker reads it up to its last state). None found is weaker than none through the traffic:
 // past the traffic no step's cap is told (`exhaustive` speaks of the traffic's steps only).
@@ -35,7 +35,9 @@ namespace frenetic::commonroad {
 
 struct WayThroughOptions {
   int max_states = 10000;         // valid states kept per step (a spread when more)
-  int max_steps = 200;            // steps searched at most after the initial one
+  // s searched at most after the initial state, in the scenario's steps (200 at 0.1 s, 500 at
+  // 0.04 s); with no moving car, the traffic's part lasts a twentieth of it (1 s).
+  double max_seconds = 20.0;
   double cell_xy = 0.25;          // m, grid cell of the position
   double cell_v = 0.25;           // m/s, of the speed
   double cell_heading = 0.01;     // rad, of the heading
@@ -44,7 +46,7 @@ struct WayThroughOptions {
 
 struct WayThrough {
   bool found = false;        // some state lasts from the initial step to last_step
-  int last_step = 0;         // the traffic's last step (capped by max_steps)
+  int last_step = 0;         // the traffic's last step (capped by max_seconds)
   int survived_to = 0;       // the last step some state reached (last_step when found)
   bool exhaustive = true;    // no step was capped at max_states
   std::int64_t checked = 0;  // states checked for collision and road
@@ -53,7 +55,7 @@ struct WayThrough {
 };
 
 // The search from problem.initial to the last step any dynamic obstacle exists (at most
-// options.max_steps later), then on until a state meets a goal (above); `checker` is the
+// options.max_seconds later), then on until a state meets a goal (above); `checker` is the
 // scenario's, for `vehicle`. An initial state that already fails gives found false and
 // survived_to the initial step.
 WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& problem,
