@@ -2,10 +2,10 @@
 """Writes a CommonRoad scenario at another time step size DT (s): every trajectory obstacle's
 states at the steps of DT (linear between the recorded ones, the heading the short way round,
 speed and acceleration likewise), the goals' time windows in those steps (the whole steps within
-them), `timeStepSize` set to DT. The traffic moves as it did, in seconds. CommonRoad's own
-converters write a recording's rate (highD, exiD: 25 Hz, 0.04 s) unless told to downsample, so a
-planner that works only at 0.1 s fails such files; run a set both ways and compare
-(docs/commonroad.md, "A file's own step size").
+them), the problems' initial steps likewise, `timeStepSize` set to DT. The traffic moves as it
+did, in seconds. CommonRoad's own converters write a recording's rate (highD, exiD: 25 Hz,
+0.04 s) unless told to downsample, so a planner that works only at 0.1 s fails such files; run
+a set both ways and compare (docs/commonroad.md, "A file's own step size").
 
     scripts/commonroad-resample.py IN.xml|IN_DIR OUT_DIR --dt 0.05
 
@@ -79,6 +79,10 @@ def resample(src, dst, dt):
                 trajectory.append(s)
             if len(new) == 1:
                 obstacle.remove(trajectory)
+    for problem in root.findall("planningProblem"):
+        exact = problem.find("initialState/time/exact")
+        if exact is not None:
+            exact.text = str(int(round(int(exact.text) / r)))
     for goal in root.iter("goalState"):
         time = goal.find("time")
         if time is None:

@@ -27,7 +27,7 @@ def rewrite_each(files, out_dir, rewrite):
     for f in files:
         try:
             written += rewrite(f, os.path.join(out_dir, os.path.basename(f))) is not False
-        except (ET.ParseError, ValueError, OSError, AttributeError, TypeError) as e:
+        except (ET.ParseError, ValueError, OSError, AttributeError, TypeError, KeyError) as e:
             print(f"{f}: {e}", file=sys.stderr)
             return 1
     print(f"{written} files in {out_dir}")

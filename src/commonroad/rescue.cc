@@ -564,8 +564,10 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   const double rate = share * std::min(std::abs(p.steering_rate_min), std::abs(p.steering_rate_max));
   const double rates[5] = {-rate, -0.5 * rate, 0.0, 0.5 * rate, rate};
   // A layer of the search holds its input for sub_ scenario steps (the last one for what is
-  // left of `steps`): about 0.1 s whatever the file's step size.
-  const int layers = (steps + sub_ - 1) / sub_;
+  // left of `steps`): about 0.1 s whatever the file's step size. A goal is looked for at every
+  // step, within a layer too (a window of one step may lie between two layers' ends).
+  const int sub = sub_;
+  const int layers = (steps + sub - 1) / sub;
   // tan of each rate's change of the steering angle to a quarter layer, mid-layer and its end.
   double tan_rq[5] = {}, tan_rm[5] = {}, tan_r1[5] = {};
   double h = 0;
@@ -575,10 +577,10 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   layers_[0].push_back({start, fe0.s, fe0.d, -1, {}, 0.0});
   // Stratum's speed across the start heading, from each child's sine and cosine of its heading.
   const double cos_h0 = std::cos(ego.orientation), sin_h0 = std::sin(ego.orientation);
-  int depth = 0, met = -1;
+  int depth = 0, met = -1, met_steps = 0;  // met_steps: the scenario steps of the way that met
   for (int k = 1; k <= layers; ++k) {
-    const int k_end = std::min(k * sub_, steps);  // the layer's last scenario step
-    const int n_sub = k_end - (k - 1) * sub_;
+    const int k_end = std::min(k * sub, steps);  // the layer's last scenario step
+    const int n_sub = k_end - (k - 1) * sub;
     if (n_sub * dt_ != h) {
       h = n_sub * dt_;
       for (int j = 0; j < 5; ++j) {
@@ -660,23 +662,33 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
       Node node = next_[rank_[v].second].second;
       map::FrenetPoint at;
       // The layer's end first (most states that fail, fail there), then the steps within it.
+      int met_within = 0;  // the first step within the layer that meets a goal (0: none)
       if (Clear(node.state, k_end, node.s, &at) &&
-          (n_sub == 1 ||
-           ClearBetween(now[node.parent].state, node.input, (k - 1) * sub_, n_sub, node.s))) {
+          (n_sub == 1 || ClearBetween(now[node.parent].state, node.input, (k - 1) * sub, n_sub,
+                                      node.s, met < 0 ? &goals : nullptr, &met_within))) {
         node.s = at.s;
         node.d = at.d;
         const double t = k_end * dt_;
+        if (met < 0 && met_within > 0) {  // the way ends there
+          layer.push_back(node);
+          met = static_cast<int>(layer.size()) - 1;
+          met_steps = (k - 1) * sub + met_within;
+          continue;
+        }
         if (goal_only && !MayMeetGoal(node.s, node.d, node.state, t, goals, steps)) continue;
         layer.push_back(node);
         if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
-                                               t, goals) == 0) met = static_cast<int>(layer.size()) - 1;
+                                    t, goals) == 0) {
+          met = static_cast<int>(layer.size()) - 1;
+          met_steps = k_end;
+        }
       }
     }
     if (layer.empty()) break;
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && (goal_only || std::min(depth * sub_, steps) < steps)) return;
+  if (met < 0 && (goal_only || std::min(depth * sub, steps) < steps)) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];
@@ -692,23 +704,30 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
     }
   }
   goal_way_ = met >= 0;
-  // Each layer's input for each scenario step it holds.
-  way_.resize(std::min(depth * sub_, steps));
+  // Each layer's input for each scenario step it holds (to the step that met a goal).
+  way_.resize(met >= 0 ? met_steps : std::min(depth * sub, steps));
   for (int k = depth, i = best; k >= 1; --k) {
     const Node& node = layers_[k][i];
-    for (int q = (k - 1) * sub_; q < std::min(k * sub_, steps); ++q) way_[q] = node.input;
+    for (int q = (k - 1) * sub; q < std::min({k * sub, steps, static_cast<int>(way_.size())}); ++q) {
+      way_[q] = node.input;
+    }
     i = node.parent;
   }
 }
 
-bool Rescue::ClearBetween(const KsState& from, const KsInput& input, int k0, int n,
-                          double s_hint) const {
+bool Rescue::ClearBetween(const KsState& from, const KsInput& input, int k0, int n, double s_hint,
+                          const std::vector<cost::GoalRegion>* goals, int* met) const {
   KsState q = from;
   map::FrenetPoint at;
   for (int j = 1; j < n; ++j) {
     q = SimulateKs(q, input, dt_, vehicle_, 1);
     if (!Clear(q, k0 + j, s_hint, &at)) return false;
     s_hint = at.s;
+    if (goals != nullptr && *met == 0 &&
+        GoalDistance(at.s, at.d, q.velocity, q.orientation, (k0 + j) * dt_, *goals) == 0) {
+      *met = j;
+      return true;  // the way ends here: the rest of the layer is not driven
+    }
   }
   return true;
 }

@@ -317,7 +317,6 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       if (rescue) {
         const auto p0 = std::chrono::steady_clock::now();
         rescue->Predict(t);
-        rescue->SetPathPhase(phase);
         way_holds = rescue->Holds(ego, t.goals);
         holds_ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p0)
@@ -328,6 +327,9 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       const auto t0 = std::chrono::steady_clock::now();
       (*planner)->set_least_harm(!way_holds);
       const plan::PlanResult& res = (*planner)->Plan(t);
+      // A path planned afresh from the ego's state (none of the previous points kept: it did
+      // not match the planner's own) starts a tick on, on the ticks.
+      if (res.summary.points_kept == 0) phase = 0;
       if (options.on_plan) options.on_plan(input, res);
       if (tracing) {
         // The best candidate of each lane: its cost by term and what became of it.
@@ -353,6 +355,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
       double rescue_ms = holds_ms;
       if (rescue) {
         const auto r0 = std::chrono::steady_clock::now();
+        rescue->SetPathPhase(phase);
         const RescueStep step = rescue->Answer(
             t, res.x, res.y, ego, res.status == plan::PlanStatus::kFallbackUsed, PlanMissesGoal(res));
         rescue_ms +=

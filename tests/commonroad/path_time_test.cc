@@ -36,17 +36,28 @@ TEST(PathTimeTest, WholeTicksConsumedKeepTheirPhaseWithinHalfATickAndAddUpToTheT
       ASSERT_EQ(phase, 0.0) << dt;
     }
   }
-  // 0.05 s and 1/30 s a step: the points consumed over many steps are the time passed, to half
-  // a tick, and the phase never exceeds half a tick.
-  for (const double dt : {0.05, 1.0 / 30}) {
-    double phase = 0;
-    long total = 0;
-    for (int k = 1; k <= 3000; ++k) {
-      total += TicksConsumed(dt, &phase);
-      ASSERT_LE(std::abs(phase), 0.5 * plan::kTickSeconds + 1e-12) << dt << " step " << k;
-      ASSERT_NEAR(total * plan::kTickSeconds, k * dt + phase, 1e-9) << dt << " step " << k;
-    }
+  // 0.05 s a step: 3 points, then 2 (2.5 ticks), the phase 0.01 s, then 0; 1/30 s: 5 points
+  // every 3 steps (0.1 s), the phase never past half a tick.
+  double phase = 0;
+  for (int k = 0; k < 1000; ++k) {
+    ASSERT_EQ(TicksConsumed(0.05, &phase), 3) << k;
+    ASSERT_NEAR(phase, 0.01, 1e-12) << k;
+    ASSERT_EQ(TicksConsumed(0.05, &phase), 2) << k;
+    ASSERT_EQ(phase, 0.0) << k;
   }
+  phase = 0;
+  for (int k = 0; k < 1000; ++k) {
+    int three = 0;
+    for (int j = 0; j < 3; ++j) {
+      three += TicksConsumed(1.0 / 30, &phase);
+      ASSERT_LE(std::abs(phase), 0.5 * plan::kTickSeconds + 1e-12) << k;
+    }
+    ASSERT_EQ(three, 5) << k;
+  }
+  // A step no path is that long: a million points, not an overflow.
+  phase = 0;
+  EXPECT_EQ(TicksConsumed(1e9, &phase), 1000000);
+  EXPECT_EQ(PathIndexAt(1e9).lo, 1000000);
 }
 
 }  // namespace

@@ -402,6 +402,25 @@ cost::GoalRegion Lane0Goal(double t_lo, double t_hi, double s_hi = 400) {
   return {.s_lo = 60, .s_hi = s_hi, .d_lo = 0.5, .d_hi = 3.0, .t_lo = t_lo, .t_hi = t_hi};
 }
 
+// At 0.04 s a search layer holds its input for 3 steps (0.12 s): a window of one step, at step 5
+// (0.2 s), lies between two layers' ends (0.12 s, 0.24 s). The goal is looked for at every step
+// within a layer too, and the way ends at the step that meets it.
+TEST(RescueTest, AGoalWindowNarrowerThanASearchLayerIsStillMet) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), 0.04);
+  rescue.Predict(Scene(58));
+  const KsState ego = Ego(58, kLane0, 20);  // in lane 0, 2 m short of the region (s 60 on)
+  ASSERT_TRUE(rescue.Next(ego, {Lane0Goal(0.2, 0.2)}, true).has_value());
+  std::vector<double> x, y;
+  rescue.Points(ego, &x, &y);
+  EXPECT_EQ(x.size(), 10u);  // 5 steps of 0.04 s: the way ends at the step it meets the region
+  // A window of three layers is still looked for at the layers' ends (and met).
+  ASSERT_TRUE(rescue.Next(ego, {Lane0Goal(0.2, 0.56)}, true).has_value());
+  rescue.Points(ego, &x, &y);
+  EXPECT_GE(x.size() * plan::kTickSeconds, 0.2 - 1e-9);
+  EXPECT_LE(x.size() * plan::kTickSeconds, 0.56 + 0.03 + 1e-9);
+}
+
 TEST(RescueTest, AGoalIsAtRiskWhenThePathMissesItAndItClosesOrIsPassed) {
   const auto road = TwoLanes();
   Rescue rescue(*road, VehicleParams(), kStep);

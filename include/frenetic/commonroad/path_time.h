@@ -14,13 +14,15 @@ namespace frenetic::commonroad {
 
 // Where on a path (points every tick, the first one tick after the path's start) a time t s
 // after its start lies: between point lo and lo + 1, frac of the way (0 within 1e-9 of a
-// point: a whole number of ticks reads the point itself). Before the first point: the first.
+// point: a whole number of ticks reads the point itself). Before the first point: the first
+// (a step shorter than 0.03 s, with its phase, may read a little late).
 struct PathIndex {
   int lo = 0;
   double frac = 0;
 };
 inline PathIndex PathIndexAt(double t) {
-  const double f = t / plan::kTickSeconds - 1.0;
+  // Past a million points: there (no path is that long; the int stays defined).
+  const double f = std::min(t / plan::kTickSeconds - 1.0, 1e6);
   if (!(f > 0)) return {};
   const double whole = std::round(f);
   if (std::abs(f - whole) < 1e-9) return {static_cast<int>(whole), 0.0};
@@ -33,7 +35,8 @@ inline PathIndex PathIndexAt(double t) {
 // left over (at most half a tick either way; 0 when dt is a whole number of ticks).
 inline int TicksConsumed(double dt, double* phase) {
   const double tick = plan::kTickSeconds;
-  const int consumed = std::max(0, static_cast<int>(std::lround((dt - *phase) / tick)));
+  const int consumed =
+      static_cast<int>(std::lround(std::clamp((dt - *phase) / tick, 0.0, 1e6)));
   double next = consumed * tick + *phase - dt;
   if (std::abs(next) < 1e-9) next = 0;
   *phase = next;

@@ -244,8 +244,10 @@ class Rescue {
   bool OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const;
   // Whether the states `input` reaches from `from` at scenario steps k0 + 1 .. k0 + n - 1
   // (SimulateKs a step at a time) are all Clear: within a search layer that holds its input
-  // for n steps.
-  bool ClearBetween(const KsState& from, const KsInput& input, int k0, int n, double s_hint) const;
+  // for n steps. With goals: *met becomes the first j whose state meets one (GoalDistance 0),
+  // and the steps after it are not looked at (true).
+  bool ClearBetween(const KsState& from, const KsInput& input, int k0, int n, double s_hint,
+                    const std::vector<cost::GoalRegion>* goals = nullptr, int* met = nullptr) const;
   // A way from `ego` (fe0: its point in the road's frame) that meets a goal region (the first
   // found), else one that lasts the whole horizon of `steps`, the nearest a goal region at its
   // end (then the farthest along the road), in way_ (empty when none), with at most max_states
