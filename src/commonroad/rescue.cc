@@ -79,9 +79,8 @@ bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, dou
   if (j + 1 + between >= n) return false;
   const int a = std::max(0, j - 1), b = j + 1 + between;
   const double dx = x[b] - x[a], dy = y[b] - y[a];
-  const double px = between ? x[j] + in.frac * (x[j + 1] - x[j]) : x[j];
-  const double py = between ? y[j] + in.frac * (y[j + 1] - y[j]) : y[j];
-  *p = {px, py, std::atan2(dy, dx), std::hypot(dx, dy) / ((b - a) * plan::kTickSeconds)};
+  *p = {PathValueAt(x, in), PathValueAt(y, in), std::atan2(dy, dx),
+        std::hypot(dx, dy) / ((b - a) * plan::kTickSeconds)};
   return true;
 }
 
@@ -566,8 +565,7 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   // A layer of the search holds its input for sub_ scenario steps (the last one for what is
   // left of `steps`): about 0.1 s whatever the file's step size. A goal is looked for at every
   // step, within a layer too (a window of one step may lie between two layers' ends).
-  const int sub = sub_;
-  const int layers = (steps + sub - 1) / sub;
+  const int layers = (steps + sub_ - 1) / sub_;
   // tan of each rate's change of the steering angle to a quarter layer, mid-layer and its end.
   double tan_rq[5] = {}, tan_rm[5] = {}, tan_r1[5] = {};
   double h = 0;
@@ -579,8 +577,8 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   const double cos_h0 = std::cos(ego.orientation), sin_h0 = std::sin(ego.orientation);
   int depth = 0, met = -1, met_steps = 0;  // met_steps: the scenario steps of the way that met
   for (int k = 1; k <= layers; ++k) {
-    const int k_end = std::min(k * sub, steps);  // the layer's last scenario step
-    const int n_sub = k_end - (k - 1) * sub;
+    const int k_end = std::min(k * sub_, steps);  // the layer's last scenario step
+    const int n_sub = k_end - (k - 1) * sub_;
     if (n_sub * dt_ != h) {
       h = n_sub * dt_;
       for (int j = 0; j < 5; ++j) {
@@ -664,7 +662,7 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
       // The layer's end first (most states that fail, fail there), then the steps within it.
       int met_within = 0;  // the first step within the layer that meets a goal (0: none)
       if (Clear(node.state, k_end, node.s, &at) &&
-          (n_sub == 1 || ClearBetween(now[node.parent].state, node.input, (k - 1) * sub, n_sub,
+          (n_sub == 1 || ClearBetween(now[node.parent].state, node.input, (k - 1) * sub_, n_sub,
                                       node.s, met < 0 ? &goals : nullptr, &met_within))) {
         node.s = at.s;
         node.d = at.d;
@@ -672,7 +670,7 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
         if (met < 0 && met_within > 0) {  // the way ends there
           layer.push_back(node);
           met = static_cast<int>(layer.size()) - 1;
-          met_steps = (k - 1) * sub + met_within;
+          met_steps = (k - 1) * sub_ + met_within;
           continue;
         }
         if (goal_only && !MayMeetGoal(node.s, node.d, node.state, t, goals, steps)) continue;
@@ -688,7 +686,7 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
     depth = k;
     if (met >= 0) break;
   }
-  if (met < 0 && (goal_only || std::min(depth * sub, steps) < steps)) return;
+  if (met < 0 && (goal_only || std::min(depth * sub_, steps) < steps)) return;
   // The state that meets a goal, else the last layer's nearest a goal region at its end (then
   // the farthest along the road, then the first), and its inputs back.
   const std::vector<Node>& last = layers_[depth];
@@ -705,10 +703,10 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   }
   goal_way_ = met >= 0;
   // Each layer's input for each scenario step it holds (to the step that met a goal).
-  way_.resize(met >= 0 ? met_steps : std::min(depth * sub, steps));
+  way_.resize(met >= 0 ? met_steps : std::min(depth * sub_, steps));
   for (int k = depth, i = best; k >= 1; --k) {
     const Node& node = layers_[k][i];
-    for (int q = (k - 1) * sub; q < std::min({k * sub, steps, static_cast<int>(way_.size())}); ++q) {
+    for (int q = (k - 1) * sub_; q < std::min({k * sub_, steps, static_cast<int>(way_.size())}); ++q) {
       way_[q] = node.input;
     }
     i = node.parent;

@@ -80,8 +80,7 @@ KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::
   const int j = in.lo, between = in.frac > 0 ? 1 : 0;
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   if (n < j + 3 + between) return SimulateKs(ego, {0, 0}, dt, vp);
-  const double xj = between ? x[j] + in.frac * (x[j + 1] - x[j]) : x[j];
-  const double yj = between ? y[j] + in.frac * (y[j + 1] - y[j]) : y[j];
+  const double xj = PathValueAt(x, in), yj = PathValueAt(y, in);
   // The neighbours the heading and curvature are measured over: the next points, or farther
   // ones at a crawl (points millimetres apart give no direction).
   int a = std::max(0, j - 1), b = j + 1 + between;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "frenetic/plan/planner.h"
 
@@ -28,6 +29,12 @@ inline PathIndex PathIndexAt(double t) {
   if (std::abs(f - whole) < 1e-9) return {static_cast<int>(whole), 0.0};
   const double lo = std::floor(f);
   return {static_cast<int>(lo), f - lo};
+}
+
+// One coordinate of a path (its x or its y) at `in`: the point, or linear between it and the
+// next (which must exist when in.frac > 0).
+inline double PathValueAt(const std::vector<double>& v, const PathIndex& in) {
+  return in.frac > 0 ? v[in.lo] + in.frac * (v[in.lo + 1] - v[in.lo]) : v[in.lo];
 }
 
 // The whole points of a path that a step of dt s consumes, when the path's first point lies
