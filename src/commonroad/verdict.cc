@@ -85,6 +85,29 @@ std::string Fmt(const char* format, double a, double b = 0, double c = 0, double
   return buffer;
 }
 
+// Where obstacle o was when it first came into the scene, during the trajectory before step
+// `until`, seen from the ego then (centre to centre along the ego's heading): "; in the scene
+// from step 8, 9.8 m behind the ego then". A car that enters the scene (a recording's view) close behind the
+// ego and hits it could not be foreseen from what the ego saw.
+std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int until) {
+  for (const KsState& e : traj) {
+    if (e.time_step > until) break;
+    const std::optional<ShapeGroup> occupancy = o.OccupancyAt(e.time_step);
+    if (!occupancy) continue;
+    const std::optional<State> state = o.StateAt(e.time_step);
+    const Vec2 at = state ? state->position : occupancy->Centroid();
+    const double dx = at.x - e.x, dy = at.y - e.y;
+    const double c = std::cos(e.orientation), sn = std::sin(e.orientation);
+    const double ahead = dx * c + dy * sn;  // along the ego's heading, centre to centre
+    std::string out = e.time_step == traj.front().time_step
+                          ? std::string("; in the scene from the start, ")
+                          : "; in the scene from step " + std::to_string(e.time_step) + ", ";
+    return out + Fmt(ahead < 0 ? "%.1f m behind the ego then" : "%.1f m ahead of the ego then",
+                     std::abs(ahead));
+  }
+  return "";
+}
+
 bool Finite(const KsState& s) {
   return std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.steering_angle) &&
          std::isfinite(s.velocity) && std::isfinite(s.orientation);
@@ -280,6 +303,9 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
   for (const KsState& s : traj) {
     if (!have[static_cast<int>(FailureKind::kCollision)]) {
       if (std::optional<Failure> f = CollisionAt(s)) {
+        for (const Obstacle& o : scenario_->obstacles) {
+          if (f->obstacle_id && o.id == *f->obstacle_id) f->detail += FirstSeen(o, traj, f->step);
+        }
         fail(f->kind, f->step, std::move(f->detail), f->obstacle_id);
       }
     }

@@ -138,7 +138,33 @@ TEST(VerdictTest, CollisionWithAStaticObstacleInTheLane) {
   EXPECT_EQ(v.failures[0].step, 43);
   EXPECT_EQ(v.failures[0].obstacle_id, 30);
   EXPECT_THAT(v.failures[0].detail, HasSubstr("obstacle 30 (parkedVehicle)"));
+  // Where the ego first saw it: at its start, centre to centre along its heading.
+  EXPECT_THAT(v.failures[0].detail, HasSubstr("in the scene from the start, 90.0 m ahead of the ego then"));
   EXPECT_TRUE(v.goal_step.has_value());  // reached, but the collision fails it
+}
+
+TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
+  // A car that enters the scene (a recording's view) at step `enter`, 8 m behind the ego in its
+  // lane, closing at 20 m/s: it hits the ego within half a second, whatever was seen before.
+  for (const int enter : {0, 5}) {
+    std::vector<testing::StateXml> car;
+    for (int k = enter; k <= 30; ++k) {
+      car.push_back({k, {10 + 2.0 * enter - 8 + 4.0 * (k - enter), -1.75}, 0.0, 40});
+    }
+    ScenarioXml xml;
+    AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
+        100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
+    const Scenario s = Parse(xml);
+    const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
+    const Failure* hit = v.Find(FailureKind::kCollision);
+    ASSERT_NE(hit, nullptr) << v.Summary();
+    EXPECT_EQ(hit->obstacle_id, 9);
+    // Bumpers 8 - 4.5 / 2 - 4.508 / 2 = 3.5 m apart, closing at 20 m/s: contact within 0.2 s.
+    EXPECT_LE(hit->step, enter + 2);
+    EXPECT_THAT(hit->detail, HasSubstr(enter == 0 ? "in the scene from the start, 8.0 m behind the ego then"
+                                                  : "in the scene from step 5, 8.0 m behind the ego then"))
+        << hit->detail;
+  }
 }
 
 TEST(VerdictTest, PassingBesideAnObstacleIsNoCollision) {
