@@ -363,8 +363,9 @@ void RegisterCommonRoad(CLI::App& app) {
       "and gives per family of scenarios (country and map, the map's trailing site number "
       "dropped: DEU_LocationALower26 -> DEU_LocationALower; a road's number kept: USA_US101) the "
       "problems, solved, unsolved by their first failure (the earliest by step, a missed goal "
-      "only when nothing else failed) and planning "
-      "time per cycle (ms; with --json also the rescue's part of it, rescue_ms, per problem and "
+      "only when nothing else failed; of the collisions, those with a car that came into the "
+      "scene, as into a recording's view, at most 1 s before it hit: collisions_entering) and "
+      "planning time per cycle (ms; with --json also the rescue's part of it, rescue_ms, per problem and "
       "family). Under `mpirun -n N` the files are split across the ranks (file i on "
       "rank i mod N, each with --jobs threads) and rank 0 prints what a single process prints. "
       "Unsolved problems are results: the exit status is 0 unless a file could not be read (1).");

@@ -59,7 +59,8 @@ json FailureWire(const cr::Failure& f) {
   return {{"kind", static_cast<int>(f.kind)},
           {"step", f.step},
           {"detail", f.detail},
-          {"obstacle", OptionalInt(f.obstacle_id)}};
+          {"obstacle", OptionalInt(f.obstacle_id)},
+          {"entered_s", f.entered_s ? Num(*f.entered_s) : json(nullptr)}};
 }
 
 cr::Failure FailureFrom(const json& j) {
@@ -68,6 +69,7 @@ cr::Failure FailureFrom(const json& j) {
   f.step = j.at("step").get<int>();
   f.detail = j.at("detail").get<std::string>();
   f.obstacle_id = OptionalIntFrom(j.at("obstacle"));
+  if (const json& e = j.at("entered_s"); !e.is_null()) f.entered_s = NumFrom(e);
   return f;
 }
 

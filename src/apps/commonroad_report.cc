@@ -181,6 +181,7 @@ json ProblemJson(const ProblemReport& p, double dt) {
   for (const cr::Failure& fl : p.verdict.failures) {
     json e = {{"kind", cr::ToString(fl.kind)}, {"step", fl.step}, {"detail", fl.detail}};
     if (fl.obstacle_id) e["obstacle"] = *fl.obstacle_id;
+    if (fl.entered_s) e["obstacle_entered_s"] = *fl.entered_s;
     failures.push_back(e);
   }
   j["failures"] = failures;

@@ -53,7 +53,13 @@ void Count(const ProblemReport& p, Counts* c) {
   } else if (p.verdict.solved) {
     ++c->solved;
   } else {
-    ++c->unsolved[FirstFailure(p)];
+    const std::string first = FirstFailure(p);
+    ++c->unsolved[first];
+    const cr::Failure* hit = p.verdict.Find(cr::FailureKind::kCollision);
+    if (first == "collision" && hit != nullptr && hit->entered_s &&
+        *hit->entered_s <= kEnteringSeconds + 1e-9) {
+      ++c->collisions_entering;
+    }
   }
 }
 
@@ -119,6 +125,7 @@ json CountsJson(const Counts& c) {
           {"solved", c.solved},
           {"solved_share", Share(c.solved, c.problems - c.infeasible_at_start)},
           {"unsolved", c.unsolved},
+          {"collisions_entering", c.collisions_entering},
           {"cycles", static_cast<int>(c.plan_ms.size())},
           {"plan_ms", TimesJson(c.plan_ms)},
           {"rescue_ms", TimesJson(c.rescue_ms)}};
@@ -197,6 +204,7 @@ json SummaryJson(const Summary& s, const SummarySettings& settings) {
             {"solved", a.solved},
             {"solved_share", Share(a.solved, a.problems - a.infeasible_at_start)},
             {"unsolved", a.unsolved},
+            {"collisions_entering", a.collisions_entering},
             {"unreadable_files", s.unreadable_files},
             {"failures", s.failures},
             {"cycles", static_cast<int>(cycles)},
@@ -237,6 +245,19 @@ std::string SummaryText(const Summary& s, const SummarySettings& settings) {
                  Percentile(a.rescue_ms, 0.5), Percentile(a.rescue_ms, 0.99), Max(a.rescue_ms));
   text += Format("candidates per cycle: mean %.0f\n", cycles ? s.candidates / cycles : 0.0);
   text += FamilyTable(s);
+  if (a.unsolved.count("collision") > 0) {
+    std::string by_family;
+    for (const auto& [name, c] : s.families) {
+      if (c.collisions_entering > 0) {
+        by_family += Format("%s%s %d", by_family.empty() ? "" : ", ",
+                            commonroad::Printable(name).c_str(), c.collisions_entering);
+      }
+    }
+    text += Format("collisions with a car that came into the scene at most %.0f s before it hit "
+                   "(after the start): %d of %d",
+                   kEnteringSeconds, a.collisions_entering, a.unsolved.at("collision"));
+    text += by_family.empty() ? "\n" : " (" + by_family + ")\n";
+  }
   if (s.comparison.solution_files > 0) text += ComparisonText(s.comparison);
   if (s.way_searched > 0) {
     text += Format(

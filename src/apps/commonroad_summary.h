@@ -34,11 +34,18 @@ struct SummarySettings {
 };
 
 // The counts of a set of problems (one family, or all).
+// A collision counts as with a car new in the scene when the car came into it at most this many
+// seconds before (Counts::collisions_entering).
+inline constexpr double kEnteringSeconds = 1.0;
+
 struct Counts {
   int problems = 0;
   int infeasible_at_start = 0;  // apart: neither solved nor unsolved
   int solved = 0;               // of the problems - infeasible_at_start others
   std::map<std::string, int> unsolved;  // by FirstFailure: sums to the unsolved problems
+  // Of unsolved["collision"]: the car hit came into the scene (a recording's view) at most
+  // kEnteringSeconds before, after the run's start (Failure::entered_s).
+  int collisions_entering = 0;
   std::vector<double> plan_ms;          // every cycle's planning time
   std::vector<double> rescue_ms;        // every cycle's rescue time (part of plan_ms)
 };

@@ -259,6 +259,7 @@ void RunRecorder::OnProblemEnd(const PlanningProblem& problem, const ProblemRun&
   for (const Failure& f : run.verdict.failures) {
     json e = {{"kind", ToString(f.kind)}, {"step", f.step}, {"detail", f.detail}};
     e["obstacle"] = f.obstacle_id ? json(*f.obstacle_id) : json(nullptr);
+    if (f.entered_s) e["obstacle_entered_s"] = *f.entered_s;
     failures.push_back(std::move(e));
   }
   std::vector<double> ms;

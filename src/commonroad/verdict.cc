@@ -89,7 +89,8 @@ std::string Fmt(const char* format, double a, double b = 0, double c = 0, double
 // `until`, seen from the ego then (centre to centre along the ego's heading): "; in the scene
 // from step 8, 9.8 m behind the ego then". A car that enters the scene (a recording's view) close behind the
 // ego and hits it could not be foreseen from what the ego saw.
-std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int until) {
+std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int until, double dt,
+                      std::optional<double>* entered_s) {
   for (const KsState& e : traj) {
     if (e.time_step > until) break;
     const std::optional<ShapeGroup> occupancy = o.OccupancyAt(e.time_step);
@@ -99,7 +100,9 @@ std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int unti
     const double dx = at.x - e.x, dy = at.y - e.y;
     const double c = std::cos(e.orientation), sn = std::sin(e.orientation);
     const double ahead = dx * c + dy * sn;  // along the ego's heading, centre to centre
-    std::string out = e.time_step == traj.front().time_step
+    const bool from_start = e.time_step == traj.front().time_step;
+    if (!from_start) *entered_s = (until - e.time_step) * dt;
+    std::string out = from_start
                           ? std::string("; in the scene from the start, ")
                           : "; in the scene from step " + std::to_string(e.time_step) + ", ";
     return out + Fmt(ahead < 0 ? "%.1f m behind the ego then" : "%.1f m ahead of the ego then",
@@ -220,10 +223,11 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
   std::vector<Failure> found;
   std::vector<bool> have(static_cast<int>(FailureKind::kDynamics) + 1, false);
   const auto fail = [&](FailureKind kind, int step, std::string detail,
-                        std::optional<int> obstacle = std::nullopt) {
+                        std::optional<int> obstacle = std::nullopt,
+                        std::optional<double> entered_s = std::nullopt) {
     if (have[static_cast<int>(kind)]) return;
     have[static_cast<int>(kind)] = true;
-    found.push_back({kind, step, std::move(detail), obstacle});
+    found.push_back({kind, step, std::move(detail), obstacle, entered_s});
   };
   const auto finish = [&]() {
     std::stable_sort(found.begin(), found.end(), [](const Failure& a, const Failure& b) {
@@ -304,9 +308,11 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
     if (!have[static_cast<int>(FailureKind::kCollision)]) {
       if (std::optional<Failure> f = CollisionAt(s)) {
         for (const Obstacle& o : scenario_->obstacles) {
-          if (f->obstacle_id && o.id == *f->obstacle_id) f->detail += FirstSeen(o, traj, f->step);
+          if (f->obstacle_id && o.id == *f->obstacle_id) {
+            f->detail += FirstSeen(o, traj, f->step, scenario_->dt, &f->entered_s);
+          }
         }
-        fail(f->kind, f->step, std::move(f->detail), f->obstacle_id);
+        fail(f->kind, f->step, std::move(f->detail), f->obstacle_id, f->entered_s);
       }
     }
     if (!have[static_cast<int>(FailureKind::kOffRoad)]) {

@@ -51,6 +51,7 @@ FileReport Awkward() {
   collision.step = 1;
   collision.detail = "the ego overlaps obstacle 10782 (car) at (4.58, -22.48)";
   collision.obstacle_id = 10782;
+  collision.entered_s = 0.30000000000000004;
   cr::Failure dynamics;
   dynamics.kind = cr::FailureKind::kDynamics;
   dynamics.step = 7;
@@ -122,6 +123,9 @@ TEST(CommonRoadMpiTest, ReportsReadBackExactly) {
   ASSERT_EQ(q.verdict.failures.size(), 2u);
   EXPECT_EQ(q.verdict.failures[0].obstacle_id, 10782);
   EXPECT_FALSE(q.verdict.failures[1].obstacle_id.has_value());
+  ASSERT_TRUE(q.verdict.failures[0].entered_s.has_value());
+  EXPECT_TRUE(SameBits(*q.verdict.failures[0].entered_s, 0.30000000000000004));
+  EXPECT_FALSE(q.verdict.failures[1].entered_s.has_value());
   ASSERT_TRUE(q.reference.has_value());
   EXPECT_EQ(q.reference->costs, p.reference->costs);
   EXPECT_EQ(q.reference->goal_step, 75);

@@ -93,6 +93,41 @@ TEST(CommonRoadSummaryTest, FirstFailureIsTheEarliestThenTheVerdictsOrderTheGoal
   EXPECT_EQ(FirstFailure(no_road), "road");
 }
 
+TEST(CommonRoadSummaryTest, CollisionsWithACarNewInTheSceneAreCountedPerFamily) {
+  using K = cr::FailureKind;
+  // A car that came into the scene `entered` s before it hit (none: there from the start).
+  const auto hit = [](std::optional<double> entered, int step = 12) {
+    cr::Failure f = Fail(K::kCollision, step);
+    f.obstacle_id = 7;
+    f.entered_s = entered;
+    return f;
+  };
+  const std::vector<FileReport> files = {
+      File("DEU_LocationALower26-1_1_T-1",
+           {Failed({hit(0.4)}), Failed({hit(1.0)}), Failed({hit(1.5)}), Failed({hit(std::nullopt)})}),
+      // Counted only when the collision is the problem's first failure.
+      File("DEU_LocationAUpper26-1_1_T-1",
+           {Failed({Fail(K::kOffRoad, 5), hit(0.2)}), Failed({Fail(K::kGoal, 40), hit(0.3, 40)})}),
+      File("USA_US101-15_2_T-1", {Failed({hit(std::nullopt)}), Solved(20)}),
+  };
+  const Summary s = Summarise(files);
+  EXPECT_EQ(s.families.at("DEU_LocationALower").collisions_entering, 2);
+  EXPECT_EQ(s.families.at("DEU_LocationAUpper").collisions_entering, 1);
+  EXPECT_EQ(s.families.at("USA_US101").collisions_entering, 0);
+  EXPECT_EQ(s.all.collisions_entering, 3);
+  EXPECT_EQ(s.all.unsolved.at("collision"), 6);
+  const json j = SummaryJson(s, {"constant-velocity", 2});
+  EXPECT_EQ(j.at("collisions_entering"), 3);
+  EXPECT_EQ(j.at("families").at("DEU_LocationALower").at("collisions_entering"), 2);
+  EXPECT_THAT(SummaryText(s, {"constant-velocity", 2}),
+              HasSubstr("\ncollisions with a car that came into the scene at most 1 s before it "
+                        "hit (after the start): 3 of 6 (DEU_LocationALower 2, "
+                        "DEU_LocationAUpper 1)\n"));
+  // Without a collision among the unsolved, no such line.
+  EXPECT_THAT(SummaryText(Summarise({File("USA_US101-15_2_T-1", {Solved(20)})}), {"recorded", 2}),
+              ::testing::Not(HasSubstr("came into the scene")));
+}
+
 TEST(CommonRoadSummaryTest, TheRescuesPartOfThePlanningTimeIsReportedApart) {
   ProblemReport a = Solved(40, {1, 5, 9});
   a.rescue_ms = {0.5, 4, 0.5};

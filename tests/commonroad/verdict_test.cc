@@ -164,6 +164,13 @@ TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
     EXPECT_THAT(hit->detail, HasSubstr(enter == 0 ? "in the scene from the start, 8.0 m behind the ego then"
                                                   : "in the scene from step 5, 8.0 m behind the ego then"))
         << hit->detail;
+    // How long before the hit it came in: none when it was there from the start.
+    if (enter == 0) {
+      EXPECT_FALSE(hit->entered_s.has_value());
+    } else {
+      ASSERT_TRUE(hit->entered_s.has_value());
+      EXPECT_NEAR(*hit->entered_s, (hit->step - enter) * kDt, 1e-9);
+    }
   }
 }
 

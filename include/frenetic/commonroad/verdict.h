@@ -79,6 +79,10 @@ struct Failure {
   int step = 0;                    // time step; for per-step limits, that of the step's start
   std::string detail;              // one line, values and units
   std::optional<int> obstacle_id;  // kCollision
+  // kCollision: s before the collision that the obstacle came into the scene, when that was
+  // after the trajectory's first state (a car entering a recording's view); none when it was
+  // there from the start.
+  std::optional<double> entered_s;
 };
 
 struct Verdict {

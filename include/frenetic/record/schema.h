@@ -45,8 +45,9 @@
 // Footer ("type": "footer"): "report", the run's report: a drive's DriveReport::ToJson()
 // (drive/drive_report.h: miles, incidents and incidents_by_kind, plan_ms {p50, p99, max},
 // incident_log...), a CommonRoad run's verdict ("solved", "goal_step", "stop_reason",
-// "failures" [{kind, step, detail, obstacle}], "incidents" by kind, "steps", "distance_m",
-// "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max}, "plan_fallbacks").
+// "failures" [{kind, step, detail, obstacle, obstacle_entered_s (when a collision's car came
+// into the scene after the start: s before the contact)}], "incidents" by kind, "steps",
+// "distance_m", "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max}, "plan_fallbacks").
 #pragma once
 
 namespace frenetic::record {
