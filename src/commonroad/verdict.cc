@@ -85,10 +85,12 @@ std::string Fmt(const char* format, double a, double b = 0, double c = 0, double
   return buffer;
 }
 
-// Where obstacle o was when it first came into the scene, during the trajectory before step
-// `until`, seen from the ego then (centre to centre along the ego's heading): "; in the scene
-// from step 8, 9.8 m behind the ego then". A car that enters the scene (a recording's view) close behind the
-// ego and hits it could not be foreseen from what the ego saw.
+// Where obstacle o was when it first came into the scene during the trajectory, up to and
+// including step `until` (its collision), seen from the ego then (centre to centre along the
+// ego's heading): "; in the scene from step 8, 9.8 m behind the ego then". *entered_s: the
+// seconds from then to `until`, when that was after the trajectory's first state. A car that
+// enters the scene (a recording's view) close behind the ego gives it little time to react. An
+// obstacle there at the start, gone and back (a set-based one with gaps), counts from the start.
 std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int until, double dt,
                       std::optional<double>* entered_s) {
   for (const KsState& e : traj) {
@@ -101,10 +103,12 @@ std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int unti
     const double c = std::cos(e.orientation), sn = std::sin(e.orientation);
     const double ahead = dx * c + dy * sn;  // along the ego's heading, centre to centre
     const bool from_start = e.time_step == traj.front().time_step;
-    if (!from_start) *entered_s = (until - e.time_step) * dt;
+    // Rounded to a nanosecond: 0.3, not 0.30000000000000004, in the JSON.
+    if (!from_start) *entered_s = std::round((until - e.time_step) * dt * 1e9) / 1e9;
     std::string out = from_start
                           ? std::string("; in the scene from the start, ")
                           : "; in the scene from step " + std::to_string(e.time_step) + ", ";
+    if (std::abs(ahead) < 0.05) return out + "beside the ego then";
     return out + Fmt(ahead < 0 ? "%.1f m behind the ego then" : "%.1f m ahead of the ego then",
                      std::abs(ahead));
   }

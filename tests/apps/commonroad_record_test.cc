@@ -149,6 +149,56 @@ TEST_F(CommonRoadRecordTest, RecordReadsBackWithLanesCarsAndOneExchangePerStep) 
   EXPECT_GT(fs::file_size(html), 40000u);
 }
 
+// A car comes into the scene at step 5 in the ego's lane, 7 m behind it (2.5 m between the
+// bumpers) and 40 m/s faster: it hits at once, whatever the ego does.
+std::string EnteringXml() {
+  crt::ScenarioXml xml("ZAM_Entering-1_1_T-1");
+  crt::AddStraightRoad(xml, 400);
+  std::vector<crt::StateXml> car;
+  for (int k = 5; k <= 40; ++k) car.push_back({k, {10 + 20 * 0.5 - 7 + 60.0 * 0.1 * (k - 5), -1.75}, 0, 60});
+  xml.DynamicObstacle(9, 4.5, 1.8, car);
+  xml.Problem(1, {10, -1.75}, 0, 20, {crt::GoalTimeOnlyXml(30, 40)});
+  return xml.Str();
+}
+
+TEST_F(CommonRoadRecordTest, ACarThatCameIntoTheSceneIsNamedInTheJsonTheRecordAndTheSummary) {
+  const fs::path scenario = dir_ / "entering.xml";
+  std::ofstream(scenario) << EnteringXml();
+  const fs::path records = dir_ / "entering_records";
+  CommandResult r = RunFrenetic("commonroad " + scenario.string() +
+                                " --json --no-timing --no-rescue --record " + records.string());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = json::parse(r.out);
+  const json& p = j["scenarios"][0]["problems"][0];
+  ASSERT_FALSE(p["solved"].get<bool>());
+  json hit;
+  for (const json& f : p["failures"]) {
+    if (f["kind"] == "collision") hit = f;
+  }
+  ASSERT_FALSE(hit.is_null()) << p.dump();
+  EXPECT_EQ(hit["obstacle"], 9);
+  // It came in at step 5 and hit within 0.3 s: the seconds between, the step in the detail.
+  const double entered = hit["obstacle_entered_s"].get<double>();
+  EXPECT_NEAR(entered, 0.1 * (hit["step"].get<int>() - 5), 1e-9);
+  EXPECT_LE(entered, 0.3);
+  EXPECT_THAT(hit["detail"].get<std::string>(), HasSubstr("in the scene from step 5, "));
+  EXPECT_EQ(j["summary"]["collisions_entering"], 1);
+  EXPECT_EQ(j["summary"]["families"]["ZAM_Entering"]["collisions_entering"], 1);
+  // The record's footer carries the same.
+  auto run = record::ReadRecordFile(
+      (records / commonroad::RecordFileName("ZAM_Entering-1_1_T-1", 1)).string());
+  ASSERT_TRUE(run.ok()) << run.message();
+  ASSERT_TRUE(run->has_footer);
+  const json footer = json::parse(run->footer_json);
+  bool found = false;
+  for (const json& f : footer["failures"]) {
+    if (f["kind"] != "collision") continue;
+    found = true;
+    EXPECT_EQ(f["obstacle_entered_s"], hit["obstacle_entered_s"]);
+  }
+  EXPECT_TRUE(found) << footer.dump();
+}
+
 TEST_F(CommonRoadRecordTest, UnwritableDirIsAOneLineError) {
   const fs::path file = dir_ / "a_file";
   std::ofstream(file) << "x";

@@ -172,6 +172,20 @@ TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
       EXPECT_NEAR(*hit->entered_s, (hit->step - enter) * kDt, 1e-9);
     }
   }
+  // A car that appears on the ego at step 5: it hits there, 0 s after it came in, beside it.
+  std::vector<testing::StateXml> car;
+  for (int k = 5; k <= 30; ++k) car.push_back({k, {10 + 2.0 * k, -1.75}, 0.0, 20});
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
+      100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
+  const Scenario s = Parse(xml);
+  const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
+  const Failure* hit = v.Find(FailureKind::kCollision);
+  ASSERT_NE(hit, nullptr) << v.Summary();
+  EXPECT_EQ(hit->step, 5);
+  EXPECT_THAT(hit->detail, HasSubstr("in the scene from step 5, beside the ego then"));
+  ASSERT_TRUE(hit->entered_s.has_value());
+  EXPECT_EQ(*hit->entered_s, 0.0);
 }
 
 TEST(VerdictTest, PassingBesideAnObstacleIsNoCollision) {
