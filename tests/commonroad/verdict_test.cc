@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <numbers>
 
@@ -143,21 +144,29 @@ TEST(VerdictTest, CollisionWithAStaticObstacleInTheLane) {
   EXPECT_TRUE(v.goal_step.has_value());  // reached, but the collision fails it
 }
 
+// The collision of the ego driving 20 m/s along the right lane from x = 10 for 25 steps with a
+// car at x = x_at(k) from step `enter` on (none: no collision).
+std::optional<Failure> HitByACarFrom(int enter, const std::function<double(int)>& x_at, double v) {
+  std::vector<testing::StateXml> car;
+  for (int k = enter; k <= 30; ++k) car.push_back({k, {x_at(k), -1.75}, 0.0, v});
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
+      100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
+  const Scenario s = Parse(xml);
+  const Verdict verdict =
+      CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
+  const Failure* hit = verdict.Find(FailureKind::kCollision);
+  if (hit == nullptr) return std::nullopt;
+  return *hit;
+}
+
 TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
   // A car that enters the scene (a recording's view) at step `enter`, 8 m behind the ego in its
   // lane, closing at 20 m/s: it hits the ego within half a second, whatever was seen before.
   for (const int enter : {0, 5}) {
-    std::vector<testing::StateXml> car;
-    for (int k = enter; k <= 30; ++k) {
-      car.push_back({k, {10 + 2.0 * enter - 8 + 4.0 * (k - enter), -1.75}, 0.0, 40});
-    }
-    ScenarioXml xml;
-    AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
-        100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
-    const Scenario s = Parse(xml);
-    const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
-    const Failure* hit = v.Find(FailureKind::kCollision);
-    ASSERT_NE(hit, nullptr) << v.Summary();
+    const std::optional<Failure> hit =
+        HitByACarFrom(enter, [enter](int k) { return 10 + 2.0 * enter - 8 + 4.0 * (k - enter); }, 40);
+    ASSERT_TRUE(hit.has_value()) << enter;
     EXPECT_EQ(hit->obstacle_id, 9);
     // Bumpers 8 - 4.5 / 2 - 4.508 / 2 = 3.5 m apart, closing at 20 m/s: contact within 0.2 s.
     EXPECT_LE(hit->step, enter + 2);
@@ -173,15 +182,8 @@ TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
     }
   }
   // A car that appears on the ego at step 5: it hits there, 0 s after it came in, beside it.
-  std::vector<testing::StateXml> car;
-  for (int k = 5; k <= 30; ++k) car.push_back({k, {10 + 2.0 * k, -1.75}, 0.0, 20});
-  ScenarioXml xml;
-  AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
-      100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
-  const Scenario s = Parse(xml);
-  const Verdict v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
-  const Failure* hit = v.Find(FailureKind::kCollision);
-  ASSERT_NE(hit, nullptr) << v.Summary();
+  const std::optional<Failure> hit = HitByACarFrom(5, [](int k) { return 10 + 2.0 * k; }, 20);
+  ASSERT_TRUE(hit.has_value());
   EXPECT_EQ(hit->step, 5);
   EXPECT_THAT(hit->detail, HasSubstr("in the scene from step 5, beside the ego then"));
   ASSERT_TRUE(hit->entered_s.has_value());
