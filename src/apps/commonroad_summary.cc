@@ -253,9 +253,10 @@ std::string SummaryText(const Summary& s, const SummarySettings& settings) {
                             commonroad::Printable(name).c_str(), c.collisions_entering);
       }
     }
-    text += Format("collisions with a car that came into the scene at most %.0f s before it hit "
-                   "(after the start): %d of %d",
-                   kEnteringSeconds, a.collisions_entering, a.unsolved.at("collision"));
+    text += Format(
+        "collisions with a car that came into the scene at most %.0f s before it hit "
+        "(after the start): %d of %d",
+        kEnteringSeconds, a.collisions_entering, a.unsolved.at("collision"));
     text += by_family.empty() ? "\n" : " (" + by_family + ")\n";
   }
   if (s.comparison.solution_files > 0) text += ComparisonText(s.comparison);

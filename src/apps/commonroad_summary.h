@@ -33,11 +33,11 @@ struct SummarySettings {
   int vehicle_type = 2;
 };
 
-// The counts of a set of problems (one family, or all).
 // A collision counts as with a car new in the scene when the car came into it at most this many
 // seconds before (Counts::collisions_entering).
 inline constexpr double kEnteringSeconds = 1.0;
 
+// The counts of a set of problems (one family, or all).
 struct Counts {
   int problems = 0;
   int infeasible_at_start = 0;  // apart: neither solved nor unsolved

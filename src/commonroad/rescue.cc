@@ -71,8 +71,8 @@ double RegionGap(const cost::GoalRegion& g, double s, double d) {
 struct PathPoint {
   double x, y, heading, speed;
 };
-bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, double t,
-                 double phase, PathPoint* p) {
+bool PathPointAt(const std::vector<double>& x, const std::vector<double>& y, double t, double phase,
+                 PathPoint* p) {
   const int n = static_cast<int>(std::min(x.size(), y.size()));
   const PathIndex in = PathIndexAt(t - phase);
   const int j = in.lo, between = in.frac > 0 ? 1 : 0;
@@ -104,8 +104,9 @@ Rescue::Rescue(const map::Road& road, const VehicleParams& vehicle, double dt,
     : road_(road), vehicle_(vehicle), dt_(dt), options_(options) {
   const double step = dt > 0 ? dt : 0.1;
   const auto steps_in = [step](double seconds) {  // at least one, at most 2000
-    return std::isfinite(seconds) ? static_cast<int>(std::lround(std::clamp(seconds / step, 1.0, 2000.0)))
-                                  : 1;
+    return std::isfinite(seconds)
+               ? static_cast<int>(std::lround(std::clamp(seconds / step, 1.0, 2000.0)))
+               : 1;
   };
   // A search layer's scenario steps: about 0.1 s (1 at 0.1 s and above, 3 at 0.04 s).
   sub_ = std::max(1, static_cast<int>(std::lround(std::min(0.1 / step, 100.0))));
@@ -675,8 +676,8 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
         }
         if (goal_only && !MayMeetGoal(node.s, node.d, node.state, t, goals, steps)) continue;
         layer.push_back(node);
-        if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation,
-                                    t, goals) == 0) {
+        if (met < 0 && GoalDistance(node.s, node.d, node.state.velocity, node.state.orientation, t,
+                                    goals) == 0) {
           met = static_cast<int>(layer.size()) - 1;
           met_steps = k_end;
         }
@@ -706,9 +707,8 @@ void Rescue::Search(const KsState& ego, const map::FrenetPoint& fe0,
   way_.resize(met >= 0 ? met_steps : std::min(depth * sub_, steps));
   for (int k = depth, i = best; k >= 1; --k) {
     const Node& node = layers_[k][i];
-    for (int q = (k - 1) * sub_; q < std::min({k * sub_, steps, static_cast<int>(way_.size())}); ++q) {
-      way_[q] = node.input;
-    }
+    const int q_end = std::min({k * sub_, steps, static_cast<int>(way_.size())});
+    for (int q = (k - 1) * sub_; q < q_end; ++q) way_[q] = node.input;
     i = node.parent;
   }
 }

@@ -404,8 +404,8 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
         ego = FollowPath(ego, res.x, res.y, dt, vp, phase);
         ego.time_step = k + 1;
         const size_t used = static_cast<size_t>(TicksConsumed(dt, &phase));
-        const size_t j = std::min<size_t>(std::max<size_t>(used, 1) - 1,
-                                          res.x.empty() ? 0 : res.x.size() - 1);
+        const size_t j =
+            std::min<size_t>(std::max<size_t>(used, 1) - 1, res.x.empty() ? 0 : res.x.size() - 1);
         if (!res.x.empty()) cyc.tracking_error = std::hypot(ego.x - res.x[j], ego.y - res.y[j]);
         path_x.assign(res.x.begin() + std::min(used, res.x.size()), res.x.end());
         path_y.assign(res.y.begin() + std::min(used, res.y.size()), res.y.end());

@@ -105,9 +105,8 @@ std::string FirstSeen(const Obstacle& o, std::span<const KsState> traj, int unti
     const bool from_start = e.time_step == traj.front().time_step;
     // Rounded to a nanosecond: 0.3, not 0.30000000000000004, in the JSON.
     if (!from_start) *entered_s = std::round((until - e.time_step) * dt * 1e9) / 1e9;
-    std::string out = from_start
-                          ? std::string("; in the scene from the start, ")
-                          : "; in the scene from step " + std::to_string(e.time_step) + ", ";
+    std::string out = from_start ? std::string("; in the scene from the start, ")
+                                 : "; in the scene from step " + std::to_string(e.time_step) + ", ";
     if (std::abs(ahead) < 0.05) return out + "beside the ego then";
     return out + Fmt(ahead < 0 ? "%.1f m behind the ego then" : "%.1f m ahead of the ego then",
                      std::abs(ahead));
@@ -311,10 +310,8 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
   for (const KsState& s : traj) {
     if (!have[static_cast<int>(FailureKind::kCollision)]) {
       if (std::optional<Failure> f = CollisionAt(s)) {
-        for (const Obstacle& o : scenario_->obstacles) {
-          if (f->obstacle_id && o.id == *f->obstacle_id) {
-            f->detail += FirstSeen(o, traj, f->step, scenario_->dt, &f->entered_s);
-          }
+        if (const Obstacle* o = scenario_->FindObstacle(*f->obstacle_id); o != nullptr) {
+          f->detail += FirstSeen(*o, traj, f->step, scenario_->dt, &f->entered_s);
         }
         fail(f->kind, f->step, std::move(f->detail), f->obstacle_id, f->entered_s);
       }
@@ -396,7 +393,7 @@ std::optional<Failure> VerdictChecker::CollisionAt(const KsState& s) const {
       return Failure{FailureKind::kCollision, s.time_step,
                      "the ego overlaps obstacle " + std::to_string(o.id) + " (" + o.type +
                          Fmt(") at (%.2f, %.2f)", at.x, at.y),
-                     o.id};
+                     o.id, std::nullopt};
     }
   }
   return std::nullopt;
@@ -408,7 +405,7 @@ std::optional<Failure> VerdictChecker::OffRoadAt(const KsState& s) const {
   return Failure{FailureKind::kOffRoad, s.time_step,
                  Fmt("the ego's box at (%.2f, %.2f), orientation %.3f rad, leaves the lanelets",
                      s.x, s.y, s.orientation),
-                 std::nullopt};
+                 std::nullopt, std::nullopt};
 }
 
 std::optional<Failure> VerdictChecker::StartFailure(const PlanningProblem& problem) const {
@@ -465,7 +462,7 @@ std::optional<Failure> VerdictChecker::UnavoidableCollision(const PlanningProble
       return Failure{FailureKind::kCollision, step,
                      "every state the vehicle can reach at step " + std::to_string(step) +
                          " overlaps obstacle " + std::to_string(o.id) + " (" + o.type + ")",
-                     o.id};
+                     o.id, std::nullopt};
     }
   }
   return std::nullopt;

@@ -39,9 +39,8 @@ WayThrough SearchWayThrough(const Scenario& scenario, const PlanningProblem& pro
   const double seconds = std::isfinite(options.max_seconds) ? options.max_seconds : 0.0;
   const int max_steps =
       static_cast<int>(std::lround(std::clamp(seconds / scenario.dt, 1.0, 100000.0)));
-  const int horizon = traffic_end == INT_MIN
-                          ? std::max(1, max_steps / 20)
-                          : std::clamp(traffic_end - first, 0, max_steps);
+  const int horizon = traffic_end == INT_MIN ? std::max(1, max_steps / 20)
+                                             : std::clamp(traffic_end - first, 0, max_steps);
   r.last_step = first + horizon;
   r.survived_to = first;
   // Past the traffic, on until a goal's window has closed (a goal without one: max_steps).

@@ -155,7 +155,8 @@ std::string EnteringXml() {
   crt::ScenarioXml xml("ZAM_Entering-1_1_T-1");
   crt::AddStraightRoad(xml, 400);
   std::vector<crt::StateXml> car;
-  for (int k = 5; k <= 40; ++k) car.push_back({k, {10 + 20 * 0.5 - 7 + 60.0 * 0.1 * (k - 5), -1.75}, 0, 60});
+  for (int k = 5; k <= 40; ++k)
+    car.push_back({k, {10 + 20 * 0.5 - 7 + 60.0 * 0.1 * (k - 5), -1.75}, 0, 60});
   xml.DynamicObstacle(9, 4.5, 1.8, car);
   xml.Problem(1, {10, -1.75}, 0, 20, {crt::GoalTimeOnlyXml(30, 40)});
   return xml.Str();

@@ -103,8 +103,8 @@ TEST(CommonRoadSummaryTest, CollisionsWithACarNewInTheSceneAreCountedPerFamily) 
     return f;
   };
   const std::vector<FileReport> files = {
-      File("DEU_LocationALower26-1_1_T-1",
-           {Failed({hit(0.4)}), Failed({hit(1.0)}), Failed({hit(1.5)}), Failed({hit(std::nullopt)})}),
+      File("DEU_LocationALower26-1_1_T-1", {Failed({hit(0.4)}), Failed({hit(1.0)}),
+                                            Failed({hit(1.5)}), Failed({hit(std::nullopt)})}),
       // Counted only when the collision is the problem's first failure.
       File("DEU_LocationAUpper26-1_1_T-1",
            {Failed({Fail(K::kOffRoad, 5), hit(0.2)}), Failed({Fail(K::kGoal, 40), hit(0.3, 40)})}),

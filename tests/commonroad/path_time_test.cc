@@ -1,9 +1,9 @@
 // Reading a planner's path at a step size that need not be whole ticks (path_time.h).
 #include "frenetic/commonroad/path_time.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace frenetic::commonroad {
 namespace {

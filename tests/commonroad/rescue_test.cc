@@ -336,7 +336,8 @@ TEST(RescueTest, AtAnyStepSizeTheRescueLooksFourSecondsAheadAndFindsAWay) {
       ASSERT_LT(j, x.size());
       const double car_x = 20 + 40.0 * k * dt;
       const bool apart = std::abs(x[j] - car_x) > 4.5 || std::abs(y[j] - kLane0) > 1.8 + 0.05;
-      EXPECT_TRUE(apart) << "t " << k * dt << " ego (" << x[j] << ", " << y[j] << ") car x " << car_x;
+      EXPECT_TRUE(apart) << "t " << k * dt << " ego (" << x[j] << ", " << y[j] << ") car x "
+                         << car_x;
       EXPECT_LT(y[j], -0.8) << "t " << k * dt;
       EXPECT_GT(y[j], -6.2) << "t " << k * dt;
     }

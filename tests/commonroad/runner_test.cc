@@ -153,7 +153,8 @@ TEST(RunnerTest, AFilesOwnStepSizeDrivesTheSameSeconds) {
     std::vector<StateXml> slow;
     const int n = static_cast<int>(std::lround(8.0 / dt));
     for (int k = 0; k <= n; ++k) slow.push_back({k, {40 + 8.0 * dt * k, -1.75}, 0.0, 8.0});
-    const int lo = static_cast<int>(std::lround(4.0 / dt)), hi = static_cast<int>(std::lround(8.0 / dt));
+    const int lo = static_cast<int>(std::lround(4.0 / dt)),
+              hi = static_cast<int>(std::lround(8.0 / dt));
     AddStraightRoad(xml, 500)
         .DynamicObstacle(5, 4.8, 2, slow)
         .Problem(1, {10, -1.75}, 0, 20, {GoalLaneletXml(2, lo, hi)});
@@ -742,7 +743,8 @@ Scenario AtStepSize(Scenario sc, double dt) {
   };
   for (Obstacle& o : sc.obstacles) {
     o.dt = dt;
-    if (o.role != ObstacleRole::kDynamic || o.prediction != ObstaclePrediction::kTrajectory) continue;
+    if (o.role != ObstacleRole::kDynamic || o.prediction != ObstaclePrediction::kTrajectory)
+      continue;
     std::vector<State> old{o.initial};
     old.insert(old.end(), o.trajectory.begin(), o.trajectory.end());
     const int a0 = old.front().time_step, a1 = old.back().time_step;

@@ -1,3 +1,5 @@
+#include "frenetic/commonroad/verdict.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -9,7 +11,6 @@
 #include <numbers>
 
 #include "commonroad/scenario_xml.h"
-#include "frenetic/commonroad/verdict.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -140,7 +141,8 @@ TEST(VerdictTest, CollisionWithAStaticObstacleInTheLane) {
   EXPECT_EQ(v.failures[0].obstacle_id, 30);
   EXPECT_THAT(v.failures[0].detail, HasSubstr("obstacle 30 (parkedVehicle)"));
   // Where the ego first saw it: at its start, centre to centre along its heading.
-  EXPECT_THAT(v.failures[0].detail, HasSubstr("in the scene from the start, 90.0 m ahead of the ego then"));
+  EXPECT_THAT(v.failures[0].detail,
+              HasSubstr("in the scene from the start, 90.0 m ahead of the ego then"));
   EXPECT_TRUE(v.goal_step.has_value());  // reached, but the collision fails it
 }
 
@@ -150,8 +152,9 @@ std::optional<Failure> HitByACarFrom(int enter, const std::function<double(int)>
   std::vector<testing::StateXml> car;
   for (int k = enter; k <= 30; ++k) car.push_back({k, {x_at(k), -1.75}, 0.0, v});
   ScenarioXml xml;
-  AddStraightRoad(xml, 300).DynamicObstacle(9, 4.5, 1.8, car).Problem(
-      100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
+  AddStraightRoad(xml, 300)
+      .DynamicObstacle(9, 4.5, 1.8, car)
+      .Problem(100, {10, -1.75}, 0, 20, {GoalTimeOnlyXml(20, 30)});
   const Scenario s = Parse(xml);
   const Verdict verdict =
       CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20), 25));
@@ -164,14 +167,15 @@ TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
   // A car that enters the scene (a recording's view) at step `enter`, 8 m behind the ego in its
   // lane, closing at 20 m/s: it hits the ego within half a second, whatever was seen before.
   for (const int enter : {0, 5}) {
-    const std::optional<Failure> hit =
-        HitByACarFrom(enter, [enter](int k) { return 10 + 2.0 * enter - 8 + 4.0 * (k - enter); }, 40);
+    const std::optional<Failure> hit = HitByACarFrom(
+        enter, [enter](int k) { return 10 + 2.0 * enter - 8 + 4.0 * (k - enter); }, 40);
     ASSERT_TRUE(hit.has_value()) << enter;
     EXPECT_EQ(hit->obstacle_id, 9);
     // Bumpers 8 - 4.5 / 2 - 4.508 / 2 = 3.5 m apart, closing at 20 m/s: contact within 0.2 s.
     EXPECT_LE(hit->step, enter + 2);
-    EXPECT_THAT(hit->detail, HasSubstr(enter == 0 ? "in the scene from the start, 8.0 m behind the ego then"
-                                                  : "in the scene from step 5, 8.0 m behind the ego then"))
+    EXPECT_THAT(hit->detail,
+                HasSubstr(enter == 0 ? "in the scene from the start, 8.0 m behind the ego then"
+                                     : "in the scene from step 5, 8.0 m behind the ego then"))
         << hit->detail;
     // How long before the hit it came in: none when it was there from the start.
     if (enter == 0) {
@@ -182,7 +186,8 @@ TEST(VerdictTest, ACollisionNamesWhereTheCarCameIntoTheScene) {
     }
   }
   // A car that appears on the ego at step 5: it hits there, 0 s after it came in, beside it.
-  const std::optional<Failure> hit = HitByACarFrom(5, [](int k) { return 10 + 2.0 * k; }, 20);
+  const std::optional<Failure> hit = HitByACarFrom(
+      5, [](int k) { return 10 + 2.0 * k; }, 20);
   ASSERT_TRUE(hit.has_value());
   EXPECT_EQ(hit->step, 5);
   EXPECT_THAT(hit->detail, HasSubstr("in the scene from step 5, beside the ego then"));

@@ -166,8 +166,9 @@ TEST(WayThroughTest, AFilesOwnStepSizeSearchesTheSameSeconds) {
     std::vector<StateXml> far;  // a car in the other lane, far ahead at the ego's speed
     for (int k = 0; k <= n; ++k) far.push_back({k, {300 + 20 * dt * k, 1.75}, 0.0, 20});
     ScenarioXml xml("ZAM_Test-1_1_T-1", dt);
-    AddStraightRoad(xml, 700).DynamicObstacle(9, 4.5, 1.8, far).Problem(
-        100, {50, -1.75}, 0, 20, {GoalTimeOnlyXml(n, n)});
+    AddStraightRoad(xml, 700)
+        .DynamicObstacle(9, 4.5, 1.8, far)
+        .Problem(100, {50, -1.75}, 0, 20, {GoalTimeOnlyXml(n, n)});
     WayThroughOptions few = Small();
     few.max_states = 100;
     const WayThrough w = Search(Parse(xml), few);

@@ -42,8 +42,7 @@ inline double PathValueAt(const std::vector<double>& v, const PathIndex& in) {
 // left over (at most half a tick either way; 0 when dt is a whole number of ticks).
 inline int TicksConsumed(double dt, double* phase) {
   const double tick = plan::kTickSeconds;
-  const int consumed =
-      static_cast<int>(std::lround(std::clamp((dt - *phase) / tick, 0.0, 1e6)));
+  const int consumed = static_cast<int>(std::lround(std::clamp((dt - *phase) / tick, 0.0, 1e6)));
   double next = consumed * tick + *phase - dt;
   if (std::abs(next) < 1e-9) next = 0;
   *phase = next;

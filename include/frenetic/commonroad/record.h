@@ -18,7 +18,8 @@
 // kRecordCandidates traced candidates; times 0 with timing off) and "metrics" (speed_mph, lane).
 // The footer's report holds the verdict: "solved", "goal_step", "stop_reason", "failures"
 // ([{kind, step, detail, obstacle, obstacle_entered_s}]: see schema.h), and the run's "steps",
-// "distance_m", "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max} and "plan_fallbacks".
+// "distance_m", "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max} and
+// "plan_fallbacks".
 //
 // Recording does not change the run, nor its planning times: the candidates are traced by a
 // replica of the planner that plans every cycle again on the writer's thread (checked to send

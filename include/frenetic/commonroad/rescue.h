@@ -290,7 +290,7 @@ class Rescue {
   RescueOptions options_;
   // The horizons in the scenario's steps (RescueOptions::horizon, goal_horizon).
   int steps_ = 40, goal_steps_ = 60;
-  int sub_ = 1;  // scenario steps a search layer holds its input for (Search)
+  int sub_ = 1;            // scenario steps a search layer holds its input for (Search)
   double path_phase_ = 0;  // SetPathPhase
   double half_length_ = 0, half_width_ = 0;  // m, of the ego's box grown by ego_margin
   double ego_radius_ = 0;                     // m, its circumradius

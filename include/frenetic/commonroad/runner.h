@@ -139,9 +139,8 @@ StatusOr<plan::PlannerConfig> CommonRoadConfig(plan::PlannerConfig base, const V
 // the state the feed-forward input would reach; the speed corrected by the along-track error. A
 // one-step fit of the position instead steers back and forth at speed (the position answers
 // the steering rate only within the step).
-KsState FollowPath(const KsState& ego, const std::vector<double>& x,
-                   const std::vector<double>& y, double dt, const VehicleParams& vp,
-                   double phase = 0.0);
+KsState FollowPath(const KsState& ego, const std::vector<double>& x, const std::vector<double>& y,
+                   double dt, const VehicleParams& vp, double phase = 0.0);
 
 // Whether the planner's plan, as its goal term sees it (the winner continued past its end),
 // meets no goal region: the term is 0 only when it passes through one in its window. False when

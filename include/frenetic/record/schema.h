@@ -33,10 +33,10 @@
 //   "path"         {"x": [...], "y": [...]}: the path sent, m, map frame, a point per 0.02 s
 //   "plan"         PlanJson (plan_json.h): "status", "ms_total" and, from an in-process planner,
 //                  the counts, "rejections" by reason, "winner_costs" [{name, weight, value}],
-//                  the winner's lane, end speed and duration, the refinement and "candidates" (best first:
-//                  lane, end_speed, duration, total_cost, checked, winner, reject, reject_car,
-//                  reject_t, x, y at 0.1 m, costs). Times are 0 with timing off, so the same
-//                  seed gives byte-identical records.
+//                  the winner's lane, end speed and duration, the refinement and "candidates" (best
+//                  first: lane, end_speed, duration, total_cost, checked, winner, reject,
+//                  reject_car, reject_t, x, y at 0.1 m, costs). Times are 0 with timing off, so the
+//                  same seed gives byte-identical records.
 //   "metrics"      the simulator's measures after the exchange: speed_mph, lane and, from a
 //                  drive, acc, acc_t, acc_n, jerk, gap, headway, leader, distance_m,
 //                  curr_miles, best_miles, l_old, l_new
@@ -47,7 +47,8 @@
 // incident_log...), a CommonRoad run's verdict ("solved", "goal_step", "stop_reason",
 // "failures" [{kind, step, detail, obstacle, obstacle_entered_s (when a collision's car came
 // into the scene after the start: s before the contact)}], "incidents" by kind, "steps",
-// "distance_m", "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max}, "plan_fallbacks").
+// "distance_m", "sim_seconds", "avg_speed_mph", "max_speed_mph", "plan_ms" {p50, p99, max},
+// "plan_fallbacks").
 #pragma once
 
 namespace frenetic::record {
