@@ -45,6 +45,7 @@ struct DriveArgs {
   bool oracle = false;
   double oracle_headway = sim::OracleOptions().headway;
   double oracle_room = sim::OracleOptions().room_behind;
+  double oracle_foresight = sim::OracleOptions().foresight;
   int judge_budget = sim::JudgeOptions().budget_blocks;
   bool no_timing = false;
   bool real_time_deadlines = false;
@@ -129,6 +130,13 @@ int Drive(const DriveArgs& a) {
   sim::OracleOptions oracle;
   oracle.headway = a.oracle_headway;
   oracle.room_behind = a.oracle_room;
+  oracle.foresight = a.oracle_foresight;
+  if (a.oracle) {
+    // CLI's ranges let NaN through.
+    if (Status s = oracle.Validate(); !s.ok()) {
+      return Fail("--oracle-headway, --oracle-room, --oracle-foresight: " + s.message());
+    }
+  }
   if (!a.connect.empty()) {
     if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
     if (a.oracle) return Fail("--oracle needs the traffic's history: drive in-process (no --connect)");
@@ -306,6 +314,15 @@ void RegisterDrive(CLI::App& app) {
                   "speed) left behind when moving in front of a car in another lane. Default: 5 "
                   "(the planner's)")
       ->check(CLI::Range(0.0, 50.0))
+      ->needs(oracle_flag);
+  sub->add_option("--oracle-foresight", args->oracle_foresight,
+                  "With --oracle: s of the traffic's future the search may know. 0: the whole "
+                  "20 s window. Else a receding search: at every 0.5 s it plans this far ahead "
+                  "and takes the first 0.5 s, what a planner that foresaw the traffic that long "
+                  "could have driven (a window where it finds no way on is counted stuck: JSON "
+                  "oracle.stuck_windows). Cost: about foresight / 1 s times the whole window's. "
+                  "Default: 0")
+      ->check(CLI::Number & (CLI::IsMember({0.0}) | CLI::Range(0.5, 20.0)))
       ->needs(oracle_flag);
   sub->add_option("--judge-budget", args->judge_budget,
                   "Judging: 0.2 s blocks simulated per start before a search gives up (the start "

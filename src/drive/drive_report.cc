@@ -34,7 +34,8 @@ nlohmann::json OracleWindowsJson(const OracleResult& r) {
                    {"best_m", w.best_m},
                    {"lanes", w.lanes},
                    {"speeds", w.speeds},
-                   {"driven_lanes", w.driven_lanes}});
+                   {"driven_lanes", w.driven_lanes},
+                   {"stuck_stage", w.stuck_stage}});
   }
   return arr;
 }
@@ -182,6 +183,8 @@ nlohmann::json DriveReport::ToJson() const {
                      {"mph", oracle.mph()},
                      {"driven_m", oracle.driven_m},
                      {"driven_mph", oracle.driven_mph()},
+                     {"foresight_s", oracle.foresight},
+                     {"stuck_windows", oracle.stuck_windows},
                      {"windows", OracleWindowsJson(oracle)}};
   }
   return out;

@@ -114,6 +114,9 @@ Status OracleOptions::Validate() const {
   if (!(spawn_grace >= 0)) return Status::Error("oracle spawn_grace must be >= 0 s");
   if (!(behind > 0 && behind <= 1000)) return Status::Error("oracle behind must be in (0, 1000] m");
   if (!(horizon > 0 && horizon <= 120)) return Status::Error("oracle horizon must be in (0, 120] s");
+  if (!(foresight == 0 || (foresight >= step && foresight <= 120))) {
+    return Status::Error("oracle foresight must be 0 or step..120 s");
+  }
   if (!(headway >= 0)) return Status::Error("oracle headway must be >= 0 s");
   if (!(room_behind >= 0) || !(closing_time >= 0)) {
     return Status::Error("oracle room_behind and closing_time must be >= 0");
@@ -212,23 +215,42 @@ class Search {
     }
   }
 
-  // The farthest s reached at k1, and in *lanes the path's lane at each stage after k0 (a digit,
-  // or '/' astride).
-  double Run(int k0, int k1, int start_row, std::string* lanes, std::vector<double>* speeds) {
+  // A state of the search: its lane (or lane change and phase), speed index and s.
+  struct State {
+    int g = 0, v = 0;
+    double s = 0;
+  };
+  // The ego's state as it drove at stage k.
+  State Driven(int k) const {
+    const OracleTrace::Row& r0 = trace_.rows()[st_[k].row];
+    State x;
+    x.g = std::clamp(static_cast<int>(std::floor(r0.ego_d / o_.lane_width)), 0, nl_ - 1);
+    for (int i = 0; i < nv_; ++i) {
+      if (std::abs(speeds_[i] - r0.ego_speed) < std::abs(speeds_[x.v] - r0.ego_speed)) x.v = i;
+    }
+    x.s = st_[k].ego_s;
+    return x;
+  }
+
+  // The farthest s reached at k1 from the ego's state as it drove at k0, and in *lanes the
+  // path's lane at each stage after k0 (a digit, or '/' astride).
+  double Run(int k0, int k1, std::string* lanes, std::vector<double>* speeds) {
+    return RunFrom(k0, k1, Driven(k0), lanes, speeds, nullptr);
+  }
+
+  // The same from state x at stage k0 (-inf when every way is blocked before k1); with `first`,
+  // the best path's state at k0 + 1.
+  double RunFrom(int k0, int k1, const State& x, std::string* lanes, std::vector<double>* speeds,
+                 State* first) {
     parents_.clear();
-    const OracleTrace::Row& r0 = trace_.rows()[start_row];
     double lo = 0, lo1 = 0;
     int bins = 0, bins1 = 0;
+    start_s_ = x.s;
     Window(k0, k0, &lo, &bins);
     cur_.assign(static_cast<std::size_t>(ng_) * nv_ * bins, kNegInf);
-    const int lane = std::clamp(static_cast<int>(std::floor(r0.ego_d / o_.lane_width)), 0, nl_ - 1);
-    int v0 = 0;
-    for (int i = 0; i < nv_; ++i) {
-      if (std::abs(speeds_[i] - r0.ego_speed) < std::abs(speeds_[v0] - r0.ego_speed)) v0 = i;
-    }
-    const double s_start = st_[k0].ego_s;
-    cur_[(static_cast<std::size_t>(lane) * nv_ + v0) * bins +
-         static_cast<int>((s_start - lo) / o_.s_bin)] = s_start;
+    const double s_start = x.s;
+    cur_[(static_cast<std::size_t>(x.g) * nv_ + x.v) * bins +
+         std::clamp(static_cast<int>((s_start - lo) / o_.s_bin), 0, bins - 1)] = s_start;
     std::vector<int> cell_count;
     cell_count.push_back(bins);
     int succ[3];
@@ -263,6 +285,7 @@ class Search {
           }
         }
       }
+      if (k == k0 && first != nullptr) first_ = nxt_;
       cur_.swap(nxt_);
       lo = lo1;
       bins = bins1;
@@ -274,6 +297,14 @@ class Search {
         best = cur_[c];
         best_at = c;
       }
+    }
+    if (first != nullptr && best != kNegInf) {
+      long at = static_cast<long>(best_at);
+      for (std::size_t k = parents_.size(); k-- > 1 && at >= 0;) at = parents_[k][at];
+      const int cells = cell_count[1];
+      first->g = static_cast<int>(at / (static_cast<long>(nv_) * cells));
+      first->v = static_cast<int>((at / cells) % nv_);
+      first->s = first_[at];
     }
     if (lanes != nullptr) {
       lanes->assign(parents_.size(), '?');
@@ -304,10 +335,18 @@ class Search {
     if (g > 0) out[n++] = nl_ + (2 * (g - 1) + 1) * np_;     // left, to g - 1
     return n;
   }
+
+ public:
+  char LaneChar(int g) const {
+    return astride_[g] ? '/' : static_cast<char>('0' + __builtin_ctz(occupies_[g]));
+  }
+  double Speed(int v) const { return speeds_[v]; }
+
+ private:
   // Stage k's positions: from `behind` m behind the ego as driven to the farthest reachable.
-  // Both ends within what is reachable from the window's start, whatever the ego's s did.
+  // Both ends within what is reachable from the search's start, whatever the ego's s did.
   void Window(int k0, int k, double* lo, int* bins) const {
-    const double start = st_[k0].ego_s;
+    const double start = start_s_;
     const double hi = start + o_.top_speed * (k - k0) * o_.step + o_.s_bin;
     *lo = std::clamp(st_[k].ego_s - o_.behind, start - o_.s_bin, hi - o_.s_bin);
     *bins = static_cast<int>(std::ceil((hi - *lo) / o_.s_bin)) + 1;
@@ -322,7 +361,8 @@ class Search {
   std::vector<unsigned> occupies_;
   std::vector<int> lands_;
   std::vector<bool> astride_;
-  std::vector<double> cur_, nxt_;
+  std::vector<double> cur_, nxt_, first_;
+  double start_s_ = 0;  // the s the search starts from
   std::vector<std::vector<int>> parents_;  // per stage searched: each cell's cell before
 };
 
@@ -343,7 +383,31 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
     OracleWindow w;
     w.t = st[k0].t;
     w.driven_m = st[k1].ego_s - st[k0].ego_s;
-    const double best = search.Run(k0, k1, st[k0].row, &w.lanes, &w.speeds);
+    double best = kNegInf;
+    if (o.foresight > 0) {
+      // Receding: plan `ahead` stages (fewer near the window's end, or when no way on is found
+      // that far), take the first.
+      const int ahead = std::max(1, static_cast<int>(std::lround(o.foresight / o.step)));
+      Search::State x = search.Driven(k0);
+      for (int k = k0; k < k1; ++k) {
+        Search::State next;
+        double reached = kNegInf;
+        for (int h = std::min(ahead, k1 - k); h >= 1 && reached == kNegInf; h = h > 1 ? h / 2 : 0) {
+          reached = search.RunFrom(k, k + h, x, nullptr, nullptr, &next);
+        }
+        if (reached == kNegInf) {
+          w.stuck_stage = k - k0;
+          ++result.stuck_windows;
+          break;
+        }
+        x = next;
+        w.lanes.push_back(search.LaneChar(x.g));
+        w.speeds.push_back(search.Speed(x.v));
+      }
+      best = x.s;
+    } else {
+      best = search.Run(k0, k1, &w.lanes, &w.speeds);
+    }
     w.best_m = std::max(w.driven_m, best - st[k0].ego_s);
     for (int k = k0 + 1; k <= k1; ++k) {
       const double d = trace.rows()[st[k].row].ego_d;
@@ -355,6 +419,7 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
     result.windows.push_back(std::move(w));
   }
   result.seconds = stages * o.step;
+  result.foresight = o.foresight;
   return result;
 }
 

@@ -101,12 +101,31 @@ TEST(DriveCli, IncidentsAreJudgedUnlessSwitchedOff) {
   EXPECT_EQ(j.dump(), p.dump());
 }
 
+// --oracle-foresight: 0 or 0.5..20 s, only with --oracle; its value is in the JSON.
+TEST(DriveCli, TheOraclesForesightIsCheckedAndReported) {
+  for (const char* bad : {"--oracle --oracle-foresight 0.3", "--oracle --oracle-foresight 25",
+                          "--oracle --oracle-foresight nan", "--oracle-foresight 3"}) {
+    CommandResult r = RunFrenetic(std::string("drive --seconds 5 ") + bad + " 2>&1");
+    EXPECT_NE(r.exit_code, 0) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--oracle"), std::string::npos) << bad << ": " << r.out;
+  }
+  CommandResult r = RunFrenetic(
+      "drive --seconds 25 --planner baseline --json --no-timing --no-judge --oracle "
+      "--oracle-foresight 2.5 2>/dev/null");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j["oracle"]["foresight_s"].get<double>(), 2.5);
+  EXPECT_TRUE(j["oracle"]["stuck_windows"].is_number_integer());
+  ASSERT_EQ(j["oracle"]["windows"].size(), 2u);  // 20 s and 5 s
+  EXPECT_TRUE(j["oracle"]["windows"][0]["stuck_stage"].is_number_integer());
+}
+
 TEST(DriveCli, HelpExplainsOptionsWithDefaults) {
   CommandResult r = RunFrenetic("drive --help");
   ASSERT_EQ(r.exit_code, 0);
   for (const char* option :
        {"--map", "--scenario", "--seed", "--laps", "--planner", "--record", "--json", "--episodes",
-        "--connect", "--progress", "--no-judge", "--judge-budget"}) {
+        "--connect", "--progress", "--no-judge", "--judge-budget", "--oracle-foresight"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }
   EXPECT_NE(r.out.find("Default"), std::string::npos);

@@ -303,5 +303,36 @@ TEST(RunEpisode, TheOracleNeverChangesTheDriveAndIsReported) {
   EXPECT_NE(searched->ToText().find("oracle          "), std::string::npos);
 }
 
+TEST(RunEpisode, TheOracleWithAForesightPlansAheadOnlyThatFarAndSaysSo) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  testing::KeepLanePlanner planner(world->line, 15);
+  const EpisodeLimits limits{0, 0, 30, 60};
+  RunOptions options;
+  options.timing = false;
+  options.oracle = OracleOptions();
+  const auto with_whole = RunEpisode(world, Scenario(), 5, limits, planner, options);
+  options.oracle->foresight = 3.0;
+  const auto with_ahead = RunEpisode(world, Scenario(), 5, limits, planner, options);
+  ASSERT_TRUE(with_whole.ok() && with_ahead.ok());
+  const OracleResult& r = with_ahead->oracle;
+  EXPECT_DOUBLE_EQ(r.foresight, 3.0);
+  EXPECT_DOUBLE_EQ(with_whole->oracle.foresight, 0.0);
+  // Both start every window from the ego as it drove and beat its 15 m/s.
+  ASSERT_EQ(r.windows.size(), with_whole->oracle.windows.size());
+  EXPECT_DOUBLE_EQ(r.driven_m, with_whole->oracle.driven_m);
+  EXPECT_GT(r.mph(), r.driven_mph() + 1.0);
+  const nlohmann::json j = with_ahead->ToJson();
+  EXPECT_DOUBLE_EQ(j["oracle"]["foresight_s"].get<double>(), 3.0);
+  EXPECT_EQ(j["oracle"]["stuck_windows"].get<int>(), r.stuck_windows);
+  ASSERT_EQ(j["oracle"]["windows"].size(), r.windows.size());
+  for (std::size_t w = 0; w < r.windows.size(); ++w) {
+    EXPECT_EQ(j["oracle"]["windows"][w]["stuck_stage"].get<int>(), r.windows[w].stuck_stage);
+    // A receding search that went on to the window's end took a stage at each.
+    if (r.windows[w].stuck_stage < 0) {
+      EXPECT_EQ(r.windows[w].lanes.size(), with_whole->oracle.windows[w].lanes.size());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace frenetic::sim

@@ -203,3 +203,54 @@ TEST(Oracle, TheEgoSAndTheCarsWrapWithTheTrack) {
 
 }  // namespace
 }  // namespace frenetic::sim
+
+namespace frenetic::sim {
+namespace {
+
+// Lane 0: the ego at 15 m/s and a car at 5 m/s 60 m ahead of it. Lane 1: a queue at 15 m/s,
+// 8 m apart (too close to slip between), from 10 m ahead of the ego to far ahead. Over the
+// first seconds lane 0 is the faster; from the fourth on the ego is held behind its slow car,
+// and the queue alongside keeps it there unless it dropped behind the queue in time.
+std::vector<Mover> Trap() {
+  std::vector<Mover> movers = {{0, 60.0, 5.0, 2.0}};
+  for (int i = 0; i < 30; ++i) movers.push_back({1 + i, 10.0 + 8.0 * i, 15.0, 6.0});
+  return movers;
+}
+
+TEST(Oracle, ForesightOfTheWholeWindowRecedingFindsWhatTheWholeSearchFinds) {
+  OracleOptions o = Lanes(2);
+  const OracleTrace trace = Trace(20.0, 15.0, 0, Trap());
+  const OracleResult whole = SearchOracle(trace, o);
+  o.foresight = 20.0;
+  const OracleResult receding = SearchOracle(trace, o);
+  EXPECT_EQ(receding.stuck_windows, 0);
+  ASSERT_EQ(receding.windows.size(), 1u);
+  EXPECT_EQ(receding.windows[0].lanes.size(), 40u);
+  EXPECT_EQ(receding.windows[0].speeds.size(), 40u);
+  EXPECT_EQ(receding.windows[0].stuck_stage, -1);
+  // Taking the first stage of the best way and searching again from there loses nothing but
+  // what the 0.5 m bins of the whole search kept from it.
+  EXPECT_NEAR(receding.distance_m, whole.distance_m, 1.0);
+  // The way: behind the queue into lane 1, at its 15 m/s.
+  EXPECT_NE(receding.windows[0].lanes.find('1'), std::string::npos) << receding.windows[0].lanes;
+  EXPECT_GT(whole.distance_m, 15.0 * 20.0 - 20.0);
+}
+
+TEST(Oracle, ShortForesightDrivesIntoTheTrapThatTheWholeWindowAvoids) {
+  OracleOptions o = Lanes(2);
+  const OracleTrace trace = Trace(20.0, 15.0, 0, Trap());
+  o.foresight = 20.0;
+  const double whole = SearchOracle(trace, o).distance_m;
+  o.foresight = 1.0;
+  const OracleResult short_sighted = SearchOracle(trace, o);
+  // It speeds up in lane 0 and is held behind the 5 m/s car, the queue alongside.
+  EXPECT_LT(short_sighted.distance_m, whole - 50.0) << short_sighted.windows[0].lanes;
+  EXPECT_EQ(short_sighted.windows[0].lanes.find('1'), std::string::npos)
+      << short_sighted.windows[0].lanes;
+  o.foresight = 0.3;
+  EXPECT_FALSE(o.Validate().ok());
+  EXPECT_NE(o.Validate().message().find("foresight"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace frenetic::sim

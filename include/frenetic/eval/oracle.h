@@ -51,6 +51,11 @@ struct OracleOptions {
   double spawn_grace = 1.0;  // s a car is ignored after it appears or jumps (a respawn)
   double behind = 60.0;      // m: states this far behind the ego as it drove are dropped
   double horizon = 20.0;     // s: each window's search starts from the ego's state as it drove
+  // s: 0, the search knows the traffic over the whole window. Else a receding search: at each
+  // stage it plans this far ahead against the traffic as it will move and takes the plan's
+  // first stage; what a planner that foresaw the traffic this long (and only that long) could
+  // have driven, within the window, from the same start.
+  double foresight = 0.0;
 
   // Ok, or a one-line message naming the first invalid field.
   Status Validate() const;
@@ -97,6 +102,9 @@ struct OracleWindow {
                          // found no way through)
   std::vector<double> speeds;  // the search's speed at each stage, m/s
   std::string driven_lanes;  // the ego's lane at each stage (its d's)
+  // With a foresight: the stage at which a receding search found no way on and stopped (its
+  // distance so far kept), or -1.
+  int stuck_stage = -1;
 };
 
 struct OracleResult {
@@ -104,6 +112,8 @@ struct OracleResult {
   double distance_m = 0;  // the best distance along the road in that time
   double driven_m = 0;    // the ego's own in the same time, as the trace has it
   std::vector<OracleWindow> windows;
+  double foresight = 0;   // s: OracleOptions::foresight (0: each whole window)
+  int stuck_windows = 0;  // with a foresight: windows where the receding search found no way on
   double mph() const { return seconds > 0 ? distance_m / seconds * units::kMpsToMph13 : 0; }
   double driven_mph() const { return seconds > 0 ? driven_m / seconds * units::kMpsToMph13 : 0; }
 };
