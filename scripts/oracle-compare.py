@@ -40,11 +40,20 @@ def load(path):
     episodes = report.get("per_episode")
     if episodes is None:  # one episode: the report is the episode
         episodes = [report]
+    if not isinstance(episodes, list) or not episodes:
+        raise Mismatch(f"{path}: no episodes in it")
     for k, e in enumerate(episodes):
-        o = e.get("oracle")
-        if not isinstance(o, dict) or "driven_mph" not in o or "windows" not in o:
-            raise Mismatch(f"{path}: episode {k + 1} has no oracle windows")
+        o = e.get("oracle") if isinstance(e, dict) else None
+        if (not isinstance(o, dict) or not all(key in o for key in ("driven_mph", "mph", "windows"))
+                or not all(isinstance(w, dict) and all(key in w for key in ("t", "driven_m", "best_m"))
+                           for w in o["windows"])):
+            raise Mismatch(f"{path}: episode {k + 1} has no oracle figures and windows")
     return report, episodes
+
+
+def describe(e):
+    # What makes two episodes the same drive: the scenario and seed (when the report has them).
+    return (e.get("scenario"), e.get("seed"))
 
 
 def compare(base_path, new_path, top):
@@ -52,10 +61,14 @@ def compare(base_path, new_path, top):
     new, en = load(new_path)
     if len(eb) != len(en):
         raise Mismatch(f"{base_path} has {len(eb)} episodes, {new_path} {len(en)}: not the same drives")
+    for k, (b, n) in enumerate(zip(eb, en)):
+        if describe(b) != describe(n):
+            raise Mismatch(f"episode {k + 1} is {describe(b)} in {base_path} but {describe(n)} in "
+                           f"{new_path}: not the same drives")
     diffs = [n["oracle"]["driven_mph"] - b["oracle"]["driven_mph"] for b, n in zip(eb, en)]
     count = len(diffs)
     mean = sum(diffs) / count if count else 0.0
-    se = (math.sqrt(sum((d - mean) ** 2 for d in diffs) / (count - 1) / count) if count > 1 else 0.0)
+    se = math.sqrt(sum((d - mean) ** 2 for d in diffs) / (count - 1) / count) if count > 1 else None
     ego_base = sum(e["oracle"]["driven_mph"] for e in eb) / count if count else 0.0
     ego_new = sum(e["oracle"]["driven_mph"] for e in en) / count if count else 0.0
     oracle_base = sum(e["oracle"]["mph"] for e in eb) / count if count else 0.0
@@ -92,7 +105,8 @@ def compare(base_path, new_path, top):
         "windows_paired": len(windows),
         "windows_changed": sum(abs(w["gain_m"]) > 1e-6 for w in windows),
         "best_windows": [w for w in windows[:top] if w["gain_m"] > 1e-6],
-        "worst_windows": [w for w in reversed(windows[-top:]) if w["gain_m"] < -1e-6],
+        "worst_windows": [w for w in reversed(windows[len(windows) - top:]) if w["gain_m"] < -1e-6]
+                         if top > 0 else [],
     }
 
 
@@ -100,8 +114,10 @@ def text(r):
     lines = [
         f"episodes {r['episodes']}: ego {r['ego_mph']['base']:.3f} -> {r['ego_mph']['new']:.3f} mph "
         f"along the road (oracle {r['oracle_mph']:.3f})",
-        f"paired difference {r['difference_mph']:+.3f} +- {r['standard_error_mph']:.3f} mph "
-        f"(one standard error); faster in {r['faster']}, slower in {r['slower']}",
+        f"paired difference {r['difference_mph']:+.3f}"
+        + (f" +- {r['standard_error_mph']:.3f} mph (one standard error)"
+           if r["standard_error_mph"] is not None else " mph (one episode: no standard error)")
+        + f"; faster in {r['faster']}, slower in {r['slower']}",
     ]
     if r["lead_closed"] is not None:
         lines.append(f"share of the oracle's lead closed: {100 * r['lead_closed']:.1f}%")
@@ -162,7 +178,38 @@ def self_test():
                 assert "bad.json" in str(e), e
             else:
                 raise AssertionError("a broken report was read")
+        # --top 0 lists no window.
+        r0 = compare(pb, pn, 0)
+        assert r0["best_windows"] == [] and r0["worst_windows"] == [], r0
+        # One episode against itself: no standard error.
         one = report([40.0], [44.0], [[(0.0, 100)]])
+        single = os.path.join(d, "one.json")
+        with open(single, "w", encoding="utf-8") as f:
+            json.dump(one, f)
+        r1 = compare(single, single, 5)
+        assert r1["standard_error_mph"] is None and "no standard error" in text(r1), r1
+        # Other seeds are other drives; a window without its figures is a broken report.
+        other = report([40.0, 42.0], [44.0, 46.0], [[(0.0, 100)], [(0.0, 200)]])
+        other["per_episode"][1]["seed"] = 7
+        base["per_episode"][1]["seed"] = 2
+        for r_, p_ in ((base, pb), (other, pn)):
+            with open(p_, "w", encoding="utf-8") as f:
+                json.dump(r_, f)
+        try:
+            compare(pb, pn, 5)
+        except Mismatch as e:
+            assert "episode 2" in str(e), e
+        else:
+            raise AssertionError("episodes of other seeds were paired")
+        del other["per_episode"][0]["oracle"]["windows"][0]["t"]
+        with open(pn, "w", encoding="utf-8") as f:
+            json.dump(other, f)
+        try:
+            compare(single, pn, 5)
+        except Mismatch as e:
+            assert "n.json" in str(e), e
+        else:
+            raise AssertionError("a window without its start was read")
         with open(bad, "w", encoding="utf-8") as f:
             json.dump(one, f)
         try:
@@ -179,7 +226,7 @@ def main():
     p.add_argument("base", nargs="?", help="the `drive --oracle --json` report to compare against")
     p.add_argument("new", nargs="?", help="the report of the changed planner, same episodes")
     p.add_argument("--top", type=int, default=5,
-                   help="windows listed each way (default: 5)")
+                   help="windows listed each way (default: 5; 0: none)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--self-test", action="store_true", help="check the arithmetic and exit")
     a = p.parse_args()

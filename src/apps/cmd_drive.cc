@@ -316,12 +316,15 @@ void RegisterDrive(CLI::App& app) {
       ->check(CLI::Range(0.0, 50.0))
       ->needs(oracle_flag);
   sub->add_option("--oracle-foresight", args->oracle_foresight,
-                  "With --oracle: s of the traffic's future the search may know. 0: the whole "
-                  "20 s window. Else a receding search: at every 0.5 s it plans this far ahead "
-                  "and takes the first 0.5 s, what a planner that foresaw the traffic that long "
-                  "could have driven (a window where it finds no way on is counted stuck: JSON "
-                  "oracle.stuck_windows). Cost: about foresight / 1 s times the whole window's. "
-                  "Default: 0")
+                  "With --oracle: s of the traffic's future the search may know (rounded to whole "
+                  "0.5 s stages). 0: the whole 20 s window. Else a receding search: at every "
+                  "0.5 s it plans this far ahead and takes the first 0.5 s, what a planner that "
+                  "foresaw the traffic that long could have driven. It keeps no reserve for what "
+                  "it cannot see, so a window where it finds no way on is stuck; the report adds "
+                  "the stuck windows and, over the others, the search's mph and the ego's "
+                  "(JSON: oracle.stuck_windows, through_search_mph, through_driven_mph; each "
+                  "window's search_m and stuck_stage). Cost against the whole window's search: "
+                  "about 0.2x at 3 s, 2x at 6 s, 10x at 10 s. Default: 0")
       ->check(CLI::Number & (CLI::IsMember({0.0}) | CLI::Range(0.5, 20.0)))
       ->needs(oracle_flag);
   sub->add_option("--judge-budget", args->judge_budget,

@@ -18,12 +18,22 @@ std::string Maybe(double v, const char* fmt_unit) {
 
 double Share(double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0; }
 
-// The "oracle" line of a report.
-std::string OracleText(double oracle_mph, double driven_mph) {
-  return fmt::format(
+// The "oracle" line of a report, and with a foresight (a receding search) a second one.
+std::string OracleText(double oracle_mph, double driven_mph, double foresight = 0, int stuck = 0,
+                       double through_s = 0, double through_search_m = 0,
+                       double through_driven_m = 0) {
+  std::string out = fmt::format(
       "oracle          {:.2f} mph along the road at best against this traffic (offline search), "
       "the ego {:.2f} mph there\n",
       oracle_mph, driven_mph);
+  if (foresight > 0) {
+    const double k = through_s > 0 ? units::kMpsToMph13 / through_s : 0;
+    out += fmt::format(
+        "                foresight {:.1f} s: {} windows stuck; where it went through ({:.0f} s), "
+        "the search {:.2f} mph, the ego {:.2f} mph\n",
+        foresight, stuck, through_s, through_search_m * k, through_driven_m * k);
+  }
+  return out;
 }
 
 nlohmann::json OracleWindowsJson(const OracleResult& r) {
@@ -35,6 +45,7 @@ nlohmann::json OracleWindowsJson(const OracleResult& r) {
                    {"lanes", w.lanes},
                    {"speeds", w.speeds},
                    {"driven_lanes", w.driven_lanes},
+                   {"search_m", w.search_m},
                    {"stuck_stage", w.stuck_stage}});
   }
   return arr;
@@ -185,6 +196,9 @@ nlohmann::json DriveReport::ToJson() const {
                      {"driven_mph", oracle.driven_mph()},
                      {"foresight_s", oracle.foresight},
                      {"stuck_windows", oracle.stuck_windows},
+                     {"through_seconds", oracle.through_seconds},
+                     {"through_search_mph", oracle.through_search_mph()},
+                     {"through_driven_mph", oracle.through_driven_mph()},
                      {"windows", OracleWindowsJson(oracle)}};
   }
   return out;
@@ -222,7 +236,11 @@ std::string DriveReport::ToText() const {
     << Maybe(min_headway_s, "{:.2f} s") << "\n";
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max, plan_fallbacks);
-  if (oracle_run) o << OracleText(oracle.mph(), oracle.driven_mph()) << OracleWorstText(oracle, 3);
+  if (oracle_run) {
+    o << OracleText(oracle.mph(), oracle.driven_mph(), oracle.foresight, oracle.stuck_windows,
+                    oracle.through_seconds, oracle.through_search_m, oracle.through_driven_m)
+      << OracleWorstText(oracle, 3);
+  }
   if (judged) o << VerdictsText(CountVerdicts(*this));
   for (std::size_t n = 0; n < incident_log.size(); ++n) {
     const Incident& i = incident_log[n];
@@ -256,6 +274,11 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
       a.oracle_run = true;
       a.oracle_mph += r.oracle.mph();
       a.driven_mph += r.oracle.driven_mph();
+      a.oracle_foresight = r.oracle.foresight;
+      a.oracle_stuck_windows += r.oracle.stuck_windows;
+      a.through_seconds += r.oracle.through_seconds;
+      a.through_search_m += r.oracle.through_search_m;
+      a.through_driven_m += r.oracle.through_driven_m;
     }
     if (r.judged) {
       a.judged = true;
@@ -311,7 +334,16 @@ nlohmann::json AggregateReport::ToJson() const {
       {"breakdown", BreakdownJson(breakdown, nullptr)},
       {"per_episode", eps}};
   if (judged) out["judged"] = VerdictsJson(verdicts);
-  if (oracle_run) out["oracle"] = {{"mph", oracle_mph}, {"driven_mph", driven_mph}};
+  if (oracle_run) {
+    const double k = through_seconds > 0 ? units::kMpsToMph13 / through_seconds : 0;
+    out["oracle"] = {{"mph", oracle_mph},
+                     {"driven_mph", driven_mph},
+                     {"foresight_s", oracle_foresight},
+                     {"stuck_windows", oracle_stuck_windows},
+                     {"through_seconds", through_seconds},
+                     {"through_search_mph", through_search_m * k},
+                     {"through_driven_mph", through_driven_m * k}};
+  }
   return out;
 }
 
@@ -329,7 +361,10 @@ std::string AggregateReport::ToText() const {
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms (worst episode)\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max);
   o << BreakdownText(breakdown);
-  if (oracle_run) o << OracleText(oracle_mph, driven_mph);
+  if (oracle_run) {
+    o << OracleText(oracle_mph, driven_mph, oracle_foresight, oracle_stuck_windows, through_seconds,
+                    through_search_m, through_driven_m);
+  }
   for (const DriveReport& r : episodes) {
     o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi",
                      r.seed, r.miles(), r.avg_speed_mph, r.incidents, r.miles_to_first_incident);

@@ -115,7 +115,7 @@ Status OracleOptions::Validate() const {
   if (!(behind > 0 && behind <= 1000)) return Status::Error("oracle behind must be in (0, 1000] m");
   if (!(horizon > 0 && horizon <= 120)) return Status::Error("oracle horizon must be in (0, 120] s");
   if (!(foresight == 0 || (foresight >= step && foresight <= 120))) {
-    return Status::Error("oracle foresight must be 0 or step..120 s");
+    return Status::Error("oracle foresight must be 0 or from one step to 120 s");
   }
   if (!(headway >= 0)) return Status::Error("oracle headway must be >= 0 s");
   if (!(room_behind >= 0) || !(closing_time >= 0)) {
@@ -378,6 +378,7 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
   const std::vector<Stage> st = MakeStages(trace, o, stages);
   Search search(st, trace, o);
   const int per_window = std::max(1, static_cast<int>(std::lround(o.horizon / o.step)));
+  const int ahead = std::max(1, static_cast<int>(std::lround(o.foresight / o.step)));
   for (int k0 = 0; k0 < stages; k0 += per_window) {
     const int k1 = std::min(stages, k0 + per_window);
     OracleWindow w;
@@ -385,17 +386,12 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
     w.driven_m = st[k1].ego_s - st[k0].ego_s;
     double best = kNegInf;
     if (o.foresight > 0) {
-      // Receding: plan `ahead` stages (fewer near the window's end, or when no way on is found
-      // that far), take the first.
-      const int ahead = std::max(1, static_cast<int>(std::lround(o.foresight / o.step)));
+      // Receding: plan `ahead` stages (fewer near the window's end), take the first. No way
+      // that far from x: every way from x ends within it (up to the bins), the window is stuck.
       Search::State x = search.Driven(k0);
       for (int k = k0; k < k1; ++k) {
         Search::State next;
-        double reached = kNegInf;
-        for (int h = std::min(ahead, k1 - k); h >= 1 && reached == kNegInf; h = h > 1 ? h / 2 : 0) {
-          reached = search.RunFrom(k, k + h, x, nullptr, nullptr, &next);
-        }
-        if (reached == kNegInf) {
+        if (search.RunFrom(k, std::min(k + ahead, k1), x, nullptr, nullptr, &next) == kNegInf) {
           w.stuck_stage = k - k0;
           ++result.stuck_windows;
           break;
@@ -404,9 +400,11 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
         w.lanes.push_back(search.LaneChar(x.g));
         w.speeds.push_back(search.Speed(x.v));
       }
-      best = x.s;
+      w.search_m = x.s - st[k0].ego_s;
+      best = w.stuck_stage < 0 ? x.s : kNegInf;
     } else {
       best = search.Run(k0, k1, &w.lanes, &w.speeds);
+      w.search_m = best == kNegInf ? -1.0 : best - st[k0].ego_s;
     }
     w.best_m = std::max(w.driven_m, best - st[k0].ego_s);
     for (int k = k0 + 1; k <= k1; ++k) {
@@ -416,10 +414,15 @@ OracleResult SearchOracle(const OracleTrace& trace, const OracleOptions& o) {
     }
     result.distance_m += w.best_m;
     result.driven_m += w.driven_m;
+    if (w.stuck_stage < 0 && w.search_m >= 0) {
+      result.through_seconds += (k1 - k0) * o.step;
+      result.through_search_m += w.search_m;
+      result.through_driven_m += w.driven_m;
+    }
     result.windows.push_back(std::move(w));
   }
   result.seconds = stages * o.step;
-  result.foresight = o.foresight;
+  result.foresight = o.foresight > 0 ? ahead * o.step : 0.0;
   return result;
 }
 

@@ -118,6 +118,18 @@ TEST(DriveCli, TheOraclesForesightIsCheckedAndReported) {
   EXPECT_TRUE(j["oracle"]["stuck_windows"].is_number_integer());
   ASSERT_EQ(j["oracle"]["windows"].size(), 2u);  // 20 s and 5 s
   EXPECT_TRUE(j["oracle"]["windows"][0]["stuck_stage"].is_number_integer());
+  EXPECT_TRUE(j["oracle"]["windows"][0]["search_m"].is_number());
+  // Over several episodes the summary has them too.
+  CommandResult two = RunFrenetic(
+      "drive --seconds 25 --planner baseline --json --no-timing --no-judge --episodes 2 "
+      "--oracle --oracle-foresight 2.5 2>/dev/null");
+  ASSERT_EQ(two.exit_code, 0) << two.out;
+  const auto a = nlohmann::json::parse(two.out);
+  EXPECT_DOUBLE_EQ(a["oracle"]["foresight_s"].get<double>(), 2.5);
+  int stuck = 0;
+  for (const auto& e : a["per_episode"]) stuck += e["oracle"]["stuck_windows"].get<int>();
+  EXPECT_EQ(a["oracle"]["stuck_windows"].get<int>(), stuck);
+  EXPECT_TRUE(a["oracle"]["through_search_mph"].is_number());
 }
 
 TEST(DriveCli, HelpExplainsOptionsWithDefaults) {

@@ -208,9 +208,10 @@ namespace frenetic::sim {
 namespace {
 
 // Lane 0: the ego at 15 m/s and a car at 5 m/s 60 m ahead of it. Lane 1: a queue at 15 m/s,
-// 8 m apart (too close to slip between), from 10 m ahead of the ego to far ahead. Over the
-// first seconds lane 0 is the faster; from the fourth on the ego is held behind its slow car,
-// and the queue alongside keeps it there unless it dropped behind the queue in time.
+// 8 m apart (too close to slip between), from 10 m ahead of the ego on. The way past the slow
+// car: into lane 1 behind the queue while there is time, past the slow car at 15 m/s, and back
+// into lane 0 ahead of it. Sped up in lane 0 instead, the ego is soon held behind the slow car
+// with the queue alongside: a dead end.
 std::vector<Mover> Trap() {
   std::vector<Mover> movers = {{0, 60.0, 5.0, 2.0}};
   for (int i = 0; i < 30; ++i) movers.push_back({1 + i, 10.0 + 8.0 * i, 15.0, 6.0});
@@ -223,30 +224,53 @@ TEST(Oracle, ForesightOfTheWholeWindowRecedingFindsWhatTheWholeSearchFinds) {
   const OracleResult whole = SearchOracle(trace, o);
   o.foresight = 20.0;
   const OracleResult receding = SearchOracle(trace, o);
-  EXPECT_EQ(receding.stuck_windows, 0);
+  ASSERT_EQ(whole.windows.size(), 1u);
   ASSERT_EQ(receding.windows.size(), 1u);
-  EXPECT_EQ(receding.windows[0].lanes.size(), 40u);
-  EXPECT_EQ(receding.windows[0].speeds.size(), 40u);
-  EXPECT_EQ(receding.windows[0].stuck_stage, -1);
-  // Taking the first stage of the best way and searching again from there loses nothing but
-  // what the 0.5 m bins of the whole search kept from it.
-  EXPECT_NEAR(receding.distance_m, whole.distance_m, 1.0);
-  // The way: behind the queue into lane 1, at its 15 m/s.
-  EXPECT_NE(receding.windows[0].lanes.find('1'), std::string::npos) << receding.windows[0].lanes;
-  EXPECT_GT(whole.distance_m, 15.0 * 20.0 - 20.0);
+  const OracleWindow& w = receding.windows[0];
+  EXPECT_EQ(receding.stuck_windows, 0);
+  EXPECT_EQ(w.stuck_stage, -1);
+  EXPECT_EQ(w.lanes.size(), 40u);
+  EXPECT_EQ(w.speeds.size(), 40u);
+  // Past the slow car (the ego as it drove went through it: 300 m).
+  EXPECT_GT(whole.windows[0].search_m, 300.0 + 50.0) << whole.windows[0].lanes;
+  EXPECT_NE(whole.windows[0].lanes.find('1'), std::string::npos) << whole.windows[0].lanes;
+  // Taking the first stage of the best way and searching again from there finds the same way,
+  // up to what the 0.5 m bins of the whole search kept of it.
+  EXPECT_NEAR(w.search_m, whole.windows[0].search_m, 1.0) << w.lanes;
+  EXPECT_NE(w.lanes.find('1'), std::string::npos) << w.lanes;
+  // The window went through: its figures are the search's own.
+  EXPECT_DOUBLE_EQ(receding.through_seconds, 20.0);
+  EXPECT_DOUBLE_EQ(receding.through_search_m, w.search_m);
+  EXPECT_DOUBLE_EQ(receding.through_driven_m, w.driven_m);
+  EXPECT_DOUBLE_EQ(receding.foresight, 20.0);
 }
 
 TEST(Oracle, ShortForesightDrivesIntoTheTrapThatTheWholeWindowAvoids) {
   OracleOptions o = Lanes(2);
   const OracleTrace trace = Trace(20.0, 15.0, 0, Trap());
-  o.foresight = 20.0;
-  const double whole = SearchOracle(trace, o).distance_m;
+  const OracleWindow full = SearchOracle(trace, o).windows[0];
+  const double whole = full.search_m;
+  // 1 s ahead: lane 0 is the faster, until no way on is left behind the slow car.
   o.foresight = 1.0;
-  const OracleResult short_sighted = SearchOracle(trace, o);
-  // It speeds up in lane 0 and is held behind the 5 m/s car, the queue alongside.
-  EXPECT_LT(short_sighted.distance_m, whole - 50.0) << short_sighted.windows[0].lanes;
-  EXPECT_EQ(short_sighted.windows[0].lanes.find('1'), std::string::npos)
-      << short_sighted.windows[0].lanes;
+  const OracleResult one = SearchOracle(trace, o);
+  ASSERT_EQ(one.windows.size(), 1u);
+  EXPECT_EQ(one.stuck_windows, 1);
+  EXPECT_GE(one.windows[0].stuck_stage, 1);
+  EXPECT_LT(one.windows[0].stuck_stage, 10);
+  EXPECT_EQ(one.windows[0].lanes.size(), static_cast<std::size_t>(one.windows[0].stuck_stage));
+  EXPECT_EQ(one.windows[0].lanes.find('1'), std::string::npos) << one.windows[0].lanes;
+  EXPECT_LT(one.windows[0].search_m, 80.0);
+  // Its best_m is floored at the ego's (which drove through the car, as no search may); a
+  // stuck window counts in no figure of the windows gone through.
+  EXPECT_DOUBLE_EQ(one.windows[0].best_m, one.windows[0].driven_m);
+  EXPECT_DOUBLE_EQ(one.through_seconds, 0.0);
+  // 3 s ahead: it sees the trap in time, later than the whole search, and gets past it.
+  o.foresight = 3.0;
+  const OracleResult three = SearchOracle(trace, o);
+  EXPECT_EQ(three.stuck_windows, 0);
+  EXPECT_GT(three.windows[0].search_m, 300.0) << three.windows[0].lanes;
+  EXPECT_LE(three.windows[0].search_m, whole + 1.0) << three.windows[0].lanes;
+  EXPECT_GT(three.windows[0].lanes.find('/'), full.lanes.find('/')) << three.windows[0].lanes;
   o.foresight = 0.3;
   EXPECT_FALSE(o.Validate().ok());
   EXPECT_NE(o.Validate().message().find("foresight"), std::string::npos);

@@ -52,9 +52,10 @@ struct OracleOptions {
   double behind = 60.0;      // m: states this far behind the ego as it drove are dropped
   double horizon = 20.0;     // s: each window's search starts from the ego's state as it drove
   // s: 0, the search knows the traffic over the whole window. Else a receding search: at each
-  // stage it plans this far ahead against the traffic as it will move and takes the plan's
-  // first stage; what a planner that foresaw the traffic this long (and only that long) could
-  // have driven, within the window, from the same start.
+  // stage it plans this far ahead (in whole stages) against the traffic as it will move and
+  // takes the plan's first stage; what a planner that foresaw the traffic this long (and only
+  // that long) could have driven, within the window, from the same start. It keeps no reserve
+  // for what it cannot see: a plan may end where no way on is left (the window is then stuck).
   double foresight = 0.0;
 
   // Ok, or a one-line message naming the first invalid field.
@@ -97,13 +98,16 @@ class OracleTrace {
 struct OracleWindow {
   double t = 0;          // s, its start
   double driven_m = 0;   // the ego's distance along the road in it
-  double best_m = 0;     // the search's (at least the ego's)
+  double best_m = 0;     // the search's, at least the ego's (the ego did drive it)
+  // The search's own distance, before that floor: for the whole-window search -1 when it found
+  // no way through; for a stuck receding search the distance it drove before it stopped.
+  double search_m = 0;
   std::string lanes;     // the search's lane at each stage: a digit, '/' astride ('?' when it
                          // found no way through)
   std::vector<double> speeds;  // the search's speed at each stage, m/s
   std::string driven_lanes;  // the ego's lane at each stage (its d's)
-  // With a foresight: the stage at which a receding search found no way on and stopped (its
-  // distance so far kept), or -1.
+  // With a foresight: the stage at which a receding search found no way on and stopped
+  // (search_m then holds the distance it had driven), or -1.
   int stuck_stage = -1;
 };
 
@@ -112,10 +116,20 @@ struct OracleResult {
   double distance_m = 0;  // the best distance along the road in that time
   double driven_m = 0;    // the ego's own in the same time, as the trace has it
   std::vector<OracleWindow> windows;
-  double foresight = 0;   // s: OracleOptions::foresight (0: each whole window)
+  double foresight = 0;   // s: the foresight searched, in whole stages (0: each whole window)
   int stuck_windows = 0;  // with a foresight: windows where the receding search found no way on
   double mph() const { return seconds > 0 ? distance_m / seconds * units::kMpsToMph13 : 0; }
   double driven_mph() const { return seconds > 0 ? driven_m / seconds * units::kMpsToMph13 : 0; }
+  // Over the windows the search went through (not stuck, a way found): its own distance, with
+  // no floor, and the ego's, in their time. The fair figures of a receding search, whose
+  // floored best_m credits it the ego's distance wherever the ego did better or it got stuck.
+  double through_seconds = 0, through_search_m = 0, through_driven_m = 0;
+  double through_search_mph() const {
+    return through_seconds > 0 ? through_search_m / through_seconds * units::kMpsToMph13 : 0;
+  }
+  double through_driven_mph() const {
+    return through_seconds > 0 ? through_driven_m / through_seconds * units::kMpsToMph13 : 0;
+  }
 };
 
 // The search; an empty or one-row trace gives a zero result.
