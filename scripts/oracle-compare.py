@@ -148,18 +148,29 @@ def self_test():
                 for t, m in w]}})
         return {"oracle": {}, "per_episode": eps}
 
+    def write(path, obj):
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(obj if isinstance(obj, str) else json.dumps(obj))
+
+    def refused(base_path, new_path, needle, what):
+        try:
+            compare(base_path, new_path, 5)
+        except Mismatch as e:
+            assert needle in str(e), e
+            return
+        raise AssertionError(what)
+
     # Episode 1's last windows (from t = 40 s) differ in length: not paired.
     base = report([40.0, 42.0], [44.0, 46.0],
                   [[(0.0, 100), (20.0, 100), (40.0, 5)], [(0.0, 200)]])
     new = report([41.0, 44.0], [44.0, 46.0],
                  [[(0.0, 130), (20.0, 90), (40.0, 9)], [(0.0, 200)]])
     with tempfile.TemporaryDirectory() as d:
-        pb, pn, bad = (os.path.join(d, x) for x in ("b.json", "n.json", "bad.json"))
-        for p, r in ((pb, base), (pn, new)):
-            with open(p, "w", encoding="utf-8") as f:
-                json.dump(r, f)
-        with open(bad, "w", encoding="utf-8") as f:
-            f.write("{ not json")
+        pb, pn, bad, single = (os.path.join(d, x)
+                               for x in ("b.json", "n.json", "bad.json", "one.json"))
+        write(pb, base)
+        write(pn, new)
+        write(bad, "{ not json")
         r = compare(pb, pn, 5)
         assert r["episodes"] == 2
         assert abs(r["difference_mph"] - 1.5) < 1e-12, r
@@ -171,53 +182,27 @@ def self_test():
         assert [w["gain_m"] for w in r["best_windows"]] == [30]
         assert [w["gain_m"] for w in r["worst_windows"]] == [-10]
         assert "+1.500 +- 0.500" in text(r)
-        for args in ((pb, bad), (bad, pn)):
-            try:
-                compare(*args, 5)
-            except Mismatch as e:
-                assert "bad.json" in str(e), e
-            else:
-                raise AssertionError("a broken report was read")
+        refused(pb, bad, "bad.json", "a broken report was read")
+        refused(bad, pn, "bad.json", "a broken report was read")
         # --top 0 lists no window.
         r0 = compare(pb, pn, 0)
         assert r0["best_windows"] == [] and r0["worst_windows"] == [], r0
         # One episode against itself: no standard error.
         one = report([40.0], [44.0], [[(0.0, 100)]])
-        single = os.path.join(d, "one.json")
-        with open(single, "w", encoding="utf-8") as f:
-            json.dump(one, f)
+        write(single, one)
         r1 = compare(single, single, 5)
         assert r1["standard_error_mph"] is None and "no standard error" in text(r1), r1
+        refused(pb, single, "2 episodes", "reports of different drives were paired")
         # Other seeds are other drives; a window without its figures is a broken report.
         other = report([40.0, 42.0], [44.0, 46.0], [[(0.0, 100)], [(0.0, 200)]])
         other["per_episode"][1]["seed"] = 7
         base["per_episode"][1]["seed"] = 2
-        for r_, p_ in ((base, pb), (other, pn)):
-            with open(p_, "w", encoding="utf-8") as f:
-                json.dump(r_, f)
-        try:
-            compare(pb, pn, 5)
-        except Mismatch as e:
-            assert "episode 2" in str(e), e
-        else:
-            raise AssertionError("episodes of other seeds were paired")
+        write(pb, base)
+        write(pn, other)
+        refused(pb, pn, "episode 2", "episodes of other seeds were paired")
         del other["per_episode"][0]["oracle"]["windows"][0]["t"]
-        with open(pn, "w", encoding="utf-8") as f:
-            json.dump(other, f)
-        try:
-            compare(single, pn, 5)
-        except Mismatch as e:
-            assert "n.json" in str(e), e
-        else:
-            raise AssertionError("a window without its start was read")
-        with open(bad, "w", encoding="utf-8") as f:
-            json.dump(one, f)
-        try:
-            compare(pb, bad, 5)
-        except Mismatch as e:
-            assert "2 episodes" in str(e), e
-        else:
-            raise AssertionError("reports of different drives were paired")
+        write(pn, other)
+        refused(single, pn, "n.json", "a window without its start was read")
     print("oracle-compare self-test passed")
 
 

@@ -109,9 +109,10 @@ TEST(DriveCli, TheOraclesForesightIsCheckedAndReported) {
     EXPECT_NE(r.exit_code, 0) << bad << ": " << r.out;
     EXPECT_NE(r.out.find("--oracle"), std::string::npos) << bad << ": " << r.out;
   }
-  CommandResult r = RunFrenetic(
+  const std::string run =
       "drive --seconds 25 --planner baseline --json --no-timing --no-judge --oracle "
-      "--oracle-foresight 2.5 2>/dev/null");
+      "--oracle-foresight 2.5";
+  CommandResult r = RunFrenetic(run + " 2>/dev/null");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_DOUBLE_EQ(j["oracle"]["foresight_s"].get<double>(), 2.5);
@@ -120,9 +121,7 @@ TEST(DriveCli, TheOraclesForesightIsCheckedAndReported) {
   EXPECT_TRUE(j["oracle"]["windows"][0]["stuck_stage"].is_number_integer());
   EXPECT_TRUE(j["oracle"]["windows"][0]["search_m"].is_number());
   // Over several episodes the summary has them too.
-  CommandResult two = RunFrenetic(
-      "drive --seconds 25 --planner baseline --json --no-timing --no-judge --episodes 2 "
-      "--oracle --oracle-foresight 2.5 2>/dev/null");
+  CommandResult two = RunFrenetic(run + " --episodes 2 2>/dev/null");
   ASSERT_EQ(two.exit_code, 0) << two.out;
   const auto a = nlohmann::json::parse(two.out);
   EXPECT_DOUBLE_EQ(a["oracle"]["foresight_s"].get<double>(), 2.5);
