@@ -44,9 +44,10 @@ def load(path):
         raise Mismatch(f"{path}: no episodes in it")
     for k, e in enumerate(episodes):
         o = e.get("oracle") if isinstance(e, dict) else None
-        if (not isinstance(o, dict) or not all(key in o for key in ("driven_mph", "mph", "windows"))
-                or not all(isinstance(w, dict) and all(key in w for key in ("t", "driven_m", "best_m"))
-                           for w in o["windows"])):
+        whole = isinstance(o, dict) and all(k in o for k in ("driven_mph", "mph", "windows"))
+        fields = ("t", "driven_m", "best_m")
+        if not whole or not all(isinstance(w, dict) and all(k in w for k in fields)
+                                for w in o["windows"]):
             raise Mismatch(f"{path}: episode {k + 1} has no oracle figures and windows")
     return report, episodes
 
@@ -60,7 +61,8 @@ def compare(base_path, new_path, top):
     base, eb = load(base_path)
     new, en = load(new_path)
     if len(eb) != len(en):
-        raise Mismatch(f"{base_path} has {len(eb)} episodes, {new_path} {len(en)}: not the same drives")
+        raise Mismatch(f"{base_path} has {len(eb)} episodes, {new_path} {len(en)}: "
+                       "not the same drives")
     for k, (b, n) in enumerate(zip(eb, en)):
         if describe(b) != describe(n):
             raise Mismatch(f"episode {k + 1} is {describe(b)} in {base_path} but {describe(n)} in "
@@ -112,8 +114,8 @@ def compare(base_path, new_path, top):
 
 def text(r):
     lines = [
-        f"episodes {r['episodes']}: ego {r['ego_mph']['base']:.3f} -> {r['ego_mph']['new']:.3f} mph "
-        f"along the road (oracle {r['oracle_mph']:.3f})",
+        f"episodes {r['episodes']}: ego {r['ego_mph']['base']:.3f} -> "
+        f"{r['ego_mph']['new']:.3f} mph along the road (oracle {r['oracle_mph']:.3f})",
         f"paired difference {r['difference_mph']:+.3f}"
         + (f" +- {r['standard_error_mph']:.3f} mph (one standard error)"
            if r["standard_error_mph"] is not None else " mph (one episode: no standard error)")
@@ -128,7 +130,8 @@ def text(r):
             lines.append(f"{title}:")
         for w in r[key]:
             lines.append(f"  episode {w['episode']} from t {w['t']:.1f} s: {w['gain_m']:+.1f} m "
-                         f"(base {w['base_m']:.0f}, new {w['new_m']:.0f}, oracle {w['oracle_m']:.0f})")
+                         f"(base {w['base_m']:.0f}, new {w['new_m']:.0f}, "
+                         f"oracle {w['oracle_m']:.0f})")
             lines.append(f"    oracle {w['oracle_lanes']}")
             lines.append(f"    base   {w['base_lanes']}")
             lines.append(f"    new    {w['new_lanes']}")
