@@ -46,6 +46,7 @@ struct DriveArgs {
   double oracle_headway = sim::OracleOptions().headway;
   double oracle_room = sim::OracleOptions().room_behind;
   double oracle_foresight = sim::OracleOptions().foresight;
+  double perfect_predictions = 0;
   int judge_budget = sim::JudgeOptions().budget_blocks;
   bool no_timing = false;
   bool real_time_deadlines = false;
@@ -137,9 +138,16 @@ int Drive(const DriveArgs& a) {
       return Fail("--oracle-headway, --oracle-room, --oracle-foresight: " + s.message());
     }
   }
+  if (!(a.perfect_predictions == 0 ||
+        (a.perfect_predictions >= 0.5 && a.perfect_predictions <= 10))) {  // NaN too
+    return Fail("--perfect-predictions must be 0 or 0.5..10 s");
+  }
   if (!a.connect.empty()) {
     if (a.episodes > 1) return Fail("--connect drives one episode (--episodes 1)");
     if (a.oracle) return Fail("--oracle needs the traffic's history: drive in-process (no --connect)");
+    if (a.perfect_predictions > 0) {
+      return Fail("--perfect-predictions reads the simulator: drive in-process (no --connect)");
+    }
     ConnectOptions connect;
     connect.url = a.connect;
     connect.realtime = a.realtime;
@@ -181,6 +189,7 @@ int Drive(const DriveArgs& a) {
     options.timing = !a.no_timing;
     if (!a.no_judge) options.judge = judge;
     if (a.oracle) options.oracle = oracle;
+    options.foresee = a.perfect_predictions;
     std::unique_ptr<ProgressLine> line;
     if (a.progress || tty) {
       line = std::make_unique<ProgressLine>(tty);
@@ -202,6 +211,7 @@ int Drive(const DriveArgs& a) {
   options.timing = !a.no_timing;
   if (!a.no_judge) options.judge = judge;
   if (a.oracle) options.oracle = oracle;
+  options.foresee = a.perfect_predictions;
   if (!a.record_path.empty()) {
     auto writer = sim::RecordWriter::Open(a.record_path);
     if (!writer.ok()) return Fail(writer.message());
@@ -209,7 +219,9 @@ int Drive(const DriveArgs& a) {
     options.record = record.get();
     // A replica traces the candidates on the record's thread, so the planner that drives does
     // not (drive/record.h); with wall-clock deadlines only the planner itself knows its search.
-    if (auto replica = factory(); replica.ok() && !a.real_time_deadlines) {
+    // (Not with perfect predictions: the record does not keep them for a replica.)
+    if (auto replica = factory();
+        replica.ok() && !a.real_time_deadlines && !(a.perfect_predictions > 0)) {
       record->TraceByReplay(std::move(replica).value(), options.trace_candidates);
       options.trace_candidates = 0;
     }
@@ -327,6 +339,15 @@ void RegisterDrive(CLI::App& app) {
                   "about 0.2x at 3 s, 2x at 6 s, 10x at 10 s. Default: 0")
       ->check(CLI::Number & (CLI::IsMember({0.0}) | CLI::Range(0.5, 20.0)))
       ->needs(oracle_flag);
+  sub->add_option("--perfect-predictions", args->perfect_predictions,
+                  "A diagnostic: hand the planner every car's next S s exactly with each "
+                  "telemetry, read from a copy of the simulator run ahead with the ego on its "
+                  "path (then on along the road), as CommonRoad's recorded predictions are. What "
+                  "the planner drives when prediction is no longer its limit; it changes the "
+                  "drive. In-process only. Cost: a copy run S s ahead per exchange (about 6x the "
+                  "drive's time at 6 s). Set prediction.lane_change_ghosts: 0 in --config to drop "
+                  "the hedge against futures it now knows. Default: 0 (off)")
+      ->check(CLI::Number & (CLI::IsMember({0.0}) | CLI::Range(0.5, 10.0)));
   sub->add_option("--judge-budget", args->judge_budget,
                   "Judging: 0.2 s blocks simulated per start before a search gives up (the start "
                   "is then undecided, never unavoidable). Default: " +

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "frenetic/drive/evaluators.h"
+#include "frenetic/drive/foresee.h"
 #include "frenetic/drive/record.h"
 #include "frenetic/percentile.h"
 #include "frenetic/units.h"
@@ -215,6 +216,7 @@ StatusOr<DriveReport> RunEpisode(std::shared_ptr<const World> world, const Scena
   path_y.reserve(256);
   while (!ep.done()) {
     wire::TelemetryAsReceived(ep.telemetry(), &received);
+    if (options.foresee > 0) Foresee(ep.sim(), options.foresee, &received.futures);
     trace.candidates.clear();
     const auto t0 = std::chrono::steady_clock::now();
     const plan::PlanResult& result = planner.Plan(received);
@@ -289,6 +291,7 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
       run.timing = options.timing;
       run.judge = options.judge;
       run.oracle = options.oracle;
+      run.foresee = options.foresee;
       if (options.progress) {
         run.progress = [&, w, exchanges = 0](const Episode& ep) mutable {
           if (++exchanges % 256 != 0) return;

@@ -131,12 +131,26 @@ TEST(DriveCli, TheOraclesForesightIsCheckedAndReported) {
   EXPECT_TRUE(a["oracle"]["through_search_mph"].is_number());
 }
 
+TEST(DriveCli, PerfectPredictionsAreCheckedAndInProcessOnly) {
+  for (const char* bad :
+       {"--perfect-predictions nan", "--perfect-predictions 0.2", "--perfect-predictions 11",
+        "--perfect-predictions 2 --connect ws://127.0.0.1:1/"}) {
+    CommandResult r = RunFrenetic(std::string("drive --seconds 5 ") + bad + " 2>&1");
+    EXPECT_NE(r.exit_code, 0) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--perfect-predictions"), std::string::npos) << bad << ": " << r.out;
+  }
+  CommandResult r = RunFrenetic(
+      "drive --seconds 10 --json --no-timing --no-judge --perfect-predictions 2 2>/dev/null");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_GT(nlohmann::json::parse(r.out)["distance_m"].get<double>(), 50.0);
+}
+
 TEST(DriveCli, HelpExplainsOptionsWithDefaults) {
   CommandResult r = RunFrenetic("drive --help");
   ASSERT_EQ(r.exit_code, 0);
-  for (const char* option :
-       {"--map", "--scenario", "--seed", "--laps", "--planner", "--record", "--json", "--episodes",
-        "--connect", "--progress", "--no-judge", "--judge-budget", "--oracle-foresight"}) {
+  for (const char* option : {"--map", "--scenario", "--seed", "--laps", "--planner", "--record",
+                             "--json", "--episodes", "--connect", "--progress", "--no-judge",
+                             "--judge-budget", "--oracle-foresight", "--perfect-predictions"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }
   EXPECT_NE(r.out.find("Default"), std::string::npos);

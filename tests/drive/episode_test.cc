@@ -352,5 +352,35 @@ TEST(RunEpisode, TheOracleWithAForesightPlansAheadOnlyThatFarAndSaysSo) {
       << with_ahead->ToText();
 }
 
+// Counts the telemetry messages that came with cars' futures, and drives as KeepLanePlanner.
+class FutureCounter : public testing::KeepLanePlanner {
+ public:
+  using KeepLanePlanner::KeepLanePlanner;
+  const plan::PlanResult& Plan(const plan::Telemetry& t) override {
+    ++messages;
+    with_futures += !t.futures.empty();
+    for (const plan::CarFuture& f : t.futures) longest = std::max(longest, f.x.size());
+    return KeepLanePlanner::Plan(t);
+  }
+  int messages = 0, with_futures = 0;
+  std::size_t longest = 0;
+};
+
+TEST(RunEpisode, PerfectPredictionsReachThePlannerOnlyWhenAskedFor) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  const EpisodeLimits limits{0, 0, 20, 60};
+  RunOptions options;
+  options.timing = false;
+  FutureCounter plain(world->line, 15), foreseeing(world->line, 15);
+  ASSERT_TRUE(RunEpisode(world, Scenario(), 5, limits, plain, options).ok());
+  options.foresee = 2.0;
+  ASSERT_TRUE(RunEpisode(world, Scenario(), 5, limits, foreseeing, options).ok());
+  EXPECT_GT(plain.messages, 100);
+  EXPECT_EQ(plain.with_futures, 0);
+  // Every message once the traffic is on the road; 2 s at 0.1 s: 21 samples.
+  EXPECT_GT(foreseeing.with_futures, foreseeing.messages * 9 / 10);
+  EXPECT_EQ(foreseeing.longest, 21u);
+}
+
 }  // namespace
 }  // namespace frenetic::sim

@@ -8,8 +8,11 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "frenetic/map/reference_line.h"
 #include "frenetic/plan/planner.h"
+#include "frenetic/sim/simulator.h"
 #include "frenetic/sim/world.h"
 
 namespace frenetic::sim::testing {
@@ -34,6 +37,20 @@ inline std::shared_ptr<const World> UdacityWorld() {
 #define FRENETIC_REQUIRE_UDACITY(world)                                              \
   auto world = ::frenetic::sim::testing::UdacityWorld();                             \
   if (!world) GTEST_SKIP() << "Udacity map absent: " << ::frenetic::sim::testing::UdacityMapPath()
+
+// Sets a path along the lane at d = 6 m from where the ego is: `seconds` s at `v` m/s.
+inline void DriveAlong(Simulator& sim, double v, double seconds) {
+  const map::ReferenceLine& line = *sim.world().line;
+  const plan::Telemetry t = sim.Telemetry();
+  const double s0 = line.ToFrenet(t.x, t.y).s;
+  std::vector<double> x, y;
+  for (int i = 1; i <= static_cast<int>(seconds / kTick); ++i) {
+    const map::CartesianPose p = line.ToCartesian(s0 + v * kTick * i, 6.0);
+    x.push_back(p.x);
+    y.push_back(p.y);
+  }
+  ASSERT_TRUE(sim.ApplyPath(x, y).ok());
+}
 
 // Keeps the lane it starts in (its measured d on the smooth line), accelerates at `accel` up to
 // `speed`, always sends `points` points: the unvisited previous path plus new ones.

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
+#include "frenetic/map/reference_line.h"
 #include "sim_test_util.h"
 
 namespace frenetic::sim {
@@ -101,6 +104,37 @@ TEST(Simulator, PathFollowingPreviousPathAndEndPath) {
   x[3] = std::nan("");
   EXPECT_FALSE(sim.ApplyPath(x, y).ok());
   EXPECT_EQ(sim.ego().path_size(), 46);
+}
+
+TEST(Simulator, ACloneRunsAsTheOriginalDoesAndApart) {
+  FRENETIC_REQUIRE_UDACITY(world);
+  auto created = Simulator::Create(world, Default(), 3);
+  ASSERT_TRUE(created.ok());
+  Simulator& sim = **created;
+  testing::DriveAlong(sim, 10.0, 20.0);
+  sim.Advance(500);  // 10 s: traffic spawned and moving, random draws made
+  const std::unique_ptr<Simulator> copy = sim.Clone();
+  const plan::Telemetry before = sim.Telemetry();
+  copy->Advance(250);
+  // The original did not move with its copy.
+  EXPECT_EQ(sim.ticks(), 500);
+  EXPECT_EQ(sim.Telemetry().x, before.x);
+  sim.Advance(250);
+  const plan::Telemetry a = sim.Telemetry(), b = copy->Telemetry();
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.previous_path_x, b.previous_path_x);
+  ASSERT_EQ(a.sensor_fusion.size(), b.sensor_fusion.size());
+  int moving = 0;
+  for (std::size_t i = 0; i < a.sensor_fusion.size(); ++i) {
+    EXPECT_EQ(a.sensor_fusion[i].x, b.sensor_fusion[i].x) << i;
+    EXPECT_EQ(a.sensor_fusion[i].y, b.sensor_fusion[i].y) << i;
+    EXPECT_EQ(a.sensor_fusion[i].vx, b.sensor_fusion[i].vx) << i;
+    moving += a.sensor_fusion[i].vx != 0 || a.sensor_fusion[i].vy != 0;
+  }
+  EXPECT_GT(moving, 3);
+  EXPECT_EQ(sim.monitor().distance(), copy->monitor().distance());
+  EXPECT_EQ(sim.lane_changes(), copy->lane_changes());
 }
 
 TEST(Simulator, StandsStillWithoutAPath) {

@@ -106,6 +106,10 @@ struct RunOptions {
   // After the drive, search how far any planner could have driven against its traffic
   // (OracleObserver, evaluators.h; DriveReport::oracle); unset: off. It never changes the drive.
   std::optional<OracleOptions> oracle;
+  // s: > 0 hands the planner every car's future that long with each telemetry (Foresee,
+  // foresee.h), as CommonRoad's recorded predictions are: what the planner drives with perfect
+  // predictions (a diagnostic; it changes the drive). 0: off.
+  double foresee = 0;
 };
 
 // Drives `planner` (Reset first) through one episode. The planner sees every telemetry number
@@ -133,6 +137,7 @@ struct EpisodesOptions {
   bool timing = true;                 // RunOptions::timing
   std::optional<JudgeOptions> judge;  // RunOptions::judge
   std::optional<OracleOptions> oracle;  // RunOptions::oracle
+  double foresee = 0;                   // RunOptions::foresee
   // Called after every finished episode and every 256 exchanges of a running one, one call at a
   // time (from the worker threads, under a lock); may be empty. It cannot change the results.
   std::function<void(const EpisodesProgress&)> progress;

@@ -40,6 +40,9 @@ class Simulator {
   Status ApplyPath(std::span<const double> x, std::span<const double> y);
   // Advances `ticks` physics ticks (each: ego, traffic, incidents, frame scheduler).
   void Advance(int ticks);
+  // An independent copy in the same state (traffic and its random draws included): advanced
+  // with the same paths it runs as this one would.
+  std::unique_ptr<Simulator> Clone() const;
 
   std::int64_t ticks() const { return ticks_; }
   double time() const { return ticks_ * kTick; }
@@ -66,6 +69,7 @@ class Simulator {
  private:
   Simulator(std::shared_ptr<const World> world, const Scenario& scenario, std::uint64_t seed,
             float x, float y, double yaw);
+  Simulator(const Simulator& other);
   void Tick();
   void UpdateView();
   bool UpdateMetrics();  // true when the ego changed lane
