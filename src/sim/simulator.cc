@@ -73,29 +73,10 @@ Simulator::Simulator(std::shared_ptr<const World> world, const Scenario& scenari
   view_.s = f.s;
   view_.d = f.d;
   UpdateView();
-  traffic_ = std::make_unique<Traffic>(world_, scenario_.traffic, scenario_.car_length,
-                                       scenario_.car_width, seed, view_);
+  traffic_.emplace(world_, scenario_.traffic, scenario_.car_length, scenario_.car_width, seed,
+                   view_);
   UpdateMetrics();
 }
-
-Simulator::Simulator(const Simulator& o)
-    : world_(o.world_),
-      scenario_(o.scenario_),
-      seed_(o.seed_),
-      ego_(o.ego_),
-      traffic_(std::make_unique<Traffic>(*o.traffic_)),
-      monitor_(o.monitor_),
-      ticks_(o.ticks_),
-      frame_phase_(o.frame_phase_),
-      view_(o.view_),
-      chord_s_(o.chord_s_),
-      chord_d_(o.chord_d_),
-      leader_(o.leader_),
-      min_gap_(o.min_gap_),
-      min_headway_(o.min_headway_),
-      lane_changes_(o.lane_changes_),
-      lane_(o.lane_),
-      breakdown_(o.breakdown_) {}
 
 std::unique_ptr<Simulator> Simulator::Clone() const {
   return std::unique_ptr<Simulator>(new Simulator(*this));

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "frenetic/plan/telemetry.h"
@@ -69,7 +70,7 @@ class Simulator {
  private:
   Simulator(std::shared_ptr<const World> world, const Scenario& scenario, std::uint64_t seed,
             float x, float y, double yaw);
-  Simulator(const Simulator& other);
+  Simulator(const Simulator& other) = default;  // Clone: every member copied
   void Tick();
   void UpdateView();
   bool UpdateMetrics();  // true when the ego changed lane
@@ -79,7 +80,7 @@ class Simulator {
   Scenario scenario_;
   std::uint64_t seed_;
   EgoCar ego_;
-  std::unique_ptr<Traffic> traffic_;
+  std::optional<Traffic> traffic_;  // set in the constructor, after the ego's view
   IncidentMonitor monitor_;
   std::int64_t ticks_ = 0;
   double frame_phase_ = 0;  // fraction of a rendered frame elapsed
