@@ -18,20 +18,18 @@ std::string Maybe(double v, const char* fmt_unit) {
 
 double Share(double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0; }
 
-// The "oracle" line of a report, and with a foresight (a receding search) a second one.
-std::string OracleText(double oracle_mph, double driven_mph, double foresight = 0, int stuck = 0,
-                       double through_s = 0, double through_search_m = 0,
-                       double through_driven_m = 0) {
+// The "oracle" line of a report, and with a foresight (a receding search, `r`) a second one.
+std::string OracleText(double oracle_mph, double driven_mph, const OracleResult& r) {
   std::string out = fmt::format(
       "oracle          {:.2f} mph along the road at best against this traffic (offline search), "
       "the ego {:.2f} mph there\n",
       oracle_mph, driven_mph);
-  if (foresight > 0) {
-    const double k = through_s > 0 ? units::kMpsToMph13 / through_s : 0;
+  if (r.foresight > 0) {
     out += fmt::format(
         "                foresight {:.1f} s: {} windows stuck; where it went through ({:.0f} s), "
         "the search {:.2f} mph, the ego {:.2f} mph\n",
-        foresight, stuck, through_s, through_search_m * k, through_driven_m * k);
+        r.foresight, r.stuck_windows, r.through_seconds, r.through_search_mph(),
+        r.through_driven_mph());
   }
   return out;
 }
@@ -237,9 +235,7 @@ std::string DriveReport::ToText() const {
   o << fmt::format("planning        p50 {:.3f} ms, p99 {:.3f} ms, max {:.3f} ms; {} fallback cycles\n",
                    plan_ms_p50, plan_ms_p99, plan_ms_max, plan_fallbacks);
   if (oracle_run) {
-    o << OracleText(oracle.mph(), oracle.driven_mph(), oracle.foresight, oracle.stuck_windows,
-                    oracle.through_seconds, oracle.through_search_m, oracle.through_driven_m)
-      << OracleWorstText(oracle, 3);
+    o << OracleText(oracle.mph(), oracle.driven_mph(), oracle) << OracleWorstText(oracle, 3);
   }
   if (judged) o << VerdictsText(CountVerdicts(*this));
   for (std::size_t n = 0; n < incident_log.size(); ++n) {
@@ -274,11 +270,12 @@ AggregateReport AggregateReport::From(std::vector<DriveReport> episodes) {
       a.oracle_run = true;
       a.oracle_mph += r.oracle.mph();
       a.driven_mph += r.oracle.driven_mph();
-      a.oracle_foresight = r.oracle.foresight;
-      a.oracle_stuck_windows += r.oracle.stuck_windows;
-      a.through_seconds += r.oracle.through_seconds;
-      a.through_search_m += r.oracle.through_search_m;
-      a.through_driven_m += r.oracle.through_driven_m;
+      OracleResult& sum = a.oracle_sum;
+      sum.foresight = r.oracle.foresight;
+      sum.stuck_windows += r.oracle.stuck_windows;
+      sum.through_seconds += r.oracle.through_seconds;
+      sum.through_search_m += r.oracle.through_search_m;
+      sum.through_driven_m += r.oracle.through_driven_m;
     }
     if (r.judged) {
       a.judged = true;
@@ -335,14 +332,13 @@ nlohmann::json AggregateReport::ToJson() const {
       {"per_episode", eps}};
   if (judged) out["judged"] = VerdictsJson(verdicts);
   if (oracle_run) {
-    const double k = through_seconds > 0 ? units::kMpsToMph13 / through_seconds : 0;
     out["oracle"] = {{"mph", oracle_mph},
                      {"driven_mph", driven_mph},
-                     {"foresight_s", oracle_foresight},
-                     {"stuck_windows", oracle_stuck_windows},
-                     {"through_seconds", through_seconds},
-                     {"through_search_mph", through_search_m * k},
-                     {"through_driven_mph", through_driven_m * k}};
+                     {"foresight_s", oracle_sum.foresight},
+                     {"stuck_windows", oracle_sum.stuck_windows},
+                     {"through_seconds", oracle_sum.through_seconds},
+                     {"through_search_mph", oracle_sum.through_search_mph()},
+                     {"through_driven_mph", oracle_sum.through_driven_mph()}};
   }
   return out;
 }
@@ -362,8 +358,7 @@ std::string AggregateReport::ToText() const {
                    plan_ms_p50, plan_ms_p99, plan_ms_max);
   o << BreakdownText(breakdown);
   if (oracle_run) {
-    o << OracleText(oracle_mph, driven_mph, oracle_foresight, oracle_stuck_windows, through_seconds,
-                    through_search_m, through_driven_m);
+    o << OracleText(oracle_mph, driven_mph, oracle_sum);
   }
   for (const DriveReport& r : episodes) {
     o << fmt::format("  seed {:<6} {:7.3f} mi  {:6.2f} mph  {:3d} incidents  first after {:.3f} mi",

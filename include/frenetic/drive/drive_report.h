@@ -70,11 +70,9 @@ struct AggregateReport {
   std::array<int, 4> verdicts{};  // incidents per Verdict, summed over episodes
   bool oracle_run = false;        // the episodes have an oracle search
   double oracle_mph = 0, driven_mph = 0;  // its speed and the ego's along the road, mean over episodes
-  // A receding search (OracleResult): its foresight, the stuck windows, and over the windows it
-  // went through its distance and the ego's, summed over episodes.
-  double oracle_foresight = 0;
-  int oracle_stuck_windows = 0;
-  double through_seconds = 0, through_search_m = 0, through_driven_m = 0;
+  // A receding search's foresight, and its stuck windows and through_* figures summed over
+  // episodes (no windows kept).
+  OracleResult oracle_sum;
   static AggregateReport From(std::vector<DriveReport> episodes);
   nlohmann::json ToJson() const;
   std::string ToText() const;
