@@ -22,6 +22,24 @@ TEST(DriveCli, JsonReportOnBundledTrack) {
   EXPECT_TRUE(j.contains("incidents"));
 }
 
+// On an empty road (the bundled `free` scenario) the planner keeps its lane, with no incident,
+// and once up to speed drives at the limit every second, under the simulator's cap. (Lanes'
+// limits that change with every bend ahead made a planner change lanes 10-40 times a lap
+// here: docs/udacity-results.md, the round of 2026-12-05.)
+TEST(DriveCli, OnAnEmptyRoadThePlannerKeepsItsLaneAtTheLimit) {
+  if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
+  CommandResult r = RunFrenetic("drive --map " + UdacityMap() +
+                                " --scenario free --seconds 120 --latency random --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["incidents"].get<int>(), 0) << r.out;
+  EXPECT_EQ(j["lane_changes"].get<int>(), 0);
+  const auto& b = j["breakdown"];
+  EXPECT_GT(b["at_limit_s"].get<double>(), 120 - 5) << b.dump();  // 48 mph within 2.7 s
+  EXPECT_GT(b["at_limit_mph"].get<double>(), 49.2) << b.dump();
+  EXPECT_LT(j["max_speed_mph"].get<double>(), 49.9);
+}
+
 TEST(DriveCli, BadInputGivesOneLineAndExitOne) {
   struct Case {
     std::string args, needle;

@@ -10,7 +10,8 @@ namespace {
 
 TEST(Scenario, EveryBundledScenarioLoads) {
   const auto names = ScenarioNames();
-  for (const char* required : {"udacity", "dense", "cut-in", "hard-brake", "blocked", "seam"}) {
+  for (const char* required :
+       {"udacity", "dense", "cut-in", "hard-brake", "blocked", "seam", "free"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
   }
   for (const auto& name : names) {
@@ -21,6 +22,9 @@ TEST(Scenario, EveryBundledScenarioLoads) {
   auto dense = LoadScenario("dense");
   ASSERT_TRUE(dense.ok());
   EXPECT_EQ(dense->traffic.cars, 24);
+  auto empty = LoadScenario("free");
+  ASSERT_TRUE(empty.ok());
+  EXPECT_EQ(empty->traffic.cars, 0);
   auto seam = LoadScenario("seam");
   ASSERT_TRUE(seam.ok());
   EXPECT_EQ(seam->start.kind, StartPose::Kind::kFrenet);
@@ -87,7 +91,7 @@ TEST(Scenario, BundledScenariosBuildOnTheCalibratedUdacityTraffic) {
   auto udacity = LoadScenario("udacity");
   ASSERT_TRUE(udacity.ok()) << udacity.message();
   EXPECT_GT(udacity->traffic.linear_drag, 0);  // calibrated, unlike the built-in default
-  for (const char* name : {"dense", "cut-in", "hard-brake", "blocked", "seam", "latency"}) {
+  for (const char* name : {"dense", "cut-in", "hard-brake", "blocked", "seam", "latency", "free"}) {
     auto sc = LoadScenario(name);
     ASSERT_TRUE(sc.ok()) << sc.message();
     EXPECT_EQ(sc->name, name);
