@@ -14,7 +14,9 @@ speeds move +-0.2 mph with chaos, so this pairs what can be paired:
 - per 20 s window (each starts from the ego's own state, so windows of the same episode, start
   time and length pair up; a lap's last, shorter window only when both drives ended it alike):
   the windows where NEW drove farthest past BASE and farthest behind it,
-  with the oracle's lanes and both egos' lanes.
+  with the oracle's lanes and both egos' lanes;
+- how the drives differ (when the reports have their breakdown): the speed at the limit and the
+  time there, the time following, lane changes and incidents.
 
 --json prints the same as one JSON object. Exit status 2 on unreadable or mismatched reports,
 with a one-line message. `--self-test` checks the arithmetic on made-up reports.
@@ -50,6 +52,20 @@ def load(path):
                                 for w in o["windows"]):
             raise Mismatch(f"{path}: episode {k + 1} has no oracle figures and windows")
     return report, episodes
+
+
+# The drive's figures from a report's breakdown (the whole run's), or None without one.
+DRIVE_FIELDS = ("at_limit_mph", "at_limit_s", "following_s", "lane_changes")
+
+
+def drive_figures(report):
+    b = report.get("breakdown")
+    if not isinstance(b, dict) or not all(isinstance(b.get(k), (int, float)) for k in DRIVE_FIELDS):
+        return None
+    figures = {k: b[k] for k in DRIVE_FIELDS}
+    incidents = report.get("incidents")
+    figures["incidents"] = incidents if isinstance(incidents, int) else None
+    return figures
 
 
 def describe(e):
@@ -95,6 +111,7 @@ def compare(base_path, new_path, top):
                 "new_lanes": wn.get("driven_lanes", ""),
             })
     windows.sort(key=lambda w: (-w["gain_m"], w["episode"], w["t"]))
+    drive_base, drive_new = drive_figures(base), drive_figures(new)
     return {
         "episodes": count,
         "ego_mph": {"base": ego_base, "new": ego_new},
@@ -104,6 +121,7 @@ def compare(base_path, new_path, top):
         "faster": sum(d > 1e-9 for d in diffs),
         "slower": sum(d < -1e-9 for d in diffs),
         "lead_closed": (ego_new - ego_base) / lead if lead > 0 else None,
+        "drive": {"base": drive_base, "new": drive_new} if drive_base and drive_new else None,
         "windows_paired": len(windows),
         "windows_changed": sum(abs(w["gain_m"]) > 1e-6 for w in windows),
         "best_windows": [w for w in windows[:top] if w["gain_m"] > 1e-6],
@@ -123,6 +141,15 @@ def text(r):
     ]
     if r["lead_closed"] is not None:
         lines.append(f"share of the oracle's lead closed: {100 * r['lead_closed']:.1f}%")
+    if r["drive"] is not None:
+        b, n = r["drive"]["base"], r["drive"]["new"]
+        line = (f"at the limit {b['at_limit_mph']:.2f} -> {n['at_limit_mph']:.2f} mph "
+                f"({b['at_limit_s']:,.0f} -> {n['at_limit_s']:,.0f} s), following "
+                f"{b['following_s']:,.0f} -> {n['following_s']:,.0f} s, lane changes "
+                f"{b['lane_changes']:,} -> {n['lane_changes']:,}")
+        if b["incidents"] is not None and n["incidents"] is not None:
+            line += f", incidents {b['incidents']} -> {n['incidents']}"
+        lines.append(line)
     lines.append(f"windows paired {r['windows_paired']}, changed {r['windows_changed']}")
     for title, key in (("farthest past the base", "best_windows"),
                        ("farthest behind the base", "worst_windows")):
@@ -149,7 +176,9 @@ def self_test():
                 {"t": t, "driven_m": m, "best_m": m + 10, "lanes": "1",
                  "driven_lanes": "1" * (40 if t < 40 else int(m))}
                 for t, m in w]}})
-        return {"oracle": {}, "per_episode": eps}
+        return {"oracle": {}, "per_episode": eps, "incidents": 0,
+                "breakdown": {"at_limit_mph": 49.3, "at_limit_s": 1000.0, "following_s": 100.0,
+                              "lane_changes": 12}}
 
     def write(path, obj):
         with open(path, "w", encoding="utf-8") as f:
@@ -185,8 +214,17 @@ def self_test():
         assert [w["gain_m"] for w in r["best_windows"]] == [30]
         assert [w["gain_m"] for w in r["worst_windows"]] == [-10]
         assert "+1.500 +- 0.500" in text(r)
+        assert r["drive"]["base"]["lane_changes"] == 12, r
+        assert ("at the limit 49.30 -> 49.30 mph (1,000 -> 1,000 s), following 100 -> 100 s, "
+                "lane changes 12 -> 12, incidents 0 -> 0") in text(r), text(r)
         refused(pb, bad, "bad.json", "a broken report was read")
         refused(bad, pn, "bad.json", "a broken report was read")
+        # A report without its breakdown: no drive line, the rest as before.
+        del new["breakdown"]
+        write(pn, new)
+        rb = compare(pb, pn, 5)
+        assert rb["drive"] is None and "at the limit" not in text(rb), rb
+        assert abs(rb["difference_mph"] - 1.5) < 1e-12, rb
         # --top 0 lists no window.
         r0 = compare(pb, pn, 0)
         assert r0["best_windows"] == [] and r0["worst_windows"] == [], r0
