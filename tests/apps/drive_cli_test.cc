@@ -24,7 +24,7 @@ TEST(DriveCli, JsonReportOnBundledTrack) {
 
 // On an empty road (the bundled `free` scenario) the planner keeps its lane, with no incident,
 // and once up to speed drives at the limit every second, under the simulator's cap. (Lanes'
-// limits that change with every bend ahead made a planner change lanes 10-40 times a lap
+// limits that change with every bend ahead made a planner change lanes 7-40 times a lap
 // here: docs/udacity-results.md, the round of 2026-12-05.)
 TEST(DriveCli, OnAnEmptyRoadThePlannerKeepsItsLaneAtTheLimit) {
   if (!HaveUdacityMap()) GTEST_SKIP() << "no " << UdacityMap();
