@@ -1,6 +1,5 @@
 #include "frenetic/drive/foresee.h"
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -37,36 +36,33 @@ void Foresee(const Simulator& sim, double seconds, std::vector<plan::CarFuture>*
   }
   (void)copy->ApplyPath(x, y);
   const int samples = static_cast<int>(std::floor(seconds / 0.1 + 1e-9)) + 1;
-  std::vector<int> ids;
-  for (const TrafficCar& c : copy->traffic().cars()) {
-    if (c.spawned) ids.push_back(c.id);
-  }
-  for (int id : ids) {
-    plan::CarFuture f;
-    f.id = id;
+  // The traffic's slots stay where they are (a respawn reuses its slot): each future reads its
+  // car's slot.
+  std::vector<std::size_t> slots;
+  for (std::size_t i = 0; i < copy->traffic().cars().size(); ++i) {
+    const TrafficCar& c = copy->traffic().cars()[i];
+    if (!c.spawned) continue;
+    slots.push_back(i);
+    plan::CarFuture& f = out->emplace_back();
+    f.id = c.id;
     f.dt = 0.1;
-    out->push_back(std::move(f));
   }
-  std::vector<char> cut(ids.size(), 0);
+  std::vector<char> cut(slots.size(), 0);
   for (int k = 0; k < samples; ++k) {
     if (k > 0) copy->Advance(5);
-    const auto& cars = copy->traffic().cars();
-    for (std::size_t i = 0; i < ids.size(); ++i) {
+    for (std::size_t i = 0; i < slots.size(); ++i) {
       if (cut[i]) continue;
-      const auto it = std::find_if(cars.begin(), cars.end(),
-                                   [&](const TrafficCar& c) { return c.id == ids[i]; });
+      const TrafficCar& c = copy->traffic().cars()[slots[i]];
       plan::CarFuture& f = (*out)[i];
-      const bool jumped =
-          it == cars.end() || !it->spawned ||
-          (!f.x.empty() && std::hypot(it->x - f.x.back(), it->y - f.y.back()) > kJump);
-      if (jumped) {
+      if (c.id != f.id || !c.spawned ||
+          (!f.x.empty() && std::hypot(c.x - f.x.back(), c.y - f.y.back()) > kJump)) {
         cut[i] = 1;
         continue;
       }
-      f.x.push_back(it->x);
-      f.y.push_back(it->y);
-      f.v.push_back(std::hypot(it->vx, it->vy));
-      f.heading.push_back(std::atan2(it->vy, it->vx));
+      f.x.push_back(c.x);
+      f.y.push_back(c.y);
+      f.v.push_back(std::hypot(c.vx, c.vy));
+      f.heading.push_back(std::atan2(c.vy, c.vx));
     }
   }
   std::erase_if(*out, [](const plan::CarFuture& f) { return f.x.size() < 2; });
