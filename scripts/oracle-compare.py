@@ -197,6 +197,9 @@ def self_test():
                   [[(0.0, 100), (20.0, 100), (40.0, 5)], [(0.0, 200)]])
     new = report([41.0, 44.0], [44.0, 46.0],
                  [[(0.0, 130), (20.0, 90), (40.0, 9)], [(0.0, 200)]])
+    new["breakdown"] = {"at_limit_mph": 49.5, "at_limit_s": 990.0, "following_s": 120.0,
+                        "lane_changes": 15}
+    new["incidents"] = 1
     with tempfile.TemporaryDirectory() as d:
         pb, pn, bad, single = (os.path.join(d, x)
                                for x in ("b.json", "n.json", "bad.json", "one.json"))
@@ -215,8 +218,8 @@ def self_test():
         assert [w["gain_m"] for w in r["worst_windows"]] == [-10]
         assert "+1.500 +- 0.500" in text(r)
         assert r["drive"]["base"]["lane_changes"] == 12, r
-        assert ("at the limit 49.30 -> 49.30 mph (1,000 -> 1,000 s), following 100 -> 100 s, "
-                "lane changes 12 -> 12, incidents 0 -> 0") in text(r), text(r)
+        assert ("at the limit 49.30 -> 49.50 mph (1,000 -> 990 s), following 100 -> 120 s, "
+                "lane changes 12 -> 15, incidents 0 -> 1") in text(r), text(r)
         refused(pb, bad, "bad.json", "a broken report was read")
         refused(bad, pn, "bad.json", "a broken report was read")
         # A report without its breakdown: no drive line, the rest as before.
