@@ -34,6 +34,16 @@ std::string OracleText(double oracle_mph, double driven_mph, const OracleResult&
   return out;
 }
 
+// The receding search's figures of `r` (its foresight, 0 for the whole-window search) into the
+// "oracle" object `out`: an episode's and the sum over episodes alike.
+void AddForesightJson(const OracleResult& r, nlohmann::json* out) {
+  (*out)["foresight_s"] = r.foresight;
+  (*out)["stuck_windows"] = r.stuck_windows;
+  (*out)["through_seconds"] = r.through_seconds;
+  (*out)["through_search_mph"] = r.through_search_mph();
+  (*out)["through_driven_mph"] = r.through_driven_mph();
+}
+
 nlohmann::json OracleWindowsJson(const OracleResult& r) {
   nlohmann::json arr = nlohmann::json::array();
   for (const OracleWindow& w : r.windows) {
@@ -192,12 +202,8 @@ nlohmann::json DriveReport::ToJson() const {
                      {"mph", oracle.mph()},
                      {"driven_m", oracle.driven_m},
                      {"driven_mph", oracle.driven_mph()},
-                     {"foresight_s", oracle.foresight},
-                     {"stuck_windows", oracle.stuck_windows},
-                     {"through_seconds", oracle.through_seconds},
-                     {"through_search_mph", oracle.through_search_mph()},
-                     {"through_driven_mph", oracle.through_driven_mph()},
                      {"windows", OracleWindowsJson(oracle)}};
+    AddForesightJson(oracle, &out["oracle"]);
   }
   return out;
 }
@@ -332,13 +338,8 @@ nlohmann::json AggregateReport::ToJson() const {
       {"per_episode", eps}};
   if (judged) out["judged"] = VerdictsJson(verdicts);
   if (oracle_run) {
-    out["oracle"] = {{"mph", oracle_mph},
-                     {"driven_mph", driven_mph},
-                     {"foresight_s", oracle_sum.foresight},
-                     {"stuck_windows", oracle_sum.stuck_windows},
-                     {"through_seconds", oracle_sum.through_seconds},
-                     {"through_search_mph", oracle_sum.through_search_mph()},
-                     {"through_driven_mph", oracle_sum.through_driven_mph()}};
+    out["oracle"] = {{"mph", oracle_mph}, {"driven_mph", driven_mph}};
+    AddForesightJson(oracle_sum, &out["oracle"]);
   }
   return out;
 }
