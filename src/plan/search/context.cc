@@ -150,12 +150,15 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     // changes over tens of metres).
     ws.kappa_s0 = start.s - Workspace::kEdgeBehind;
     const double h = 0.5 * Workspace::kEdgeBin;
-    double prev = std::abs(line.At(ws.kappa_s0).kappa);
+    double prev = line.At(ws.kappa_s0).kappa;
     for (int b = 0; b < static_cast<int>(ws.abs_kappa.size()); ++b) {
       const double x = ws.kappa_s0 + b * Workspace::kEdgeBin;
-      const double mid = std::abs(line.At(x + h).kappa), next = std::abs(line.At(x + 2 * h).kappa);
-      ws.abs_kappa[b] =
-          Finite(mid) && Finite(next) && Finite(prev) ? std::max({prev, mid, next}) : 0.0;
+      const double mid = line.At(x + h).kappa, next = line.At(x + 2 * h).kappa;
+      const bool finite = Finite(mid) && Finite(next) && Finite(prev);
+      ws.abs_kappa[b] = finite ? std::max({std::abs(prev), std::abs(mid), std::abs(next)}) : 0.0;
+      // Unknown: a range across 0, which rules nothing out.
+      ws.kappa_lo[b] = finite ? std::min({prev, mid, next}) : -1.0;
+      ws.kappa_hi[b] = finite ? std::max({prev, mid, next}) : 1.0;
       prev = next;
     }
   }

@@ -91,7 +91,6 @@ class Lattice {
   // Settings::curve_prefilter: whether lon bundle i's v^2 kappa along the line rules out every
   // candidate of it (the XY check would reject them all).
   bool TooFastForTheCurve(int i) const;
-  static constexpr double kCurveSlack = 0.15;
   // Whether lon bundle i's s' at a scoring sample within the check horizon, times
   // Workspace::speed_share, is kSpeedSlack over limits.max_speed: its XY speed is then over the
   // limit whatever the lateral move, and the XY check rejects every candidate of it whose checks

@@ -106,6 +106,56 @@ LimitChecker::Ticks LimitChecker::CandidateTicks(int c, const traj::FrenetTrajec
   return {&lon_ticks_.p[i * w], &lon_ticks_.v[i * w], &lat_ticks_.p[k * w], nullptr, i, n};
 }
 
+double LimitChecker::CurveExcess(const Ticks& ticks, int n_ticks) const {
+  // The XY check's lateral acceleration at tick j is vm^2 km: the mean XY speed of the ticks
+  // j - 9..j and the mean Menger curvature of the triples centred within them (feasibility.h).
+  // Both are at least their block's smallest value. At a tick at offset d, e = d toward the
+  // bend's outside (d grows to the right, kappa is left positive), on a line of curvature
+  // kappa: the XY speed is at least s' (1 + kappa e) and the XY curvature kappa / (1 + kappa e),
+  // which grows with kappa; kappa anywhere in its bin's [lo, hi] of one sign. A lateral move
+  // adds its own acceleration across, d'', and the turning frame's 2 kappa s' d': both are
+  // taken off. A bin across a sign change, or a tick off the table, says nothing (0).
+  constexpr int kBlock = 10;
+  const double limit = (1 + kCurveSlack) * cfg_.limits.max_accel;
+  const int bins = static_cast<int>(ws_.kappa_lo.size());
+  const double* s = ticks.s;
+  const double* sd = ticks.sd;
+  const double* d = ticks.d;
+  constexpr double kInvDt = 1.0 / kTickSeconds;
+  double best = 0;
+  for (int j0 = 1; j0 + kBlock - 1 <= n_ticks; j0 += kBlock) {
+    double v_lo = 1e9, k_lo = 1e9, across = 0;
+    for (int i = j0; i < j0 + kBlock; ++i) {
+      const double x = (s[i] - ws_.kappa_s0) / Workspace::kEdgeBin;
+      if (!(x >= 0 && x < bins)) return best / limit - 1.0;  // NaN too: no further
+      const int b = static_cast<int>(x);
+      const double lo = ws_.kappa_lo[b], hi = ws_.kappa_hi[b];
+      if (!(lo * hi > 0)) {
+        k_lo = 0;
+        break;
+      }
+      const double sign = hi > 0 ? 1.0 : -1.0;
+      const double small = std::min(std::abs(lo), std::abs(hi));
+      const double big = std::max(std::abs(lo), std::abs(hi));
+      const double e = sign * d[i];
+      const double grow_small = 1 + small * e, grow_big = 1 + big * e;
+      if (!(grow_small > 0 && grow_big > 0)) {
+        k_lo = 0;
+        break;
+      }
+      v_lo = std::min(v_lo, std::max(0.0, sd[i]) * std::min(grow_small, grow_big));
+      k_lo = std::min(k_lo, small / grow_small);
+      const double d1 =
+          (d[i + 1 <= n_ticks ? i + 1 : i] - d[i - 1]) * kInvDt / (i + 1 <= n_ticks ? 2.0 : 1.0);
+      const double d2 = i + 1 <= n_ticks ? (d[i + 1] - 2 * d[i] + d[i - 1]) * kInvDt * kInvDt : 0;
+      across = std::max(across, std::abs(d2) + 2 * big * std::abs(sd[i] * d1));
+    }
+    if (!(k_lo > 0)) continue;
+    best = std::max(best, v_lo * v_lo * k_lo - across);
+  }
+  return best / limit - 1.0;
+}
+
 int LimitChecker::BuildXyPath(const Ticks& ticks) {
   int n = first_new_;
   const int n_ticks = ticks.n > 0 ? ticks.n : ws_.n_ticks;
@@ -173,6 +223,13 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
          Reject::kLaneLine);
   }
   take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
+  if (cfg_.check.curve_prefilter && ticks.lon_slot >= 0 && !(worst > 0)) {
+    // A candidate's verdict only (its bundle rows): the refinement's Violation weighs how far
+    // its trial paths break a limit, which only the XY check measures.
+    if (const double over = CurveExcess(ticks, n_ticks); over > 0) {
+      take(over, Reject::kAcceleration);
+    }
+  }
   if (worst > 0) {                      // already infeasible: skip the XY conversion
     if (reason != nullptr) *reason = why;
     return worst;

@@ -100,6 +100,12 @@ class LimitChecker {
   double CandidateMeasure(int c, Reject* reason, bool any);
   // Its bundles' ticks (sampled anew when the slots hold other trajectories).
   Ticks CandidateTicks(int c, const traj::FrenetTrajectory& tr, int n);
+  // Settings::curve_prefilter: how far (a share of limits.max_accel, > 0: over) a lower bound
+  // of the XY check's lateral acceleration on the ticks [1, n_ticks] lies above
+  // (1 + kCurveSlack) x the limit, from the line's curvature and each tick's own d; <= 0 when
+  // it says nothing. The lattice's curve prefilter must assume any d within the road, which
+  // on a hairpin lets through bundles that every lateral move of the cycle takes too fast.
+  double CurveExcess(const Ticks& ticks, int n_ticks) const;
 
   const Settings& cfg_;
   const map::ReferenceLine& line_;

@@ -22,6 +22,10 @@ inline constexpr double kFollowerLateral = 1.0;
 inline constexpr double kStraddle = 0.8;       // m
 inline constexpr double kLaneLineBand = 0.9;   // m
 inline constexpr int kMaxStraddleTicks = 135;  // ticks
+// Settings::curve_prefilter's tests (Lattice::TooFastForTheCurve, LimitChecker::CurveExcess)
+// rule out a lateral acceleration this share above limits.max_accel: the XY check measures the
+// total on 0.2 s means, which the tests' lower bounds leave a little room to.
+inline constexpr double kCurveSlack = 0.15;
 
 inline bool Finite(double v) { return std::isfinite(v); }
 

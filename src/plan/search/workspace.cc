@@ -53,6 +53,8 @@ Workspace::Workspace(const Settings& cfg) {
   edge_lo.assign(edge_bins, 0.0);
   edge_hi.assign(edge_bins, 0.0);
   abs_kappa.assign(edge_bins, 0.0);
+  kappa_lo.assign(edge_bins, 0.0);
+  kappa_hi.assign(edge_bins, 0.0);
   car_s0.assign(kMaxCars, 0.0);
   car_d0.assign(kMaxCars, 0.0);
   collision_step = TicksIn(cfg.check.collision_dt);

@@ -150,5 +150,47 @@ TEST(LimitCheckerTest, BreaksLimitsAgreesWithTheFullViolation) {
   EXPECT_GT(lane_line_only, 0);  // the timer alone broken: only the last resort takes these
 }
 
+TEST(LimitCheckerTest, TheCurveTestRejectsOnlyWhatTheXyCheckRejects) {
+  REQUIRE_UDACITY_MAP();
+  // kS lies on a gentle bend; with a total acceleration limit of 0.5 m/s^2 (below the config's
+  // range: a test-only limit) the bend rules out the faster candidates, and with
+  // check.curve_prefilter each candidate's verdict may come from the curve's lower bound at
+  // its own d instead of the XY check. The verdict is the same either way; where the curve
+  // gave it, its excess is the curve's own and its reason the acceleration.
+  PlannerConfig config = testing::DefaultConfig();
+  ASSERT_TRUE(config.Set("check.curve_prefilter", 1).ok());
+  Stages st(config);
+  st.cfg.limits.max_accel = 0.5;
+  // The lattice's own prefilter assumes any d up to the farthest across the road allows (here
+  // 150 m on the outside, also test-only): it lets through bundles that only the candidates' own
+  // d, nearer the line, rule out.
+  st.cfg.limits.d_max = 150;
+  int by_curve = 0, broken = 0, total = 0;
+  for (const double d0 : {2.0, 6.0, 10.0}) {
+    for (const double v0 : {12.0, 16.0, 20.0}) {
+      st.Prepare({kS, v0, 0, d0, 0, 0});
+      st.lattice.Generate();
+      ASSERT_TRUE(st.scorer.Score());
+      const int n = static_cast<int>(st.ws.order.size());
+      for (int c = 0; c < n; ++c) {
+        Reject why = Reject::kCount, why_ref = Reject::kCount;
+        const double worst = st.limits.CandidateViolation(c, &why);
+        st.ws.FillTicks(st.ws.Candidate(c));
+        const double worst_ref = st.limits.Violation(&why_ref);  // the XY check's verdict
+        ASSERT_EQ(worst > 0, worst_ref > 0) << "candidate " << c << " d0 " << d0 << " v0 " << v0;
+        if (worst != worst_ref) {
+          ++by_curve;
+          EXPECT_GT(worst, 0) << "candidate " << c;
+          EXPECT_EQ(why, Reject::kAcceleration) << "candidate " << c;
+        }
+        broken += worst_ref > 0;
+        ++total;
+      }
+    }
+  }
+  EXPECT_GT(by_curve, total / 20) << "of " << total;
+  EXPECT_LT(broken, total) << "some are within the limits";
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search
