@@ -42,17 +42,22 @@ LeastHarm::LeastHarm(const Settings& cfg, Workspace& ws, Scorer& scorer, LimitCh
 
 bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   bare_known_ = false;
-  if (cfg_.check.clear_enough > 0) {
-    const int c = CheapestClearEnough(over_budget);
-    if (c >= 0) {
-      ws_.TakeWinner(c);
-      return true;
-    }
-    if (*over_budget) return false;
-  }
+  // The clear tests with the planner's lane-line limit, then, astride a line with the timer
+  // running, once more with the simulator's own count less a little: a clear way off the line
+  // that leaves it a few ticks later than the margin asks beats one that stays on it (the
+  // latest contact and the ranking below drop the timer).
+  int best = -1;
   bool all_known = false;
-  int best = BestClear(over_budget, &all_known, none_passed_before);
-  if (best < 0 && all_known && !*over_budget) best = LatestContact(over_budget);
+  const bool astride = ws_.straddle_at_start > 0;
+  for (int pass = 0; pass < (astride ? 2 : 1) && best < 0; ++pass) {
+    limits_.SetStraddleLimit(pass == 0 ? kMaxStraddleTicks : kLastResortStraddleTicks);
+    if (cfg_.check.clear_enough > 0) best = CheapestClearEnough(over_budget);
+    if (best < 0 && !*over_budget) best = BestClear(over_budget, &all_known, none_passed_before);
+    if (*over_budget || (best < 0 && !all_known)) break;
+  }
+  limits_.SetStraddleLimit(kMaxStraddleTicks);
+  if (*over_budget) return false;
+  if (best < 0 && all_known) best = LatestContact(over_budget);
   if (best >= 0) {
     ws_.TakeWinner(best);
     return true;

@@ -78,7 +78,8 @@ double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
   const traj::FrenetTrajectory tr = ws_.Candidate(c);
   Verdict* v = c < static_cast<int>(verdicts_.size()) ? &verdicts_[c] : nullptr;
   if (v != nullptr && (any || !v->any) && v->prefix_stamp == prefix_stamp_ &&
-      v->straddle == ws_.straddle_at_start && std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
+      v->straddle == ws_.straddle_at_start && v->straddle_limit == straddle_limit_ &&
+      std::memcmp(&v->tr, &tr, sizeof(tr)) == 0) {
     if (reason != nullptr) *reason = v->why;
     return v->worst;
   }
@@ -87,7 +88,9 @@ double LimitChecker::CandidateMeasure(int c, Reject* reason, bool any) {
   // An early answer (worst > 0 before every limit was measured) is not the whole verdict.
   const bool partial = any && worst > 0;
   if (reason != nullptr) *reason = why;
-  if (v != nullptr) *v = {tr, prefix_stamp_, ws_.straddle_at_start, why, worst, partial};
+  if (v != nullptr) {
+    *v = {tr, prefix_stamp_, ws_.straddle_at_start, straddle_limit_, why, worst, partial};
+  }
   return worst;
 }
 
@@ -205,7 +208,7 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
       off_road = std::max(off_road, EdgeExcess(tk_s[prev], tk_s[i], read));
     }
     if (any) {
-      const bool astride = lane_line && worst_straddle > kMaxStraddleTicks;
+      const bool astride = lane_line && worst_straddle > straddle_limit_;
       if (astride || cfg_.limits.d_min - dmin > 0 || dmax - cfg_.limits.d_max > 0 ||
           off_road > 0) {
         // The first one found (which one is worst is not known).
@@ -219,7 +222,7 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
   if (cfg_.road.uniform) off_road = std::max(cfg_.limits.d_min - dmin, dmax - cfg_.limits.d_max);
   take(off_road / cfg_.road.lane_width, Reject::kOffRoad);
   if (lane_line) {
-    take(static_cast<double>(worst_straddle - kMaxStraddleTicks) / kMaxStraddleTicks,
+    take(static_cast<double>(worst_straddle - straddle_limit_) / straddle_limit_,
          Reject::kLaneLine);
   }
   take(-sdmin - 0.05, Reject::kSpeed);  // never backwards

@@ -70,6 +70,13 @@ class LimitChecker {
   // answer): measured on its bundles' ticks, not remembered, ws.tk_* left as they are.
   bool CandidateBreaksLimitsBesidesTheLaneLine(int c);
 
+  // The lane-line timer's limit (ticks astride a line, from the start's count) the checks hold
+  // a trajectory to: kMaxStraddleTicks unless set. The least-harm choice, when no candidate
+  // keeps it, asks for the simulator's own count less a little (kLastResortStraddleTicks)
+  // before it drops the timer.
+  void SetStraddleLimit(int ticks) { straddle_limit_ = ticks; }
+  int straddle_limit() const { return straddle_limit_; }
+
  private:
   // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the
   // simulator may read it there.
@@ -119,7 +126,7 @@ class LimitChecker {
   struct Verdict {
     traj::FrenetTrajectory tr;
     std::uint64_t prefix_stamp = 0;
-    int straddle = 0;
+    int straddle = 0, straddle_limit = 0;
     Reject why = Reject::kCount;
     double worst = 0;
     bool any = false;  // measured with Measure(..., any): only worst > 0 is known
@@ -131,6 +138,7 @@ class LimitChecker {
   std::vector<map::CentrePoint> lon_centre_;
   std::vector<char> lon_centre_have_;  // lon_centre_'s row is the one of lon_ticks_' row
   std::uint64_t prefix_stamp_ = 1;
+  int straddle_limit_ = kMaxStraddleTicks;
 };
 
 }  // namespace frenetic::plan::search

@@ -22,6 +22,8 @@ inline constexpr double kFollowerLateral = 1.0;
 inline constexpr double kStraddle = 0.8;       // m
 inline constexpr double kLaneLineBand = 0.9;   // m
 inline constexpr int kMaxStraddleTicks = 135;  // ticks
+// The least harm's last try before it drops the timer: the simulator's 150 less 0.1 s.
+inline constexpr int kLastResortStraddleTicks = 145;  // ticks
 // Settings::curve_prefilter's tests (Lattice::TooFastForTheCurve, LimitChecker::CurveExcess)
 // rule out a lateral acceleration this share above limits.max_accel: the XY check measures the
 // total on 0.2 s means, which the tests' lower bounds leave a little room to.
