@@ -151,6 +151,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
     ws.kappa_s0 = start.s - Workspace::kEdgeBehind;
     const double h = 0.5 * Workspace::kEdgeBin;
     double prev = line.At(ws.kappa_s0).kappa;
+    ws.kappa_abs_max = 0;
     for (int b = 0; b < static_cast<int>(ws.abs_kappa.size()); ++b) {
       const double x = ws.kappa_s0 + b * Workspace::kEdgeBin;
       const double mid = line.At(x + h).kappa, next = line.At(x + 2 * h).kappa;
@@ -159,6 +160,7 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
       // Unknown: a range across 0, which rules nothing out.
       ws.kappa_lo[b] = finite ? std::min({prev, mid, next}) : -1.0;
       ws.kappa_hi[b] = finite ? std::max({prev, mid, next}) : 1.0;
+      ws.kappa_abs_max = std::max(ws.kappa_abs_max, finite ? ws.abs_kappa[b] : 1.0);
       prev = next;
     }
   }

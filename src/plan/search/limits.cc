@@ -125,6 +125,17 @@ double LimitChecker::CurveExcess(const Ticks& ticks, int n_ticks) const {
   const double* sd = ticks.sd;
   const double* d = ticks.d;
   constexpr double kInvDt = 1.0 / kTickSeconds;
+  // Nothing to find where the bound below, with the table's largest curvature, the fastest
+  // tick and the farthest across, is within the limit (a straight road's every candidate).
+  double v_max = 0, d_max = 0;
+  for (int i = 1; i <= n_ticks; ++i) {
+    v_max = std::max(v_max, sd[i]);
+    d_max = std::max(d_max, std::abs(d[i]));
+  }
+  const double kd = ws_.kappa_abs_max * d_max;
+  if (kd < 1 && v_max * v_max * (1 + kd) * (1 + kd) * ws_.kappa_abs_max / (1 - kd) <= limit) {
+    return -1.0;
+  }
   double best = 0;
   for (int j0 = 1; j0 + kBlock - 1 <= n_ticks; j0 += kBlock) {
     double v_lo = 1e9, k_lo = 1e9, across = 0;
