@@ -57,12 +57,35 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   }
   limits_.SetStraddleLimit(kMaxStraddleTicks);
   if (*over_budget) return false;
-  if (best < 0 && all_known) best = LatestContact(over_budget);
+  if (best < 0 && all_known) {
+    best = LatestContact(over_budget);
+    if (best >= 0 && astride) best = KeepSide(best);
+  }
   if (best >= 0) {
     ws_.TakeWinner(best);
     return true;
   }
   return !*over_budget && ChooseByRanking(over_budget, all_known);
+}
+
+int LeastHarm::KeepSide(int best) {
+  const int lane = ws_.prev_lat_lane;
+  if (lane < 0 || ws_.lat[ws_.cand_lat[best]].lane == lane) return best;
+  const int steps =
+      static_cast<int>(std::lround(kKeepSideSeconds / (ws_.collision_step * kTickSeconds)));
+  const int floor = collisions_.BareContact(best) - steps;
+  int keep = -1, keep_hit = 0;
+  for (const int c : ws_.order) {
+    if (ws_.lat[ws_.cand_lat[c]].lane != lane) continue;
+    const int hit = collisions_.BareContact(c);
+    if (hit < floor || (keep >= 0 && hit < keep_hit)) continue;
+    scorer_.ExactCost(c);
+    if (keep >= 0 && hit == keep_hit && !Cheaper(ws_, c, keep)) continue;
+    if (limits_.CandidateBreaksLimits(c)) continue;
+    keep = c;
+    keep_hit = hit;
+  }
+  return keep >= 0 ? keep : best;
 }
 
 int LeastHarm::CheapestClearEnough(bool* over_budget) {

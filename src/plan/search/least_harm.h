@@ -159,6 +159,9 @@ class LeastHarm {
   // was the last call), a hint that changes no choice, only the work.
   // With check.clear_enough > 0 the cheapest feasible candidate whose bare boxes keep that far
   // from every car comes first (CheapestClearEnough); the harm ranking only when none does.
+  // Astride a line with the timer running: the clear tests once more with the simulator's
+  // count (kLastResortStraddleTicks), and the latest contact keeps the last winner's side
+  // (KeepSide).
   bool Choose(bool* over_budget, bool none_passed_before = false);
 
  private:
@@ -191,6 +194,14 @@ class LeastHarm {
   // contact exact (known_ 1) unless it returns a candidate of a contact from latest_ on or is
   // cut short.
   int LatestContact(bool* over_budget);
+  // Astride a line with the timer running, after LatestContact chose `best`: the last winner's
+  // lane (ws.prev_lat_lane) when a feasible move there meets a car at most kKeepSideSeconds
+  // sooner (the latest such, then the cheapest), else best. When no candidate passes, the
+  // latest contact's choice can swing between the lanes either side from cycle to cycle as the
+  // predictions move; each new move first spends its start reversing the last one's motion
+  // across, and the ego stays on the line until the timer runs out.
+  int KeepSide(int best);
+  static constexpr double kKeepSideSeconds = 0.3;
   // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
   // pairs [first, last), taken by bound from a heap there; -1 when none is (or the deadline cut
   // it short). *k counts the candidates taken, for the deadline checks.

@@ -164,8 +164,9 @@ PlannerConfig ClearEnoughConfig(double metres) {
 // clearance, sorted, then the first feasible one with the lane-line timer; astride a line
 // (the timer running), the first clear one within the simulator's count less a little
 // (kLastResortStraddleTicks); else the first feasible one without the timer.
-// *last_resort: the choice came from the simulator's count.
-int ReferenceChoice(Stages& st, bool* last_resort = nullptr) {
+// *last_resort: the choice came from the simulator's count; *kept_side: from the last winner's
+// lane.
+int ReferenceChoice(Stages& st, bool* last_resort = nullptr, bool* kept_side = nullptr) {
   Workspace& ws = st.ws;
   std::vector<int> order = ws.order;
   std::vector<int> hit(ws.cand_cost.size());
@@ -195,7 +196,28 @@ int ReferenceChoice(Stages& st, bool* last_resort = nullptr) {
     st.limits.SetStraddleLimit(kMaxStraddleTicks);
     if (last_resort != nullptr) *last_resort = c >= 0;
   }
-  if (c < 0) c = first_feasible(true, false);
+  if (c < 0) {
+    c = first_feasible(true, false);
+    // Astride, the last winner's lane when a feasible move there meets a car at most 0.3 s
+    // sooner (the latest such, then the cheapest).
+    const int lane = ws.prev_lat_lane;
+    if (c >= 0 && ws.straddle_at_start > 0 && lane >= 0 && ws.lat[ws.cand_lat[c]].lane != lane) {
+      const int floor = hit[c] - 3;  // collision steps of 0.1 s
+      int keep = -1;
+      for (const int k : ws.order) {
+        if (ws.lat[ws.cand_lat[k]].lane != lane || hit[k] < floor) continue;
+        if (keep >= 0 && (hit[k] < hit[keep] || (hit[k] == hit[keep] && !Cheaper(ws, k, keep)))) {
+          continue;
+        }
+        st.ws.FillTicks(ws.Candidate(k));
+        if (st.limits.Violation(nullptr, true) <= 0) keep = k;
+      }
+      if (keep >= 0) {
+        c = keep;
+        if (kept_side != nullptr) *kept_side = true;
+      }
+    }
+  }
   if (c < 0) c = first_feasible(false, false);
   return c;
 }
@@ -205,42 +227,52 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
   Stages st;
   std::mt19937 rng(14);
   std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0);
-  int chosen = 0, last_resorts = 0;
-  for (int scene = 0; scene < 24; ++scene) {
+  int chosen = 0, last_resorts = 0, kept_sides = 0;
+  for (int scene = 0; scene < 48; ++scene) {
     // Traffic in every lane around the ego, denser scene by scene; the ego at various speeds
-    // and offsets, and with the lane-line count near and past its limit.
+    // and offsets, and with the lane-line count near and past its limit (then once for each
+    // lane the last winner may have gone to, and for none).
     std::vector<SceneCar> cars;
     for (int k = 0; k < 3 + scene / 2; ++k) {
       cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
     }
-    const double d0 = st.ws.lane_center[1] + (scene % 4 == 3 ? 1.6 : 0.0);
-    Start(st, cars);
-    st.Prepare({kS, 8.0 + scene % 12, 0, d0, 0, 0}, cars);
-    st.ws.straddle_at_start = scene % 4 == 3 ? 100 + 10 * (scene % 5) : 0;
-    st.lattice.Generate();
-    ASSERT_TRUE(st.scorer.Score());
-    // Every other scene, Choose makes the costs exact itself, as far as it needs them.
-    const bool lazy = scene % 2 == 1;
-    if (!lazy) {
+    const bool astride = scene % 4 == 3;
+    const double d0 = st.ws.lane_center[1] + (astride ? 1.6 : 0.0);
+    for (int prev = -1; prev < (astride ? 3 : 0); ++prev) {
+      Start(st, cars);
+      st.Prepare({kS, 8.0 + scene % 12, 0, d0, 0, 0}, cars);
+      // Near the limit, or with time left to leave the line either way.
+      st.ws.straddle_at_start = !astride               ? 0
+                                : (scene / 4) % 2 == 0 ? 100 + 10 * (scene % 5)
+                                                       : 20 + 20 * (scene % 5);
+      st.ws.prev_lat_lane = prev;
+      st.lattice.Generate();
+      ASSERT_TRUE(st.scorer.Score());
+      // Every other scene, Choose makes the costs exact itself, as far as it needs them.
+      const bool lazy = scene % 2 == 1;
+      if (!lazy) {
+        ASSERT_TRUE(st.scorer.ResolveAll());
+      }
+      bool over_budget = false;
+      // Every third scene says the last search found nothing passing (the candidates are then
+      // visited in cost order without bounds until a clear one is found): the same choice.
+      const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
       ASSERT_TRUE(st.scorer.ResolveAll());
+      bool last_resort = false, kept_side = false;
+      const int expected = ReferenceChoice(st, &last_resort, &kept_side);
+      last_resorts += last_resort;
+      kept_sides += kept_side;
+      EXPECT_FALSE(over_budget);
+      EXPECT_EQ(ok, expected >= 0) << "scene " << scene << " prev " << prev;
+      if (ok) {
+        EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene << " prev " << prev;
+      }
+      chosen += ok;
     }
-    bool over_budget = false;
-    // Every third scene says the last search found nothing passing (the candidates are then
-    // visited in cost order without bounds until a clear one is found): the same choice.
-    const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
-    ASSERT_TRUE(st.scorer.ResolveAll());
-    bool last_resort = false;
-    const int expected = ReferenceChoice(st, &last_resort);
-    last_resorts += last_resort;
-    EXPECT_FALSE(over_budget);
-    EXPECT_EQ(ok, expected >= 0) << "scene " << scene;
-    if (ok) {
-      EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene;
-    }
-    chosen += ok;
   }
-  EXPECT_GT(chosen, 12);
+  EXPECT_GT(chosen, 24);
   EXPECT_GT(last_resorts, 0) << "a way off the line within the simulator's count decided";
+  EXPECT_GT(kept_sides, 0) << "the last winner's lane decided";
 }
 
 // check.clear_enough: the cheapest candidate (exact cost, then index) whose bare boxes keep
