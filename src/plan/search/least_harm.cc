@@ -74,8 +74,10 @@ int LeastHarm::KeepSide(int best) {
   const int steps =
       static_cast<int>(std::lround(kKeepSideSeconds / (ws_.collision_step * kTickSeconds)));
   const int floor = collisions_.BareContact(best) - steps;
-  int keep = -1, keep_hit = 0;
+  int keep = -1, keep_hit = 0, k = 0;
   for (const int c : ws_.order) {
+    // Out of time: the latest contact's own choice.
+    if ((++k & 31) == 0 && clock_.ChecksOver(cfg_.budget_ms)) return best;
     if (ws_.lat[ws_.cand_lat[c]].lane != lane) continue;
     const int hit = collisions_.BareContact(c);
     if (hit < floor || (keep >= 0 && hit < keep_hit)) continue;

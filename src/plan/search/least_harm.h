@@ -199,7 +199,8 @@ class LeastHarm {
   // sooner (the latest such, then the cheapest), else best. When no candidate passes, the
   // latest contact's choice can swing between the lanes either side from cycle to cycle as the
   // predictions move; each new move first spends its start reversing the last one's motion
-  // across, and the ego stays on the line until the timer runs out.
+  // across, and the ego stays on the line until the timer runs out. Out of time (the checks'
+  // deadline), best.
   int KeepSide(int best);
   static constexpr double kKeepSideSeconds = 0.3;
   // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
