@@ -159,9 +159,10 @@ double LimitChecker::CurveExcess(const Ticks& ticks, int n_ticks) const {
       }
       v_lo = std::min(v_lo, std::max(0.0, sd[i]) * std::min(grow_small, grow_big));
       k_lo = std::min(k_lo, small / grow_small);
-      const double d1 =
-          (d[i + 1 <= n_ticks ? i + 1 : i] - d[i - 1]) * kInvDt / (i + 1 <= n_ticks ? 2.0 : 1.0);
-      const double d2 = i + 1 <= n_ticks ? (d[i + 1] - 2 * d[i] + d[i - 1]) * kInvDt * kInvDt : 0;
+      // d' and d'' by central differences (the last tick: d' backward, d'' unknown, 0).
+      const int next = std::min(i + 1, n_ticks);
+      const double d1 = (d[next] - d[i - 1]) * kInvDt / (next - i + 1);
+      const double d2 = next > i ? (d[next] - 2 * d[i] + d[i - 1]) * kInvDt * kInvDt : 0;
       across = std::max(across, std::abs(d2) + 2 * big * std::abs(sd[i] * d1));
     }
     if (!(k_lo > 0)) continue;

@@ -75,7 +75,6 @@ class LimitChecker {
   // keeps it, asks for the simulator's own count less a little (kLastResortStraddleTicks)
   // before it drops the timer.
   void SetStraddleLimit(int ticks) { straddle_limit_ = ticks; }
-  int straddle_limit() const { return straddle_limit_; }
 
  private:
   // Violation's read-d window from tick prev to tick i of the ticks s, d: the range of d as the

@@ -116,7 +116,9 @@ struct Workspace {
   // The same bins' smallest and largest signed kappa (1/m, left positive), from the same three
   // reads: the limit checks' curve test of each candidate (LimitChecker::CurveExcess).
   std::vector<double> kappa_lo, kappa_hi;
-  double kappa_abs_max = 0;  // the largest of abs_kappa (1/m)
+  // The largest of abs_kappa (1/m), a bin whose reads were not finite counting as 1: the curve
+  // test's bound of what any candidate can meet (LimitChecker::CurveExcess).
+  double kappa_abs_max = 0;
   // The lattice's speed prefilter (Lattice::TooFastForTheVehicle): the share of s' that is at
   // least the XY speed anywhere within the road up to speed_reach m along s from the start (0:
   // none is known), from the line's largest |kappa| there.
