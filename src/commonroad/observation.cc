@@ -107,6 +107,27 @@ Footprint AppendFuture(const Obstacle& o, int q, const State& sq, const std::opt
   return fq;
 }
 
+// A set-based obstacle's growth rates (m/s) from its first occupancy (the step after its
+// initial state, whose footprint is its bare shape) to `fp`, its footprint at `step`: what a
+// sensor has seen of it so far, none before two occupancies. Never negative.
+void GrowthSoFar(const Obstacle& o, int step, const Footprint& fp, double dt,
+                 plan::SensorCar* row) {
+  const int first = o.initial.time_step + 1;
+  if (o.role != ObstacleRole::kDynamic || o.prediction != ObstaclePrediction::kSetBased ||
+      step <= first || !(dt > 0)) {
+    return;
+  }
+  const std::optional<Footprint> f1 = FootprintAt(o, first);
+  if (!f1) return;
+  const double time = (step - first) * dt;
+  const auto rate = [time](double now, double then) {
+    const double r = (now - then) / time;
+    return r > 0 ? r : 0.0;  // NaN and shrinking: 0
+  };
+  row->length_rate = rate(fp.length, f1->length);
+  row->width_rate = rate(fp.width, f1->width);
+}
+
 }  // namespace
 
 std::optional<Footprint> FootprintAt(const Obstacle& o, int step) {
@@ -149,6 +170,7 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     row.d = fo.d;
     row.length = fp.length;
     row.width = fp.width;
+    GrowthSoFar(o, step, fp, dt, &row);
     out->sensor_fusion.push_back(row);
     if (mode != PredictionMode::kRecorded) continue;
     if (futures == out->futures.size()) out->futures.emplace_back();

@@ -179,11 +179,14 @@ void Rescue::Predict(const plan::Telemetry& t) {
       add(Source::kFuture, length, width).future = future;
       continue;
     }
+    const double length_rate = std::isfinite(car.length_rate) ? car.length_rate : 0.0;
+    const double width_rate = std::isfinite(car.width_rate) ? car.width_rate : 0.0;
     if (std::hypot(car.vx, car.vy) <= 0.1) {
       const double side = std::max(length, width);
       Source& src = add(Source::kStill, side, side);
       src.x = car.x;
       src.y = car.y;
+      src.length_rate = src.width_rate = std::max(length_rate, width_rate);
       continue;
     }
     // Without a future: on along the road at its speed along the road, at its offset from the
@@ -193,6 +196,8 @@ void Rescue::Predict(const plan::Telemetry& t) {
     const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
     const double road_heading = line.At(fe.s).heading;
     Source& src = add(Source::kAlong, length, width);
+    src.length_rate = length_rate;
+    src.width_rate = width_rate;
     src.x = fe.s;
     src.y = fe.d;
     src.along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
@@ -233,7 +238,12 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
           half_width = 0.5 * f.widths[i];
           radius = std::hypot(half_length, half_width);
         }
-      } else if (src.kind == Source::kAlong) {
+      } else if (src.length_rate > 0 || src.width_rate > 0) {  // widening as seen so far
+        half_length += 0.5 * src.length_rate * step * dt_;
+        half_width += 0.5 * src.width_rate * step * dt_;
+        radius = std::hypot(half_length, half_width);
+      }
+      if (src.kind == Source::kAlong) {
         double d = src.y, rel = src.rel;
         if (src.across != 0) {
           d += src.across * step * dt_;

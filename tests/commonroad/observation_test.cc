@@ -213,6 +213,30 @@ TEST(ObserveTest, ASetBasedObstacleIsItsOccupancysBox) {
   EXPECT_NEAR(Row(t, 40)->length, 10, 1e-9);
 }
 
+// How fast its box grew, from its first region (step 1: its initial shape is the bare car) to
+// the present one: none until two regions are seen, in either mode; the bare shape's jump to
+// the first region is not growth.
+TEST(ObserveTest, ASetBasedObstaclesGrowthIsWhatItsRegionsShowedSoFar) {
+  const Scenario s = Parse(GrowingSetBasedXml());
+  plan::Telemetry t;
+  for (const int k : {0, 1}) {
+    Observe(s, k, Line(), 10, PredictionMode::kConstantVelocity, &t);
+    ASSERT_NE(Row(t, 40), nullptr) << k;
+    EXPECT_EQ(Row(t, 40)->length_rate, 0) << k;
+    EXPECT_EQ(Row(t, 40)->width_rate, 0) << k;
+  }
+  // Step 3: 5 x 2.2 m at step 1, 7 x 2.6 m now, 0.2 s later.
+  Observe(s, 3, Line(), 10, PredictionMode::kConstantVelocity, &t);
+  ASSERT_NE(Row(t, 40), nullptr);
+  EXPECT_NEAR(Row(t, 40)->length_rate, 10, 1e-9);
+  EXPECT_NEAR(Row(t, 40)->width_rate, 2, 1e-9);
+  // Step 8 (past the gap at step 5): 12 x 3.6 m, 0.7 s after step 1.
+  Observe(s, 8, Line(), 10, PredictionMode::kRecorded, &t);
+  ASSERT_NE(Row(t, 40), nullptr);
+  EXPECT_NEAR(Row(t, 40)->length_rate, 10, 1e-9);
+  EXPECT_NEAR(Row(t, 40)->width_rate, 2, 1e-9);
+}
+
 TEST(ObserveTest, ASetBasedObstaclesFutureIsItsOccupanciesCentres) {
   const Scenario s = Parse(GrowingSetBasedXml());
   plan::Telemetry t;

@@ -18,6 +18,10 @@ struct SensorCar {
   // Footprint, m: 0 (the Udacity simulator's rows) means the planner's check.car_length /
   // check.car_width.
   double length = 0, width = 0;
+  // m/s: how fast the footprint has grown so far (a CommonRoad set-based prediction's occupancy
+  // widens with its uncertainty), 0 for a fixed one. Only what was seen up to now: a
+  // constant-velocity prediction grows the footprint on at these rates.
+  double length_rate = 0, width_rate = 0;
 };
 
 // A car's known future (a CommonRoad scenario's recorded trajectory, for `--prediction
