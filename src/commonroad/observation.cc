@@ -107,9 +107,11 @@ Footprint AppendFuture(const Obstacle& o, int q, const State& sq, const std::opt
   return fq;
 }
 
-// A set-based obstacle's growth rates (m/s) from its first occupancy (the step after its
-// initial state, whose footprint is its bare shape) to `fp`, its footprint at `step`: what a
-// sensor has seen of it so far, none before two occupancies. Never negative.
+// A set-based obstacle's growth at `step` (fp: its footprint there), read from its first
+// occupancy (the step after its initial state, whose footprint is the bare shape) to the
+// present one: a reachable set's extent grows as c tau^2, tau the time since the prediction's
+// start (its initial state), so c = (now - first) / (tau_now^2 - tau_first^2), the rate now 2 c
+// tau_now and its growth 2 c. None before two occupancies are seen; never shrinking.
 void GrowthSoFar(const Obstacle& o, int step, const Footprint& fp, double dt,
                  plan::SensorCar* row) {
   const int first = o.initial.time_step + 1;
@@ -119,13 +121,16 @@ void GrowthSoFar(const Obstacle& o, int step, const Footprint& fp, double dt,
   }
   const std::optional<Footprint> f1 = FootprintAt(o, first);
   if (!f1) return;
-  const double time = (step - first) * dt;
-  const auto rate = [time](double now, double then) {
-    const double r = (now - then) / time;
-    return r > 0 ? r : 0.0;  // NaN and shrinking: 0
+  const double tau1 = dt, tau = (step - o.initial.time_step) * dt;
+  const auto c = [&](double now, double then) {
+    const double v = (now - then) / (tau * tau - tau1 * tau1);
+    return v > 0 ? v : 0.0;  // NaN and shrinking: 0
   };
-  row->length_rate = rate(fp.length, f1->length);
-  row->width_rate = rate(fp.width, f1->width);
+  const double cl = c(fp.length, f1->length), cw = c(fp.width, f1->width);
+  row->length_rate = 2 * cl * tau;
+  row->width_rate = 2 * cw * tau;
+  row->length_accel = 2 * cl;
+  row->width_accel = 2 * cw;
 }
 
 }  // namespace

@@ -267,6 +267,12 @@ TEST(RescueTest, AFootprintSeenGrowingGrowsOnWithoutAFuture) {
   still.length_rate = 4.0;
   rescue.Predict(Scene(10, {still}));
   EXPECT_EQ(rescue.PathHit(x, y), 30);
+  // Its rate growing at 8 m/s^2 instead: the half side 2 t^2 more, 0.02 k^2 m at step k; met when
+  // 10 + k + 2.3 >= 47.75 - 0.02 k^2.
+  still.length_rate = 0;
+  still.length_accel = 8.0;
+  rescue.Predict(Scene(10, {still}));
+  EXPECT_EQ(rescue.PathHit(x, y), 24);
   // A car beside the ego in the other lane at its speed: clear while it keeps its width, and
   // met once it has widened across the 3.5 m between the lanes' centres, sooner the faster.
   Straight(10, kLane1, 10, 250, &x, &y);
@@ -282,8 +288,9 @@ TEST(RescueTest, AFootprintSeenGrowingGrowsOnWithoutAFuture) {
   const int fast = rescue.PathHit(x, y);
   EXPECT_GT(fast, 0);
   EXPECT_LT(fast, slow);
-  // Not finite: no growth.
+  // Not finite, or shrinking: no growth.
   beside.width_rate = std::numeric_limits<double>::quiet_NaN();
+  beside.width_accel = -5.0;
   rescue.Predict(Scene(10, {beside}));
   EXPECT_EQ(rescue.PathHit(x, y), 0);
 }
