@@ -107,32 +107,6 @@ Footprint AppendFuture(const Obstacle& o, int q, const State& sq, const std::opt
   return fq;
 }
 
-// A set-based obstacle's growth at `step` (fp: its footprint there), read from its first
-// occupancy (the step after its initial state, whose footprint is the bare shape) to the
-// present one: a reachable set's extent grows as c tau^2, tau the time since the prediction's
-// start (its initial state), so c = (now - first) / (tau_now^2 - tau_first^2), the rate now 2 c
-// tau_now and its growth 2 c. None before two occupancies are seen; never shrinking.
-void GrowthSoFar(const Obstacle& o, int step, const Footprint& fp, double dt,
-                 plan::SensorCar* row) {
-  const int first = o.initial.time_step + 1;
-  if (o.role != ObstacleRole::kDynamic || o.prediction != ObstaclePrediction::kSetBased ||
-      step <= first || !(dt > 0)) {
-    return;
-  }
-  const std::optional<Footprint> f1 = FootprintAt(o, first);
-  if (!f1) return;
-  const double tau1 = dt, tau = (step - o.initial.time_step) * dt;
-  const auto c = [&](double now, double then) {
-    const double v = (now - then) / (tau * tau - tau1 * tau1);
-    return v > 0 ? v : 0.0;  // NaN and shrinking: 0
-  };
-  const double cl = c(fp.length, f1->length), cw = c(fp.width, f1->width);
-  row->length_rate = 2 * cl * tau;
-  row->width_rate = 2 * cw * tau;
-  row->length_accel = 2 * cl;
-  row->width_accel = 2 * cw;
-}
-
 }  // namespace
 
 std::optional<Footprint> FootprintAt(const Obstacle& o, int step) {
@@ -175,7 +149,6 @@ void Observe(const Scenario& sc, int step, const map::ReferenceLine& line, doubl
     row.d = fo.d;
     row.length = fp.length;
     row.width = fp.width;
-    GrowthSoFar(o, step, fp, dt, &row);
     out->sensor_fusion.push_back(row);
     if (mode != PredictionMode::kRecorded) continue;
     if (futures == out->futures.size()) out->futures.emplace_back();

@@ -179,16 +179,11 @@ void Rescue::Predict(const plan::Telemetry& t) {
       add(Source::kFuture, length, width).future = future;
       continue;
     }
-    const auto finite = [](double v) { return std::isfinite(v) && v > 0 ? v : 0.0; };
-    const double length_rate = finite(car.length_rate), width_rate = finite(car.width_rate);
-    const double length_accel = finite(car.length_accel), width_accel = finite(car.width_accel);
     if (std::hypot(car.vx, car.vy) <= 0.1) {
       const double side = std::max(length, width);
       Source& src = add(Source::kStill, side, side);
       src.x = car.x;
       src.y = car.y;
-      src.length_rate = src.width_rate = std::max(length_rate, width_rate);
-      src.length_accel = src.width_accel = std::max(length_accel, width_accel);
       continue;
     }
     // Without a future: on along the road at its speed along the road, at its offset from the
@@ -198,10 +193,6 @@ void Rescue::Predict(const plan::Telemetry& t) {
     const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
     const double road_heading = line.At(fe.s).heading;
     Source& src = add(Source::kAlong, length, width);
-    src.length_rate = length_rate;
-    src.width_rate = width_rate;
-    src.length_accel = length_accel;
-    src.width_accel = width_accel;
     src.x = fe.s;
     src.y = fe.d;
     src.along = car.vx * std::cos(road_heading) + car.vy * std::sin(road_heading);
@@ -242,14 +233,7 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
           half_width = 0.5 * f.widths[i];
           radius = std::hypot(half_length, half_width);
         }
-      } else if (src.length_rate > 0 || src.width_rate > 0 || src.length_accel > 0 ||
-                 src.width_accel > 0) {  // widening as seen so far
-        const double t = step * dt_;
-        half_length += 0.5 * (src.length_rate * t + 0.5 * src.length_accel * t * t);
-        half_width += 0.5 * (src.width_rate * t + 0.5 * src.width_accel * t * t);
-        radius = std::hypot(half_length, half_width);
-      }
-      if (src.kind == Source::kAlong) {
+      } else if (src.kind == Source::kAlong) {
         double d = src.y, rel = src.rel;
         if (src.across != 0) {
           d += src.across * step * dt_;

@@ -213,38 +213,6 @@ TEST(ObserveTest, ASetBasedObstacleIsItsOccupancysBox) {
   EXPECT_NEAR(Row(t, 40)->length, 10, 1e-9);
 }
 
-// How fast its box grows, read from its first region (step 1: its initial shape is the bare
-// car) to the present one as a reachable set's c tau^2 (tau: time since step 0): the rate now 2 c
-// tau and its growth 2 c. None until two regions are seen, in either mode; the bare shape's jump
-// to the first region is not growth.
-TEST(ObserveTest, ASetBasedObstaclesGrowthIsWhatItsRegionsShowedSoFar) {
-  const Scenario s = Parse(GrowingSetBasedXml());
-  plan::Telemetry t;
-  for (const int k : {0, 1}) {
-    Observe(s, k, Line(), 10, PredictionMode::kConstantVelocity, &t);
-    ASSERT_NE(Row(t, 40), nullptr) << k;
-    EXPECT_EQ(Row(t, 40)->length_rate, 0) << k;
-    EXPECT_EQ(Row(t, 40)->width_rate, 0) << k;
-    EXPECT_EQ(Row(t, 40)->length_accel, 0) << k;
-    EXPECT_EQ(Row(t, 40)->width_accel, 0) << k;
-  }
-  // Step 3: 5 x 2.2 m at 0.1 s, 7 x 2.6 m at 0.3 s: c = 2 / 0.08 and 0.4 / 0.08.
-  Observe(s, 3, Line(), 10, PredictionMode::kConstantVelocity, &t);
-  ASSERT_NE(Row(t, 40), nullptr);
-  EXPECT_NEAR(Row(t, 40)->length_rate, 2 * 25 * 0.3, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->length_accel, 2 * 25, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->width_rate, 2 * 5 * 0.3, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->width_accel, 2 * 5, 1e-9);
-  // Step 8 (past the gap at step 5): 12 x 3.6 m at 0.8 s.
-  Observe(s, 8, Line(), 10, PredictionMode::kRecorded, &t);
-  ASSERT_NE(Row(t, 40), nullptr);
-  const double cl = 7 / (0.64 - 0.01), cw = 1.4 / (0.64 - 0.01);
-  EXPECT_NEAR(Row(t, 40)->length_rate, 2 * cl * 0.8, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->length_accel, 2 * cl, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->width_rate, 2 * cw * 0.8, 1e-9);
-  EXPECT_NEAR(Row(t, 40)->width_accel, 2 * cw, 1e-9);
-}
-
 TEST(ObserveTest, ASetBasedObstaclesFutureIsItsOccupanciesCentres) {
   const Scenario s = Parse(GrowingSetBasedXml());
   plan::Telemetry t;

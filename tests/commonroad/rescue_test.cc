@@ -5,7 +5,7 @@
 // (kept while it still meets it), and no search for a goal out of reach, along the road or
 // across it; a bound of the swerve across the road; a predicted car whose footprint grows; a
 // way to a goal held and driven on when the planner sends no path that passes; a car moving
-// across predicted into the next lane; a footprint seen growing that grows on.
+// across predicted into the next lane.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -250,49 +250,6 @@ TEST(RescueTest, APredictedCarWhoseFootprintGrowsIsCheckedAtEachSamplesSize) {
   rescue.Predict(t);
   // Its rear at 50 - (2.25 + k): met when 10 + k + 2.3 >= 47.75 - k, step 18.
   EXPECT_EQ(rescue.PathHit(x, y), 18);
-}
-
-// Without a future (constant-velocity predictions) a footprint seen growing (a set-based
-// prediction's region) grows on at the rates seen: standing, as a square; moving, along and
-// across.
-TEST(RescueTest, AFootprintSeenGrowingGrowsOnWithoutAFuture) {
-  const auto road = TwoLanes();
-  Rescue rescue(*road, VehicleParams(), kStep);
-  std::vector<double> x, y;
-  Straight(10, kLane0, 10, 250, &x, &y);  // 1 m a step
-  plan::SensorCar still = Row(1, 50, kLane0, 0.0);
-  rescue.Predict(Scene(10, {still}));
-  EXPECT_EQ(rescue.PathHit(x, y), 36);  // as above: its rear at 47.75 m
-  // 4 m/s longer: its half side 0.2 m more a step; met when 10 + k + 2.3 >= 47.75 - 0.2 k.
-  still.length_rate = 4.0;
-  rescue.Predict(Scene(10, {still}));
-  EXPECT_EQ(rescue.PathHit(x, y), 30);
-  // Its rate growing at 8 m/s^2 instead: the half side 2 t^2 more, 0.02 k^2 m at step k; met when
-  // 10 + k + 2.3 >= 47.75 - 0.02 k^2.
-  still.length_rate = 0;
-  still.length_accel = 8.0;
-  rescue.Predict(Scene(10, {still}));
-  EXPECT_EQ(rescue.PathHit(x, y), 24);
-  // A car beside the ego in the other lane at its speed: clear while it keeps its width, and
-  // met once it has widened across the 3.5 m between the lanes' centres, sooner the faster.
-  Straight(10, kLane1, 10, 250, &x, &y);
-  plan::SensorCar beside = Row(2, 10, kLane0, 10.0);
-  rescue.Predict(Scene(10, {beside}));
-  EXPECT_EQ(rescue.PathHit(x, y), 0);
-  beside.width_rate = 1.0;
-  rescue.Predict(Scene(10, {beside}));
-  const int slow = rescue.PathHit(x, y);
-  EXPECT_GT(slow, 0);
-  beside.width_rate = 2.0;
-  rescue.Predict(Scene(10, {beside}));
-  const int fast = rescue.PathHit(x, y);
-  EXPECT_GT(fast, 0);
-  EXPECT_LT(fast, slow);
-  // Not finite, or shrinking: no growth.
-  beside.width_rate = std::numeric_limits<double>::quiet_NaN();
-  beside.width_accel = -5.0;
-  rescue.Predict(Scene(10, {beside}));
-  EXPECT_EQ(rescue.PathHit(x, y), 0);
 }
 
 // The way's states (Points every tick from ego): each step's centre, and whether any is NaN.

@@ -202,9 +202,6 @@ class Rescue {
     double x = 0, y = 0, along = 0, rel = 0;
     double across = 0, d_target = 0;
     double half_length = 0, half_width = 0, radius = 0;
-    // The footprint's growth (plan::SensorCar::length_rate, width_rate, m/s, and length_accel,
-    // width_accel, m/s^2): a set-based prediction's occupancy seen widening widens on.
-    double length_rate = 0, width_rate = 0, length_accel = 0, width_accel = 0;
   };
   // Stratum with the speed across given: the search has its children's sines and cosines at
   // hand (v sin(heading - heading0) = v (sin heading cos heading0 - cos heading sin heading0)).

@@ -18,13 +18,6 @@ struct SensorCar {
   // Footprint, m: 0 (the Udacity simulator's rows) means the planner's check.car_length /
   // check.car_width.
   double length = 0, width = 0;
-  // How fast the footprint grows now (m/s) and how fast that rate grows (m/s^2): a CommonRoad
-  // set-based prediction's occupancy widens with its uncertainty, as a reachable set does, by
-  // an amount that grows with the square of the time since the prediction began. 0 for a fixed
-  // one. Read from what was seen up to now; a constant-velocity prediction grows the footprint
-  // on by rate t + accel t^2 / 2.
-  double length_rate = 0, width_rate = 0;
-  double length_accel = 0, width_accel = 0;
 };
 
 // A car's known future (a CommonRoad scenario's recorded trajectory, for `--prediction
