@@ -180,10 +180,15 @@ void Rescue::Predict(const plan::Telemetry& t) {
       continue;
     }
     if (std::hypot(car.vx, car.vy) <= 0.1) {
-      const double side = std::max(length, width);
-      Source& src = add(Source::kStill, side, side);
+      // Standing: its heading is unknown (no motion), so its box lies along the road there, at
+      // its own length and width, as the planner's prediction has it. (Was a square of its
+      // longer side: a bus stopped in one lane then reached into the next, and the planner's
+      // paths past it were taken for hits; docs/commonroad.md.)
+      Source& src = add(Source::kStill, length, width);
       src.x = car.x;
       src.y = car.y;
+      const map::ReferenceLine& line = road_.line();
+      src.rel = line.At(line.ToFrenet(car.x, car.y, t.s).s).heading;
       continue;
     }
     // Without a future: on along the road at its speed along the road, at its offset from the
@@ -233,6 +238,8 @@ const std::vector<Rescue::Car>& Rescue::CarsAt(int k) const {
           half_width = 0.5 * f.widths[i];
           radius = std::hypot(half_length, half_width);
         }
+      } else if (src.kind == Source::kStill) {
+        heading = src.rel;
       } else if (src.kind == Source::kAlong) {
         double d = src.y, rel = src.rel;
         if (src.across != 0) {

@@ -94,6 +94,27 @@ TEST(RescueTest, PathHitIsTheStepAPathRunsIntoACar) {
   EXPECT_EQ(rescue.PathHit(x, y), 0);
 }
 
+// A stopped car has no heading in the telemetry (its speed is 0): the rescue lays its box along
+// the road, as the planner's prediction does, at its own length and width. A bus of 12 x 2.5 m
+// stopped in one lane leaves the next lane clear (as a square of 12 m it reached 6 m across,
+// into both), and a path in its own lane still meets its end.
+TEST(RescueTest, AStoppedCarLiesAlongTheRoadAtItsOwnSize) {
+  const auto road = TwoLanes();
+  Rescue rescue(*road, VehicleParams(), kStep);
+  plan::SensorCar bus = Row(1, 100, kLane0, 0.0);
+  bus.length = 12.0;
+  bus.width = 2.5;
+  rescue.Predict(Scene(60, {bus}));
+  std::vector<double> x, y;
+  // Beside it within the 4 s looked at: from x 60 at 20 m/s, past x 140.
+  Straight(60, kLane1, 20, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);
+  // In its lane: the ego's front (2.3 m) meets the bus's back (6 m behind its centre) when the
+  // ego's centre is past 100 - 8.3 m: from x 20 at 20 m/s, 20 + 2 k >= 91.7, step 36.
+  Straight(20, kLane0, 20, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 36);
+}
+
 // A car moving across faster than the planner's lateral threshold changes lanes in the
 // rescue's predictions as in the planner's: into the next lane's centre, then straight on.
 TEST(RescueTest, ACarMovingAcrossIsPredictedIntoTheNextLaneAndNoFarther) {

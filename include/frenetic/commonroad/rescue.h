@@ -124,7 +124,7 @@ class Rescue {
   // The predicted boxes of the telemetry's cars at steps 1..goal_steps from its instant: a car's
   // future where it has one (a car to come appears at its start), else its row carried on along
   // the road at its speed and into the next lane as RescueOptions::lateral_threshold says (a car
-  // with no speed is a square of its longer side: its heading is unknown).
+  // with no speed lies along the road: its heading is unknown, as in the planner's prediction).
   // The boxes are laid out as the checks reach their steps, from t's futures: t must outlive the
   // calls up to the next Predict (the closed loop's telemetry of the cycle does).
   void Predict(const plan::Telemetry& t);
@@ -191,7 +191,8 @@ class Rescue {
     traj::OrientedBox box;
     double cos_h, sin_h, radius;
   };
-  // Where a car's boxes come from (Predict): its future, its row standing (x, y), or its row
+  // Where a car's boxes come from (Predict): its future, its row standing (x, y; rel: the
+  // road's heading there, its box's), or its row
   // carried on along the road (x, y: its s and d; along: m/s along the road; rel: its heading
   // less the road's; across: m/s across it, toward d_target, where the move ends and the car
   // turns to the road's heading; 0: none).
