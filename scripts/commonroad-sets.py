@@ -175,6 +175,8 @@ def run(args):
             raise Failure(f"--predictions: unknown prediction '{p.strip()}' "
                           "(recorded, cv or constant-velocity)")
         preds.append(PREDICTIONS[p.strip()])
+    if args.baseline and not os.path.isdir(os.path.join(args.baseline, "results")):
+        raise Failure(f"--baseline {args.baseline}: no results/ in it (another run's --out)")
     if not os.access(args.frenetic, os.X_OK):
         raise Failure(f"{args.frenetic}: no such executable (build it: scripts/run.sh --help)")
     os.makedirs(os.path.join(out, "sets"), exist_ok=True)
@@ -275,7 +277,8 @@ def self_test():
 
 def main():
     root = os.path.dirname(HERE)
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--shared", default=os.path.join(root, "..", "shared", "commonroad"),
                    help="the shared CommonRoad files (default: ../shared/commonroad beside the "
                         "repository)")
