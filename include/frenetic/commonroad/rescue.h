@@ -192,10 +192,10 @@ class Rescue {
     double cos_h, sin_h, radius;
   };
   // Where a car's boxes come from (Predict): its future, its row standing (x, y; rel: the
-  // road's heading there, its box's), or its row
-  // carried on along the road (x, y: its s and d; along: m/s along the road; rel: its heading
-  // less the road's; across: m/s across it, toward d_target, where the move ends and the car
-  // turns to the road's heading; 0: none).
+  // road's heading there, which its box lies along), or its row carried on along the road (x,
+  // y: its s and d; along: m/s along the road; rel: its heading less the road's; across: m/s
+  // across it, toward d_target, where the move ends and the car turns to the road's heading;
+  // 0: none).
   struct Source {
     enum Kind { kFuture, kStill, kAlong };
     Kind kind = kStill;
