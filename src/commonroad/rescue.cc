@@ -179,6 +179,12 @@ void Rescue::Predict(const plan::Telemetry& t) {
       add(Source::kFuture, length, width).future = future;
       continue;
     }
+    // Its place on the road: a car without a future moves on along it (the planner's own
+    // prediction keeps a car in its lane too; a straight line would run a car on a curving ramp
+    // into the next lane), and one standing lies along it.
+    const map::ReferenceLine& line = road_.line();
+    const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
+    const double road_heading = line.At(fe.s).heading;
     if (std::hypot(car.vx, car.vy) <= 0.1) {
       // Standing: its heading is unknown (no motion), so its box lies along the road there, at
       // its own length and width, as the planner's prediction has it. (Was a square of its
@@ -187,16 +193,10 @@ void Rescue::Predict(const plan::Telemetry& t) {
       Source& src = add(Source::kStill, length, width);
       src.x = car.x;
       src.y = car.y;
-      const map::ReferenceLine& line = road_.line();
-      src.rel = line.At(line.ToFrenet(car.x, car.y, t.s).s).heading;
+      src.rel = road_heading;
       continue;
     }
-    // Without a future: on along the road at its speed along the road, at its offset from the
-    // line (the planner's own prediction keeps a car in its lane too; a straight line would
-    // run a car on a curving ramp into the next lane).
-    const map::ReferenceLine& line = road_.line();
-    const map::FrenetPoint fe = line.ToFrenet(car.x, car.y, t.s);
-    const double road_heading = line.At(fe.s).heading;
+    // On along the road at its speed along the road, at its offset from the line.
     Source& src = add(Source::kAlong, length, width);
     src.x = fe.s;
     src.y = fe.d;
