@@ -32,8 +32,11 @@ on a missing input, a failed generator or a run that printed no report, with a o
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
+
+from scenario_files import scenario_files
 
 SETS = ("shared", "hd", "us", "deu", "zip", "ramp")
 PREDICTIONS = {"recorded": "recorded", "cv": "constant-velocity",
@@ -51,18 +54,18 @@ def generators(shared, out):
         return [sys.executable, os.path.join(HERE, "commonroad-derive.py"), path,
                 os.path.join(out, name), "--horizon", str(horizon), *extra]
 
-    def files(folder, suffix, prefixes=()):
+    def files(folder, prefixes=("",)):
         if not os.path.isdir(folder):
             raise Failure(f"{folder}: no such directory (--shared names the shared CommonRoad files)")
-        return [os.path.join(folder, n) for n in sorted(os.listdir(folder))
-                if n.endswith(suffix) and n.startswith(prefixes or ("",))]
+        return [f for f in scenario_files(folder, skip_solutions=True)
+                if os.path.basename(f).startswith(prefixes)]
 
     us = os.path.join(shared, "USA_US101-10_1_T-1.xml")
     return {
         "hd": [derive(f, "hd", h, "--goal", "lane")
-               for f in files(os.path.join(shared, "highD"), ".cr.xml") for h in (4, 7)],
+               for f in files(os.path.join(shared, "highD")) for h in (4, 7)],
         "us": [derive(us, "us", h) for h in (8, 5, 6)],
-        "deu": [derive(f, "deu", h) for f in files(shared, ".xml", ("DEU_", "ZAM_"))
+        "deu": [derive(f, "deu", h) for f in files(shared, ("DEU_", "ZAM_"))
                 for h in (8, 5, 3)],
         "zip": [[sys.executable, os.path.join(HERE, "commonroad-zips.py"),
                  os.path.join(shared, "zip", "ZAM_Zip-1_1_T-1.xml"), os.path.join(out, "zip"),
@@ -72,23 +75,26 @@ def generators(shared, out):
     }
 
 
-def write_set(name, cmds, out):
+def write_set(name, shared, out):
+    """out/NAME, written by the set's generators (into out/.partial/NAME, moved when complete)
+    unless an earlier run wrote it: the same files each time."""
     folder = os.path.join(out, name)
     if os.path.isdir(folder) and any(n.endswith(".xml") for n in os.listdir(folder)):
-        return folder  # written by an earlier run: the same files
-    partial = folder + ".partial"
-    if os.path.isdir(partial):
-        for n in os.listdir(partial):
-            os.remove(os.path.join(partial, n))
-    for argv in cmds:
-        argv = [partial if a == folder else a for a in argv]
+        return folder
+    staging = os.path.join(out, ".partial")
+    shutil.rmtree(os.path.join(staging, name), ignore_errors=True)
+    for argv in generators(shared, staging)[name]:
         r = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         if r.returncode != 0:
             last = (r.stderr.strip().splitlines() or ["no message"])[-1]
             raise Failure(f"writing set {name}: {os.path.basename(argv[1])} failed: {last}")
-    if not os.path.isdir(partial):
+    if not os.path.isdir(os.path.join(staging, name)):
         raise Failure(f"writing set {name}: the generators wrote no file")
-    os.replace(partial, folder)
+    os.replace(os.path.join(staging, name), folder)
+    try:
+        os.rmdir(staging)  # when no other set is being written there
+    except OSError:
+        pass
     return folder
 
 
@@ -181,14 +187,13 @@ def run(args):
         raise Failure(f"{args.frenetic}: no such executable (build it: scripts/run.sh --help)")
     os.makedirs(os.path.join(out, "sets"), exist_ok=True)
     os.makedirs(os.path.join(out, "results"), exist_ok=True)
-    cmds = generators(shared, os.path.join(out, "sets")) if set(sets) - {"shared"} else {}
     results = {}
     for name in sets:
         if name == "shared":
             inputs = [shared] + [os.path.join(shared, d) for d in ("us101", "zip", "highD")
                                  if os.path.isdir(os.path.join(shared, d))]
         else:
-            inputs = [write_set(name, cmds[name], os.path.join(out, "sets"))]
+            inputs = [write_set(name, shared, os.path.join(out, "sets"))]
         for p in preds:
             path = os.path.join(out, "results", f"{name}-{p}.json")
             if not args.json:
@@ -277,15 +282,18 @@ def self_test():
 
 def main():
     root = os.path.dirname(HERE)
+    build = os.environ.get("FRENETIC_BUILD_DIR") or os.path.join(root, "build")  # as common.sh
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--shared", default=os.path.join(root, "..", "shared", "commonroad"),
                    help="the shared CommonRoad files (default: ../shared/commonroad beside the "
                         "repository)")
-    p.add_argument("--out", default=os.path.join(root, "build", "commonroad-sets"),
-                   help="where the sets and results go (default: build/commonroad-sets)")
-    p.add_argument("--frenetic", default=os.path.join(root, "build", "frenetic"),
-                   help="the frenetic executable (default: build/frenetic)")
+    p.add_argument("--out", default=os.path.join(build, "commonroad-sets"),
+                   help="where the sets and results go (default: build/commonroad-sets, in "
+                        "$FRENETIC_BUILD_DIR when set)")
+    p.add_argument("--frenetic", default=os.path.join(build, "frenetic"),
+                   help="the frenetic executable (default: build/frenetic, in "
+                        "$FRENETIC_BUILD_DIR when set)")
     p.add_argument("--jobs", type=int, default=0,
                    help="scenario files planned in parallel (frenetic commonroad --jobs; default "
                         "0: all cores)")
