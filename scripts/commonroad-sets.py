@@ -3,7 +3,7 @@
 
     scripts/commonroad-sets.py [--shared DIR] [--out DIR] [--frenetic BIN] [--jobs N]
                                [--sets hd,us,deu,zip,ramp,shared] [--predictions recorded,cv]
-                               [--baseline DIR] [--json]
+                               [--baseline DIR] [--json] [-- FRENETIC_OPTION ...]
 
 The sets (docs/commonroad.md tells what each probes), written under OUT/sets on the first run
 from the shared files, the same files every time:
@@ -24,7 +24,17 @@ infeasible at start. The derived sets share roads and recordings with the shared
 check a change for regressions, they are not held-out figures.
 
 --baseline DIR: another run's OUT (e.g. of the build before a change); its counts are printed
-beside, and the problems whose outcome (solved or not) differs are listed. --json prints one
+beside, and the problems whose outcome (solved or not) differs are listed. Options after `--` go
+to every `frenetic commonroad` run, so that a configuration is compared with the default on every
+set by the same build (the sets are written once and shared):
+
+    scripts/commonroad-sets.py --out build/cr-main
+    scripts/commonroad-sets.py --out build/cr-try --baseline build/cr-main \
+        -- --commonroad-config try.yaml          # or --rescue-retry 1000, --vehicle 3, ...
+
+The options are passed as they are: one that `frenetic commonroad` refuses fails the first run
+with its message. Options the script sets itself (--json, --no-timing, --prediction, --jobs) are
+refused here. --json prints one
 JSON object instead. Exit status 0 when every run completed (unsolved problems are results), 2
 on a missing input, a failed generator or a run that printed no report, with a one-line message.
 `--self-test` checks the counting and comparing on made-up reports.
@@ -39,6 +49,8 @@ import sys
 from scenario_files import scenario_files
 
 SETS = ("shared", "hd", "us", "deu", "zip", "ramp")
+# Options the script gives every run itself; not accepted after `--`.
+OWN_OPTIONS = ("--json", "--no-timing", "--prediction", "--jobs")
 PREDICTIONS = {"recorded": "recorded", "cv": "constant-velocity",
                "constant-velocity": "constant-velocity"}
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -168,6 +180,21 @@ def table(results, baseline):
     return "\n".join(lines)
 
 
+def split_args(argv):
+    """The script's own arguments, and those after `--` (for frenetic commonroad)."""
+    if "--" not in argv:
+        return list(argv), []
+    i = argv.index("--")
+    return list(argv[:i]), list(argv[i + 1:])
+
+
+def check_frenetic_args(extra):
+    for a in extra:
+        if a.split("=", 1)[0] in OWN_OPTIONS:
+            raise Failure(f"{a} after --: the script sets it itself (its own --jobs and "
+                          "--predictions choose those)")
+
+
 def run(args):
     shared = os.path.abspath(args.shared)
     out = os.path.abspath(args.out)
@@ -183,6 +210,7 @@ def run(args):
         preds.append(PREDICTIONS[p.strip()])
     if args.baseline and not os.path.isdir(os.path.join(args.baseline, "results")):
         raise Failure(f"--baseline {args.baseline}: no results/ in it (another run's --out)")
+    check_frenetic_args(args.frenetic_args)
     if not os.access(args.frenetic, os.X_OK):
         raise Failure(f"{args.frenetic}: no such executable (build it: scripts/run.sh --help)")
     os.makedirs(os.path.join(out, "sets"), exist_ok=True)
@@ -200,10 +228,13 @@ def run(args):
                 print(f"[commonroad-sets] {name}, {p} ...", file=sys.stderr, flush=True)
             with open(path, "w", encoding="utf-8") as f:
                 r = subprocess.run([args.frenetic, "commonroad", *inputs, "--no-timing", "--json",
-                                    "--prediction", p, "--jobs", str(args.jobs)],
+                                    "--prediction", p, "--jobs", str(args.jobs),
+                                    *args.frenetic_args],
                                    stdout=f, stderr=subprocess.PIPE, text=True)
             if r.returncode != 0:
-                last = (r.stderr.strip().splitlines() or ["no message"])[-1]
+                lines = [ln for ln in r.stderr.strip().splitlines()
+                         if ln.strip() and not ln.startswith("Run with --help")]
+                last = (lines or ["no message"])[-1]
                 raise Failure(f"frenetic commonroad on set {name} ({p}) exited {r.returncode}: {last}")
             results.setdefault(name, {})[p] = load(path)
     baseline = None
@@ -277,6 +308,17 @@ def self_test():
             assert "bad.json" in str(e), e
         else:
             raise AssertionError(f"{bad} was read as a report")
+    assert split_args(["--sets", "hd"]) == (["--sets", "hd"], [])
+    assert split_args(["--out", "x", "--", "--rescue-retry", "1000", "--", "y"]) == \
+        (["--out", "x"], ["--rescue-retry", "1000", "--", "y"])
+    check_frenetic_args(["--commonroad-config", "a.yaml", "--vehicle=3"])
+    for own in (["--json"], ["--jobs", "2"], ["--prediction=recorded"], ["--no-timing"]):
+        try:
+            check_frenetic_args(own)
+        except Failure as e:
+            assert own[0] in str(e), e
+        else:
+            raise AssertionError(f"{own} was passed on")
     print("commonroad-sets self-test passed")
 
 
@@ -304,7 +346,9 @@ def main():
     p.add_argument("--baseline", help="another run's --out to compare with")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--self-test", action="store_true", help="check the counting and exit")
-    a = p.parse_args()
+    argv, extra = split_args(sys.argv[1:])  # what follows `--` goes to frenetic commonroad
+    a = p.parse_args(argv)
+    a.frenetic_args = extra
     if a.self_test:
         self_test()
         return 0
@@ -313,7 +357,14 @@ def main():
     except Failure as e:
         print(f"commonroad-sets: {e}", file=sys.stderr)
         return 2
-    print(json.dumps(as_json(results, baseline), indent=1) if a.json else table(results, baseline))
+    if a.json:
+        obj = as_json(results, baseline)
+        obj["frenetic_args"] = a.frenetic_args
+        print(json.dumps(obj, indent=1))
+    else:
+        if a.frenetic_args:
+            print("frenetic commonroad options: " + " ".join(a.frenetic_args))
+        print(table(results, baseline))
     return 0
 
 
