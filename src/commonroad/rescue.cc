@@ -16,6 +16,9 @@ namespace {
 // Grid cells: position, speed, heading, steering angle; the strata of the spread (position,
 // speed, speed across the search's start heading; the 1e3 cell leaves of the steering only its
 // sign). See Rescue::Stratum.
+// m: how far from a lane's begin or end (along the road) its lanelet's end edge may lie slanted
+// across the road: a box within it is also checked against the lanelets' outline.
+constexpr double kEndReach = 5.0;
 constexpr double kCells[5] = {0.25, 0.25, 0.25, 0.01, 0.005};
 constexpr double kStrata[5] = {2.0, 2.0, 1.0, 0.5, 1e3};
 // The runner insets goal windows from the verdict's whole steps by up to half a step at each end
@@ -272,6 +275,18 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
   return ClearOfCars(s, k) && OnRoad(s, s_hint, at);
 }
 
+void Rescue::SetRoadArea(const RoadArea* area) {
+  area_ = area;
+  lane_ends_.clear();
+  if (area_ == nullptr) return;
+  for (int l = 0; l < road_.num_lanes(); ++l) {
+    for (const double end : {road_.LaneBegin(l), road_.LaneEnd(l)}) {
+      if (std::isfinite(end)) lane_ends_.push_back(end);
+    }
+  }
+  std::sort(lane_ends_.begin(), lane_ends_.end());
+}
+
 bool Rescue::OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const {
   const double hl = half_length_, hw = half_width_;
   const map::ReferenceLine& line = road_.line();
@@ -283,6 +298,14 @@ bool Rescue::OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const
   for (const double at : {fe.s - along, fe.s + along}) {
     const map::Road::Span e = road_.EdgesAt(at);
     if (!e.exists || fe.d - across < e.left || fe.d + across > e.right) return false;
+  }
+  // Between the borders: off the lanelets only where a lane's end edge may lie slanted under the
+  // box, and there only if the outline's boundary crosses it (inside the borders, the box is not
+  // wholly outside the lanelets).
+  const auto end = std::lower_bound(lane_ends_.begin(), lane_ends_.end(), fe.s - along - kEndReach);
+  if (end != lane_ends_.end() && *end <= fe.s + along + kEndReach) {
+    const auto corners = BoxCorners({s.x, s.y}, s.orientation, 2 * hl, 2 * hw);
+    return !area_->BoundaryTouches(corners);
   }
   return true;
 }

@@ -159,6 +159,17 @@ bool RoadArea::ContainsConvex(std::span<const Vec2> convex) const {
   return true;
 }
 
+bool RoadArea::BoundaryTouches(std::span<const Vec2> convex) const {
+  if (convex.empty() || !std::all_of(convex.begin(), convex.end(), Finite)) return true;
+  const BoostPolygon polygon = ToBoostPolygon(convex);
+  BoostBox box;
+  bg::envelope(polygon, box);
+  for (auto it = impl_->boundary.qbegin(bgi::intersects(box)); it != impl_->boundary.qend(); ++it) {
+    if (convex.size() < 3 || bg::intersects(*it, polygon)) return true;
+  }
+  return false;
+}
+
 bool RoadArea::Contains(Vec2 point) const {
   return Finite(point) && bg::covered_by(point, impl_->area);
 }

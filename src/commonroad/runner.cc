@@ -272,6 +272,7 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
                                              ? config.value("prediction.lateral_threshold")
                                              : 0.0;
       rescue.emplace(road, vp, dt, rescue_options);
+      rescue->SetRoadArea(&checker.road());
     }
     run.stop_reason = "time";
     const GoalTest goal(sc, problem.goals);

@@ -5,7 +5,7 @@
 // (kept while it still meets it), and no search for a goal out of reach, along the road or
 // across it; a bound of the swerve across the road; a predicted car whose footprint grows; a
 // way to a goal held and driven on when the planner sends no path that passes; a car moving
-// across predicted into the next lane.
+// across predicted into the next lane; a box over a lane's slanted first edge.
 #include "frenetic/commonroad/rescue.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "frenetic/commonroad/lanelet.h"
+#include "frenetic/commonroad/road_area.h"
 #include "frenetic/map/reference_line.h"
 #include "frenetic/plan/planner.h"
 
@@ -113,6 +115,50 @@ TEST(RescueTest, AStoppedCarLiesAlongTheRoadAtItsOwnSize) {
   // ego's centre is past 100 - 8.3 m: from x 20 at 20 m/s, 20 + 2 k >= 91.7, step 36.
   Straight(20, kLane0, 20, 250, &x, &y);
   EXPECT_EQ(rescue.PathHit(x, y), 36);
+}
+
+// A lane that begins with a slanted edge: the road's lane 1 begins at s 100 (one station), while
+// its lanelet's first edge runs from (100, -3.5) to (106, -7). A box over the lane's first
+// metres lies between the road's borders and still sticks out of the lanelets, which the verdict
+// counts as off the road: with the lanelets' outline given, the rescue sees it too.
+TEST(RescueTest, WhereALaneBeginsSlantedTheBoxIsCheckedOnTheLaneletsOutline) {
+  const std::vector<map::ReferenceLine::Point> pts = {{0, 0}, {600, 0}};
+  auto line = map::ReferenceLine::FitOpen(pts, map::ReferenceLine::Options(), "straight");
+  ASSERT_TRUE(line.ok()) << line.message();
+  map::LaneProfile lane0, lane1;
+  lane0.s = {0, 600};
+  lane0.left = {0, 0};
+  lane0.right = {3.5, 3.5};
+  lane1.s = {100, 600};
+  lane1.left = {3.5, 3.5};
+  lane1.right = {7, 7};
+  auto road = map::Road::Make(*line, {lane0, lane1}, "slanted");
+  ASSERT_TRUE(road.ok()) << road.message();
+  Lanelet a, b;
+  a.id = 1;
+  a.left = {{0, 0}, {600, 0}};
+  a.right = {{0, -3.5}, {600, -3.5}};
+  b.id = 2;
+  b.left = {{100, -3.5}, {600, -3.5}};
+  b.right = {{106, -7}, {600, -7}};
+  const std::vector<Lanelet> lanelets = {a, b};
+  const RoadArea area = RoadArea::Build(lanelets);
+
+  Rescue rescue(**road, VehicleParams(), kStep);
+  rescue.Predict(Scene(103));
+  std::vector<double> x, y;
+  // d 4.6 from x 103 at 10 m/s: at step 1 the box spans x 101.7-106.3 and y -5.46 to -3.75;
+  // the edge is at y -4.49 where the box ends (x 101.7).
+  Straight(103, -4.6, 10, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);  // the road's borders alone
+  rescue.SetRoadArea(&area);
+  EXPECT_EQ(rescue.PathHit(x, y), 1);
+  // Past the slanted edge the lane is the lanelet: the same path from x 110 stays on the road.
+  Straight(110, -4.6, 10, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);
+  // In lane 0 beside the lane's start, the outline is never crossed.
+  Straight(95, -1.75, 10, 250, &x, &y);
+  EXPECT_EQ(rescue.PathHit(x, y), 0);
 }
 
 // A car moving across faster than the planner's lateral threshold changes lanes in the

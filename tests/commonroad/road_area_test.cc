@@ -1,7 +1,11 @@
+#include "frenetic/commonroad/road_area.h"
+
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "commonroad/scenario_xml.h"
-#include "frenetic/commonroad/road_area.h"
 
 namespace frenetic::commonroad {
 namespace {
@@ -57,6 +61,24 @@ TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {
   EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 10}, 0, 4, 2)));
   EXPECT_TRUE(road.Contains({1, 1}));
   EXPECT_FALSE(road.Contains({-6, 1}));  // beyond the open start's margin
+}
+
+// BoundaryTouches is ContainsConvex without the point-in-area test: it tells a box across the
+// outline from one inside it, and says nothing of a box wholly outside.
+TEST(RoadAreaTest, TheBoundaryTouchesABoxAcrossTheOutlineOnly) {
+  const std::vector<Lanelet> lane = {Make(1, Line(0, 100, 2), Line(0, 100, -2))};
+  const RoadArea road = RoadArea::Build(lane, 0.02);
+  const auto inside = BoxCorners({50, 0}, 0, 4, 2), across = BoxCorners({50, 1.03}, 0, 4, 2);
+  const auto past_end = BoxCorners({98.5, 0}, 0, 4, 2), outside = BoxCorners({50, 10}, 0, 4, 2);
+  EXPECT_FALSE(road.BoundaryTouches(inside));
+  EXPECT_TRUE(road.BoundaryTouches(across));
+  EXPECT_TRUE(road.BoundaryTouches(past_end));  // the closed end
+  EXPECT_FALSE(road.BoundaryTouches(outside));
+  for (const auto& box : {inside, across, past_end}) {
+    EXPECT_EQ(road.BoundaryTouches(box), !road.ContainsConvex(box));
+  }
+  const std::vector<Vec2> broken = {{50, 0}, {std::nan(""), 0}, {52, 1}};
+  EXPECT_TRUE(road.BoundaryTouches(broken));  // not finite: never taken for inside
 }
 
 TEST(RoadAreaTest, AnOncomingLaneIsRoad) {

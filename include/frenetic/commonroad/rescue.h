@@ -13,7 +13,8 @@
 // five steering rates, all within `limit_share` of the vehicle's limits and within its friction
 // circle; a state is kept
 // while the ego's box (grown by `ego_margin`) is clear of every predicted car's box at that step
-// and lies between the road's edges (the planner's road, its ends closed). It uses what the
+// and lies between the road's edges (the planner's road, its ends closed; where a lane begins or
+// ends under the box, also inside the lanelets' own outline: SetRoadArea). It uses what the
 // planner was told and nothing else: the telemetry's futures of the cars (recorded
 // predictions), else each car carried on along the road at its speed, a car moving across it
 // faster than `lateral_threshold` into the next lane's centre as the planner's predictor has it
@@ -45,6 +46,7 @@
 
 #include "frenetic/commonroad/ks_model.h"
 #include "frenetic/commonroad/reach_grid.h"
+#include "frenetic/commonroad/road_area.h"
 #include "frenetic/commonroad/vehicle_params.h"
 #include "frenetic/cost/goal_region.h"
 #include "frenetic/map/road.h"
@@ -184,6 +186,14 @@ class Rescue {
   }
 
   int searches() const { return searches_; }
+
+  // The lanelets' own outline (the verdict's road; must outlive the rescue), checked where a lane
+  // of the road begins or ends within 5 m of the ego's box along the road. The road's lane
+  // begins and ends at one station, while a lanelet's first or last edge may lie slanted across
+  // the road: a box over the lane's first metres can be between the lane's borders and still
+  // stick out of the lanelets (US-101's merging lanes). Elsewhere the borders are the lanelets'.
+  // nullptr (the default): the road's borders only.
+  void SetRoadArea(const RoadArea* area);
   std::int64_t checked() const { return checked_; }
 
  private:
@@ -286,6 +296,8 @@ class Rescue {
             int from = 0);
 
   const map::Road& road_;
+  const RoadArea* area_ = nullptr;
+  std::vector<double> lane_ends_;  // s of every lane's begin and end, sorted (SetRoadArea)
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;

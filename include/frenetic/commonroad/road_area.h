@@ -45,6 +45,11 @@ class RoadArea {
   // segment of the area touches it and its vertex mean is inside.
   bool ContainsConvex(std::span<const Vec2> convex) const;
   bool Contains(Vec2 point) const;
+  // True when a boundary segment of the area touches the convex polygon: the polygon then sticks
+  // out of the area (or into a hole). Cheaper than ContainsConvex (an R-tree query, no
+  // point-in-area test): a polygon known to lie mostly on the road is off it exactly when this
+  // holds.
+  bool BoundaryTouches(std::span<const Vec2> convex) const;
 
   double Area() const;        // m^2
   int PolygonCount() const;   // separate pieces
