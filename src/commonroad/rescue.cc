@@ -16,11 +16,11 @@ namespace {
 // Grid cells: position, speed, heading, steering angle; the strata of the spread (position,
 // speed, speed across the search's start heading; the 1e3 cell leaves of the steering only its
 // sign). See Rescue::Stratum.
-// m: how far from a lane's begin or end (along the road) its lanelet's end edge may lie slanted
-// across the road: a box within it is also checked against the lanelets' outline.
-constexpr double kEndReach = 5.0;
 constexpr double kCells[5] = {0.25, 0.25, 0.25, 0.01, 0.005};
 constexpr double kStrata[5] = {2.0, 2.0, 1.0, 0.5, 1e3};
+// m: how far from a lane's begin or end (along the road) its lanelet's end edge may lie slanted
+// across the road: a box within it is also checked against the lanelets' outline (OnRoad).
+constexpr double kEndReach = 5.0;
 // The runner insets goal windows from the verdict's whole steps by up to half a step at each end
 // (a window of one step becomes an instant between two): a step within this many steps of a
 // window's inset ends is one of its whole steps, and one outside the window is a step or more

@@ -186,6 +186,7 @@ class Rescue {
   }
 
   int searches() const { return searches_; }
+  std::int64_t checked() const { return checked_; }
 
   // The lanelets' own outline (the verdict's road; must outlive the rescue), checked where a lane
   // of the road begins or ends within 5 m of the ego's box along the road. The road's lane
@@ -194,7 +195,6 @@ class Rescue {
   // stick out of the lanelets (US-101's merging lanes). Elsewhere the borders are the lanelets'.
   // nullptr (the default): the road's borders only.
   void SetRoadArea(const RoadArea* area);
-  std::int64_t checked() const { return checked_; }
 
  private:
   struct Car {
