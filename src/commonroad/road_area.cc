@@ -144,19 +144,8 @@ bool RoadArea::ContainsConvex(std::span<const Vec2> convex) const {
   Vec2 mean;
   for (const Vec2& p : convex) mean = mean + p;
   mean = (1.0 / convex.size()) * mean;
-  if (!Contains(mean)) return false;
   // Inside, unless the area's boundary enters the polygon.
-  BoostBox box;
-  bg::envelope(ToBoostPolygon(convex), box);
-  if (convex.size() < 3) {
-    return impl_->boundary.qbegin(bgi::intersects(box)) == impl_->boundary.qend();
-  }
-  const BoostPolygon polygon = ToBoostPolygon(convex);
-  for (auto it = impl_->boundary.qbegin(bgi::intersects(box)); it != impl_->boundary.qend();
-       ++it) {
-    if (bg::intersects(*it, polygon)) return false;
-  }
-  return true;
+  return Contains(mean) && !BoundaryTouches(convex);
 }
 
 bool RoadArea::BoundaryTouches(std::span<const Vec2> convex) const {
