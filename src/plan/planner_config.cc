@@ -29,6 +29,7 @@ constexpr Default kDefaults[] = {
     {"limits.d_min", 1.0, 0.8, 4, false},
     {"limits.d_max", 11.0, 8, 11.2, false},
     {"limits.edge_margin", 0.2, 0, 1, false},
+    {"limits.backward_speed", 0, 0, 1, false},
     {"road.lane_width", 4, 2.5, 5, false},
     {"road.num_lanes", 3, 1, 8, false},
     {"road.outer_lane_inset", 0.2, 0, 1, false},

@@ -5,6 +5,11 @@
 #include <cstring>
 
 namespace frenetic::plan::search {
+namespace {
+
+constexpr double kRoundingSlack = 1e-9;  // m/s of s' below 0 that is the polynomials' rounding
+
+}  // namespace
 
 LimitChecker::LimitChecker(const Settings& cfg, const map::ReferenceLine& line, Workspace& ws)
     : cfg_(cfg),
@@ -237,7 +242,11 @@ double LimitChecker::Measure(Reject* reason, bool lane_line, const Ticks& ticks,
     take(static_cast<double>(worst_straddle - straddle_limit_) / straddle_limit_,
          Reject::kLaneLine);
   }
-  take(-sdmin - 0.05, Reject::kSpeed);  // never backwards
+  // Never backwards beyond limits.backward_speed: the Udacity simulator reads a step back after
+  // one forward as a reversal, a curvature of 1e6 in its acceleration (udacity-sim.md 7.2), and
+  // at a crawl that alone is over the limit (0.05 m/s let a path creep back 1 mm a tick at a
+  // stop: dense seed 1749).
+  take(-sdmin - std::max(cfg_.limits.backward_speed, kRoundingSlack), Reject::kSpeed);
   if (cfg_.check.curve_prefilter && ticks.lon_slot >= 0 && !(worst > 0)) {
     // A candidate's verdict only (its bundle rows): the refinement's Violation weighs how far
     // its trial paths break a limit, which only the XY check measures.

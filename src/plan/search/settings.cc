@@ -24,6 +24,7 @@ Settings::Settings(const PlannerConfig& c) {
   road.num_lanes = std::clamp(c.int_value("road.num_lanes"), 1, cost::kMaxLanes);
   road.uniform = true;
   limits.edge_margin = c.value("limits.edge_margin");
+  limits.backward_speed = c.value("limits.backward_speed");
   check.ego_length = c.value("check.ego_length");
   check.ego_width = c.value("check.ego_width");
   vehicle.wheelbase = c.value("vehicle.wheelbase");

@@ -42,6 +42,7 @@ struct Settings {
     double d_min = 0;        // m: the smallest d the simulator may read on a uniform road
     double d_max = 0;        // m: the largest
     double edge_margin = 0;  // m the ego stays inside the edges of any other road
+    double backward_speed = 0;  // m/s: the most s' may fall below 0 (limits.backward_speed)
   };
   // The road's (map::Road), else road.* on the configured uniform road.
   struct Road {

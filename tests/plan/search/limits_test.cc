@@ -62,6 +62,25 @@ TEST(LimitCheckerTest, EachLimitRejectsWithItsReason) {
   EXPECT_GT(st.limits.Violation(&why), 0);
 }
 
+TEST(LimitCheckerTest, APathCreepingBackAtAStopIsRejected) {
+  REQUIRE_UDACITY_MAP();
+  // Coming to a stop (0.01 m/s, braking at 0.1 m/s^2), then pulling away at 0.5 m/s^2 from
+  // 0.3 s: the braking carries the ego back at up to 0.02 m/s first, a millimetre or less a
+  // tick. The simulator reads the turn from back to forward as a reversal (a curvature of 1e6
+  // in its acceleration): the dense seed 1749's incident of 176 m/s^2.
+  Stages st;
+  st.Prepare({kS, 0.01, -0.1, 6.0, 0, 0});
+  const auto stop_then_go = [](double t) { return t < 0.3 ? -0.1 : 0.5; };
+  Reject why = Reject::kCount;
+  st.WriteTicks(kS, 0.01, 6.0, stop_then_go);
+  EXPECT_GT(st.limits.Violation(&why), 0);
+  EXPECT_EQ(why, Reject::kSpeed);
+  // The same start at 0.05 m/s never goes back, and passes.
+  st.Prepare({kS, 0.05, -0.1, 6.0, 0, 0});
+  st.WriteTicks(kS, 0.05, 6.0, stop_then_go);
+  EXPECT_LE(st.limits.Violation(&why), 0);
+}
+
 TEST(LimitCheckerTest, JerkRejectsWithItsReason) {
   REQUIRE_UDACITY_MAP();
   // The simulator's acceleration is a magnitude, so with equal limits a jerk excess comes with
