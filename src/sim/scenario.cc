@@ -78,6 +78,7 @@ Status TrafficOptions::Validate() const {
   check(wander_period_min > 0 && wander_period_max >= wander_period_min,
         "wander_period must satisfy 0 < min <= max");
   check(throttle_wander >= 0 && throttle_wander < 1, "throttle_wander must be in [0, 1)");
+  check(wander_full_speed >= 0, "wander_full_speed must be >= 0");
   check(lane_change_gap >= 0, "lane_change_gap must be >= 0");
   check(lane_change_ego_band >= 0, "lane_change_ego_band must be >= 0");
   check(lane_change_spacing_ticks >= 0, "lane_change_spacing_ticks must be >= 0");
@@ -287,6 +288,7 @@ StatusOr<Scenario> Parse(std::string_view yaml_text, const std::string& source, 
     t.Read("follow_lateral", &o.follow_lateral);
     t.ReadPair("wander", &o.wander_min, &o.wander_max);
     t.ReadPair("wander_period", &o.wander_period_min, &o.wander_period_max);
+    t.Read("wander_full_speed", &o.wander_full_speed);
     t.Read("throttle_wander", &o.throttle_wander);
     t.Read("lane_changes", &o.lane_changes);
     t.Read("lane_change_gap", &o.lane_change_gap);

@@ -73,7 +73,8 @@ Traffic::Traffic(std::shared_ptr<const World> world, const TrafficOptions& optio
       c.slow_speed = o_.blockade_speed;
       c.v = std::min(c.top_speed, c.slow_speed);
       InitWander(c);
-      c.d = LaneCentre(lane) + Wander(c, 0);
+      c.wander_t = 0;
+      c.d = LaneCentre(lane) + Wander(c, c.wander_t);
       c.last_change_tick = 0;
       c.spawns = 1;
       Place(c);
@@ -172,7 +173,8 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
     car.switch_wait = 0;
     car.leader_v = 0;
     InitWander(car);
-    car.d = LaneCentre(lane) + Wander(car, time_);
+    car.wander_t = time_;
+    car.d = LaneCentre(lane) + Wander(car, car.wander_t);
     car.d_rate = 0;
     // §8.6: the initial velocity is top speed numerically in m/s until the next physics tick.
     car.spawn_quirk = o_.spawn_speed_quirk;
@@ -208,7 +210,7 @@ void Traffic::Frame(const EgoView& ego) {
 }
 
 void Traffic::StartChange(TrafficCar& c, int lane, double duration, std::int64_t tick) {
-  c.from_d = c.d - Wander(c, time_);
+  c.from_d = c.d - Wander(c, c.wander_t);
   c.lane = lane;
   c.changing = true;
   c.change_elapsed = 0;
@@ -404,7 +406,9 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
       if (tau >= 1) c.changing = false;
     }
     const double d_old = c.d;
-    const double d_new = base + Wander(c, time_);
+    // The wander's clock runs with the car below wander_full_speed (a car that stands, stands).
+    c.wander_t += o_.wander_full_speed > 0 ? kDt * std::min(1.0, c.v / o_.wander_full_speed) : kDt;
+    const double d_new = base + Wander(c, c.wander_t);
     c.d_rate = (d_new - d_old) / kDt;
     c.d = d_new;
     // Speed v is along the lane at offset d; the centre line advances by v / (1 + kappa d)

@@ -452,7 +452,70 @@ class LaneChangeRule : public ::testing::Test {
   std::shared_ptr<const World> world_;
   Ghost ego_;
   std::unique_ptr<Traffic> traffic_;
+
+ public:
+  const Ghost& ego() const { return ego_; }
 };
+
+// A car held at a crawl (0.3 m/s) and one cruising at 15 m/s, both wandering 0.5 m with a 10 s
+// period; returns the largest angle (rad) between each car's heading and the road's over 20 s,
+// and how far (m) each moved across the road.
+struct Sway {
+  double crawl_angle = 0, crawl_across = 0, cruise_angle = 0, cruise_across = 0;
+};
+Sway SwayAtACrawl(LaneChangeRule& rule, Traffic& traffic, const World& world) {
+  Sway out;
+  double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+  for (int t = 0; t < 1000; ++t) {
+    traffic.Tick(rule.ego().View(), t);
+    for (int id = 0; id < 2; ++id) {
+      const TrafficCar& c = traffic.cars()[id];
+      const double road = world.line->ToCartesian(c.s, c.d).heading;
+      const double angle = std::abs(std::remainder(c.heading - road, 2 * M_PI));
+      (id == 0 ? out.crawl_angle : out.cruise_angle) =
+          std::max(id == 0 ? out.crawl_angle : out.cruise_angle, angle);
+      lo[id] = std::min(lo[id], c.d);
+      hi[id] = std::max(hi[id], c.d);
+    }
+  }
+  out.crawl_across = hi[0] - lo[0];
+  out.cruise_across = hi[1] - lo[1];
+  return out;
+}
+
+TEST_F(LaneChangeRule, ACarAtACrawlDoesNotSlideSideways) {
+  for (const double full_speed : {5.0, 0.0}) {
+    TrafficOptions o;
+    o.cars = 3;
+    o.spawn_speed_quirk = false;
+    o.lane_changes = false;
+    o.wander_full_speed = full_speed;
+    traffic_ = std::make_unique<Traffic>(world_, o, 4.6, 2.4, 5, ego_.View());
+    Set(0, 0, 300, 0.3, 0.3);  // held at 0.3 m/s
+    Set(1, 2, 500, 15);
+    Park(2);
+    for (int id = 0; id < 2; ++id) {
+      TrafficCar& c = traffic_->mutable_cars()[id];
+      c.wander_amp = 0.5;
+      c.wander_w1 = c.wander_w2 = 2 * M_PI / 10;
+      c.wander_p1 = c.wander_p2 = 0;
+    }
+    const Sway sway = SwayAtACrawl(*this, *traffic_, *world_);
+    // Cruising, the wander is the same either way: about its full 1 m across, a degree or two off.
+    EXPECT_GT(sway.cruise_across, 0.9) << full_speed;
+    EXPECT_LT(sway.cruise_angle, 0.05) << full_speed;
+    if (full_speed > 0) {
+      // At a crawl it moves 6 m along the road in the 20 s, and its wander as far as at 5 m/s
+      // over those 6 m: a third of a metre across, a few degrees off the road.
+      EXPECT_LT(sway.crawl_across, 0.5);
+      EXPECT_LT(sway.crawl_angle, 0.1);
+    } else {
+      // In time alone it slides the whole wander across, its box turned tens of degrees.
+      EXPECT_GT(sway.crawl_across, 0.9);
+      EXPECT_GT(sway.crawl_angle, 0.5);
+    }
+  }
+}
 
 TEST_F(LaneChangeRule, BlockedCarMovesToTheFreeMiddleLaneAfterFiftyEvaluations) {
   Set(0, 0, 1000, 18);

@@ -83,6 +83,11 @@ struct TrafficOptions {
   double follow_lateral = 2.0;         // m, |Δd| under which a car is "in front" (ray-cast)
   double wander_min = 0.3, wander_max = 0.5;  // m, lateral wander amplitude per car
   double wander_period_min = 8, wander_period_max = 20;  // s
+  // m/s: below this speed the wander runs slower, in proportion, and stands with the car. Unity's
+  // cars steer toward a point tens of metres ahead, so their lateral motion comes with their
+  // speed (at most a few degrees off the lane); a wander in time alone would slide a car in a
+  // queue sideways and turn its box up to tens of degrees at a crawl. 0: in time alone.
+  double wander_full_speed = 5;
   double throttle_wander = 0.1;        // throttle factor in [1 - throttle_wander, 1]
   bool lane_changes = true;            // the §8.5 rule
   double lane_change_gap = 20;         // m, |Δs| every car in the target lane must exceed

@@ -43,6 +43,7 @@ struct TrafficCar {
   std::int64_t last_change_tick = -1000000;
   std::array<int, 3> clear_counts{};
   double wander_amp = 0.4, wander_w1 = 0, wander_w2 = 0, wander_p1 = 0, wander_p2 = 0;
+  double wander_t = 0;  // s: the wander's own clock (TrafficOptions::wander_full_speed)
   double throttle_w = 0, throttle_p = 0;
   bool queued = false;        // waiting for a respawn
   bool spawn_quirk = false;   // report speed in the wrong unit until the next tick
