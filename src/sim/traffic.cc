@@ -19,7 +19,9 @@ constexpr std::size_t kMaxSamples = 2'000'000;
 constexpr double kParkedX[2] = {775.8, 762.1};
 constexpr double kParkedY[6] = {1421.6, 1425.2, 1429.0, 1432.9, 1436.3, 1441.7};
 
-double Wander(const TrafficCar& c, double t) {
+// The car's lateral wander at its own clock (TrafficCar::wander_t).
+double Wander(const TrafficCar& c) {
+  const double t = c.wander_t;
   return c.wander_amp * (0.6 * std::sin(c.wander_w1 * t + c.wander_p1) +
                          0.4 * std::sin(c.wander_w2 * t + c.wander_p2));
 }
@@ -72,9 +74,8 @@ Traffic::Traffic(std::shared_ptr<const World> world, const TrafficOptions& optio
       c.slow_left = o_.blockade_seconds;
       c.slow_speed = o_.blockade_speed;
       c.v = std::min(c.top_speed, c.slow_speed);
-      InitWander(c);
-      c.wander_t = 0;
-      c.d = LaneCentre(lane) + Wander(c, c.wander_t);
+      InitWander(c, 0.0);
+      c.d = LaneCentre(lane) + Wander(c);
       c.last_change_tick = 0;
       c.spawns = 1;
       Place(c);
@@ -92,7 +93,8 @@ int Traffic::UniformInt(int lo, int hi) {
   return lo + static_cast<int>(rng_() % static_cast<std::uint64_t>(hi - lo + 1));
 }
 
-void Traffic::InitWander(TrafficCar& c) {
+void Traffic::InitWander(TrafficCar& c, double clock) {
+  c.wander_t = clock;
   constexpr double kTwoPi = 2 * std::numbers::pi;
   c.wander_amp = Uniform(o_.wander_min, o_.wander_max);
   c.wander_w1 = kTwoPi / Uniform(o_.wander_period_min, o_.wander_period_max);
@@ -172,9 +174,8 @@ bool Traffic::Spawn(TrafficCar& car, const EgoView& ego) {
     car.too_close = false;
     car.switch_wait = 0;
     car.leader_v = 0;
-    InitWander(car);
-    car.wander_t = time_;
-    car.d = LaneCentre(lane) + Wander(car, car.wander_t);
+    InitWander(car, time_);
+    car.d = LaneCentre(lane) + Wander(car);
     car.d_rate = 0;
     // §8.6: the initial velocity is top speed numerically in m/s until the next physics tick.
     car.spawn_quirk = o_.spawn_speed_quirk;
@@ -210,7 +211,7 @@ void Traffic::Frame(const EgoView& ego) {
 }
 
 void Traffic::StartChange(TrafficCar& c, int lane, double duration, std::int64_t tick) {
-  c.from_d = c.d - Wander(c, c.wander_t);
+  c.from_d = c.d - Wander(c);
   c.lane = lane;
   c.changing = true;
   c.change_elapsed = 0;
@@ -408,7 +409,7 @@ void Traffic::Tick(const EgoView& ego, std::int64_t tick) {
     const double d_old = c.d;
     // The wander's clock runs with the car below wander_full_speed (a car that stands, stands).
     c.wander_t += o_.wander_full_speed > 0 ? kDt * std::min(1.0, c.v / o_.wander_full_speed) : kDt;
-    const double d_new = base + Wander(c, c.wander_t);
+    const double d_new = base + Wander(c);
     c.d_rate = (d_new - d_old) / kDt;
     c.d = d_new;
     // Speed v is along the lane at offset d; the centre line advances by v / (1 + kappa d)

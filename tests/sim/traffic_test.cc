@@ -452,34 +452,28 @@ class LaneChangeRule : public ::testing::Test {
   std::shared_ptr<const World> world_;
   Ghost ego_;
   std::unique_ptr<Traffic> traffic_;
-
- public:
-  const Ghost& ego() const { return ego_; }
 };
 
 // A car held at a crawl (0.3 m/s) and one cruising at 15 m/s, both wandering 0.5 m with a 10 s
-// period; returns the largest angle (rad) between each car's heading and the road's over 20 s,
-// and how far (m) each moved across the road.
+// period: over 20 s, the largest angle (rad) between each car's heading and the road's, and how
+// far (m) each moved across the road ([0]: the crawling car, [1]: the cruising one).
 struct Sway {
-  double crawl_angle = 0, crawl_across = 0, cruise_angle = 0, cruise_across = 0;
+  double angle[2] = {0, 0}, across[2] = {0, 0};
 };
-Sway SwayAtACrawl(LaneChangeRule& rule, Traffic& traffic, const World& world) {
+Sway SwayOver20s(Traffic& traffic, const EgoView& ego, const World& world) {
   Sway out;
   double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
   for (int t = 0; t < 1000; ++t) {
-    traffic.Tick(rule.ego().View(), t);
+    traffic.Tick(ego, t);
     for (int id = 0; id < 2; ++id) {
       const TrafficCar& c = traffic.cars()[id];
       const double road = world.line->ToCartesian(c.s, c.d).heading;
-      const double angle = std::abs(std::remainder(c.heading - road, 2 * M_PI));
-      (id == 0 ? out.crawl_angle : out.cruise_angle) =
-          std::max(id == 0 ? out.crawl_angle : out.cruise_angle, angle);
+      out.angle[id] = std::max(out.angle[id], std::abs(std::remainder(c.heading - road, 2 * M_PI)));
       lo[id] = std::min(lo[id], c.d);
       hi[id] = std::max(hi[id], c.d);
     }
   }
-  out.crawl_across = hi[0] - lo[0];
-  out.cruise_across = hi[1] - lo[1];
+  for (int id = 0; id < 2; ++id) out.across[id] = hi[id] - lo[id];
   return out;
 }
 
@@ -500,19 +494,19 @@ TEST_F(LaneChangeRule, ACarAtACrawlDoesNotSlideSideways) {
       c.wander_w1 = c.wander_w2 = 2 * M_PI / 10;
       c.wander_p1 = c.wander_p2 = 0;
     }
-    const Sway sway = SwayAtACrawl(*this, *traffic_, *world_);
+    const Sway sway = SwayOver20s(*traffic_, ego_.View(), *world_);
     // Cruising, the wander is the same either way: about its full 1 m across, a degree or two off.
-    EXPECT_GT(sway.cruise_across, 0.9) << full_speed;
-    EXPECT_LT(sway.cruise_angle, 0.05) << full_speed;
+    EXPECT_GT(sway.across[1], 0.9) << full_speed;
+    EXPECT_LT(sway.angle[1], 0.05) << full_speed;
     if (full_speed > 0) {
       // At a crawl it moves 6 m along the road in the 20 s, and its wander as far as at 5 m/s
       // over those 6 m: a third of a metre across, a few degrees off the road.
-      EXPECT_LT(sway.crawl_across, 0.5);
-      EXPECT_LT(sway.crawl_angle, 0.1);
+      EXPECT_LT(sway.across[0], 0.5);
+      EXPECT_LT(sway.angle[0], 0.1);
     } else {
       // In time alone it slides the whole wander across, its box turned tens of degrees.
-      EXPECT_GT(sway.crawl_across, 0.9);
-      EXPECT_GT(sway.crawl_angle, 0.5);
+      EXPECT_GT(sway.across[0], 0.9);
+      EXPECT_GT(sway.angle[0], 0.5);
     }
   }
 }

@@ -94,7 +94,7 @@ class Traffic {
 
  private:
   bool Spawn(TrafficCar& car, const EgoView& ego);
-  void InitWander(TrafficCar& car);
+  void InitWander(TrafficCar& car, double clock);  // its wander's draws, its clock at `clock`
   void StartChange(TrafficCar& car, int lane, double duration, std::int64_t tick);
   void LaneChangeRule(TrafficCar& car, const EgoView& ego, std::int64_t tick);
   bool LaneClear(const TrafficCar& car, int lane, const EgoView& ego) const;
