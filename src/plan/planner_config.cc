@@ -82,6 +82,7 @@ constexpr Default kDefaults[] = {
     {"check.headway_min", 0.5, 0, 2, false},
     {"check.behind_time", 1.0, 0, 4, false},
     {"check.clear_enough", 0, 0, 20, false},
+    {"check.side_clear", 0, 0, 5, false},
     {"check.curve_prefilter", 0, 0, 1, false},
     {"vehicle.wheelbase", 0, 0, 10, false},
     {"vehicle.max_steer", 0, 0, 1.5, false},

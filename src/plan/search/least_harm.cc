@@ -175,8 +175,10 @@ bool LeastHarm::ClearEnough(int c) {
     lon_clear_done_[i] = 1;
   }
   if (!lat_clear_done_[k]) {
-    fill(rows.d, ws_.step_d, ws_.car_sep_d, [floor](double b) { return b >= floor; },
-         &lat_clear_[k * kMaxCars]);
+    const double side = ws_.side_clear;
+    fill(
+        rows.d, ws_.step_d, ws_.car_sep_d,
+        [floor, side](double b) { return SidePart(b, side) >= floor; }, &lat_clear_[k * kMaxCars]);
     lat_clear_done_[k] = 1;
   }
   const std::uint64_t all = n_steps == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << n_steps) - 1;
@@ -228,12 +230,14 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
   const int row = kProbes * num_cars;
   lon_done_.assign(ws_.lon.size(), 0);
   lat_done_.assign(ws_.lat.size(), 0);
+  // (The part across through SidePart, as the clearance counts it.)
   const auto fill = [&](const double* p, const std::vector<double>& car_p,
-                        const std::vector<double>& size, double* out) {
+                        const std::vector<double>& size, bool across, double* out) {
     for (int q = 0; q < kProbes; ++q) {
       const int j = std::clamp(probe[q], 1, n_steps);
       for (int car = 0; car < num_cars; ++car) {
-        out[q * num_cars + car] = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size[car];
+        const double sep = std::abs(car_p[car * (n_steps + 1) + j] - p[j]) - size[car];
+        out[q * num_cars + car] = across ? SidePart(sep, ws_.side_clear) : sep;
       }
     }
   };
@@ -242,8 +246,8 @@ int LeastHarm::BestClear(bool* over_budget, bool* all_known, bool unbounded) {
     const int i = ws_.cand_lon[c], k = ws_.cand_lat[c];
     if (!lon_done_[i] || !lat_done_[k]) {
       const CollisionChecker::Rows rows = collisions_.StepRows(c);
-      if (!lon_done_[i]) fill(rows.s, ws_.step_s, ws_.car_sep_s, &lon_sep_[i * row]);
-      if (!lat_done_[k]) fill(rows.d, ws_.step_d, ws_.car_sep_d, &lat_sep_[k * row]);
+      if (!lon_done_[i]) fill(rows.s, ws_.step_s, ws_.car_sep_s, false, &lon_sep_[i * row]);
+      if (!lat_done_[k]) fill(rows.d, ws_.step_d, ws_.car_sep_d, true, &lat_sep_[k * row]);
       lon_done_[i] = lat_done_[k] = 1;
     }
     return MinOfMax(&lon_sep_[i * row], &lat_sep_[k * row], row);

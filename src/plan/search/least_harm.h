@@ -23,6 +23,11 @@
 
 namespace frenetic::plan::search {
 
+// The part across the road of a separation as least harm's clearance counts it: a car at least
+// side_clear to the side (Settings::Check::side_clear) is clear at that step whatever the gap
+// along the road (1e9, as with no car), since it keeps its lane as the ego keeps its own.
+inline double SidePart(double lat, double side_clear) { return lat < side_clear ? lat : 1e9; }
+
 // The smallest separation (m) of the bare boxes of `tr` from any car of ws over the check
 // horizon, in the Frenet frame with the boxes aligned to the lane: max(|ds| - ws.car_sep_s,
 // |dd| - ws.car_sep_d), < 0 on overlap.
@@ -36,8 +41,9 @@ double ClearanceAt(const Workspace& ws, StateAt state_at) {
     const traj::FrenetState st = state_at(j * ws.collision_step);
     for (int c = 0; c < ws.ctx.num_cars; ++c) {
       const int at = c * (ws.n_steps + 1) + j;
-      const double sep = std::max(std::abs(ws.step_s[at] - st.s) - ws.car_sep_s[c],
-                                  std::abs(ws.step_d[at] - st.d) - ws.car_sep_d[c]);
+      const double sep =
+          std::max(std::abs(ws.step_s[at] - st.s) - ws.car_sep_s[c],
+                   SidePart(std::abs(ws.step_d[at] - st.d) - ws.car_sep_d[c], ws.side_clear));
       worst = std::min(worst, sep);
     }
   }
@@ -60,9 +66,10 @@ inline double ClearanceAt(const Workspace& ws, const StepStates& steps) {
   for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
-    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c];
+    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c], side = ws.side_clear;
     for (int j = 1; j <= n_steps; ++j) {
-      const double sep = std::max(std::abs(cs[j] - s[j]) - len, std::abs(cd[j] - d[j]) - wid);
+      const double sep =
+          std::max(std::abs(cs[j] - s[j]) - len, SidePart(std::abs(cd[j] - d[j]) - wid, side));
       col[j] = sep < col[j] ? sep : col[j];
     }
   }
@@ -129,9 +136,10 @@ inline double ClearanceAbove(const Workspace& ws, const double* s, const double*
   for (int c = 0; c < ws.ctx.num_cars; ++c) {
     const double* cs = ws.step_s.data() + c * (n_steps + 1);
     const double* cd = ws.step_d.data() + c * (n_steps + 1);
-    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c];
+    const double len = ws.car_sep_s[c], wid = ws.car_sep_d[c], side = ws.side_clear;
     for (int j = 1; j <= n_steps; ++j) {
-      sep[j - 1] = std::max(std::abs(cs[j] - s[j]) - len, std::abs(cd[j] - d[j]) - wid);
+      sep[j - 1] =
+          std::max(std::abs(cs[j] - s[j]) - len, SidePart(std::abs(cd[j] - d[j]) - wid, side));
     }
     const double row = MinOf(sep, n_steps);
     worst = row < worst ? row : worst;

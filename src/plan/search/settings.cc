@@ -78,6 +78,8 @@ Settings::Settings(const PlannerConfig& c) {
   check.margin_behind = c.value("check.margin_behind");
   check.headway_min = c.value("check.headway_min");
   check.clear_enough = c.value("check.clear_enough");
+  const double side_clear = c.value("check.side_clear");
+  check.side_clear = side_clear > 0 ? side_clear : std::numeric_limits<double>::infinity();
   check.curve_prefilter = c.int_value("check.curve_prefilter") != 0;
   check.behind_time = c.value("check.behind_time");
   followers_react = c.int_value("prediction.followers_react") != 0;

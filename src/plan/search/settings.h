@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "frenetic/map/road.h"
 #include "frenetic/plan/feasibility.h"
@@ -111,6 +112,9 @@ struct Settings {
     double behind_time = 0;                // ...plus this many s of its closing speed
     double headway_min = 0;                // s of headway to a car ahead
     double clear_enough = 0;               // m: least harm takes the cheapest this clear (0: off)
+    // m: least harm counts a car this far to the side of the ego (bare boxes) as clear at that
+    // step, whatever the gap along the road (infinite: off; check.side_clear 0).
+    double side_clear = std::numeric_limits<double>::infinity();
     // Longitudinal trajectories whose v^2 kappa along the line clearly exceeds
     // limits.max_accel are not candidates (Lattice::AddLon).
     bool curve_prefilter = false;

@@ -12,9 +12,9 @@
 namespace frenetic::plan::search {
 namespace {
 
+using testing::kS;
 using testing::SceneCar;
 using testing::Stages;
-using testing::kS;
 
 // Candidates by hand: velocity keeping to (end speed, T) in the middle lane, at the given costs.
 struct Option {
@@ -44,9 +44,17 @@ void Start(Stages& st, const std::vector<SceneCar>& cars) {
   st.Prepare({kS, 20, 0, st.ws.lane_center[1], 0, 0}, cars);
 }
 
+// The default configuration with check.side_clear set to `metres` (0: off).
+PlannerConfig SideClearConfig(double metres) {
+  PlannerConfig config = testing::DefaultConfig();
+  EXPECT_TRUE(
+      config.Overlay("check:\n  side_clear: " + std::to_string(metres) + "\n", "test").ok());
+  return config;
+}
+
 TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
+  Stages st(SideClearConfig(0));  // every separation counts (SideClearCountsACarAlongsideAsClear)
   // Alongside in the next lane at the same speed: 4 m apart laterally, 2.4 m wide.
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS, 2.0, 20}});
   traj::FrenetTrajectory tr;
@@ -116,6 +124,46 @@ TEST(SearchLeastHarmTest, ClearEnoughTakesTheCheapestWithThatMuchRoom) {
     ASSERT_TRUE(st.least_harm.Choose(&over_budget)) << enough;
     EXPECT_FALSE(over_budget);
     EXPECT_EQ(st.ws.winner_index, winner) << "clear_enough " << enough;
+  }
+}
+
+// check.side_clear: a car that far to the side is clear at that step, so a car passing
+// alongside in the next lane no longer caps the clearance of a harder brake.
+TEST(SearchLeastHarmTest, SideClearCountsACarAlongsideAsClear) {
+  REQUIRE_UDACITY_MAP();
+  traj::FrenetTrajectory tr;  // on in the middle lane at 20 m/s
+  tr.lon.poly.c[0] = kS;
+  tr.lon.poly.c[1] = 20;
+  tr.lon.duration = 5;
+  tr.lat.poly.c[0] = 6.0;
+  tr.lat.duration = 5;
+  // Alongside in the next lane: 4 m - 2.4 m apart across.
+  const double across = 4.0 - testing::DefaultConfig().value("check.car_width");
+  for (const auto& [side, clearance] :
+       {std::pair{0.0, across}, std::pair{across + 0.1, across}, std::pair{across - 0.1, 1e9}}) {
+    Stages st(SideClearConfig(side));
+    st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS, 2.0, 20}});
+    EXPECT_NEAR(Clearance(st.ws, tr), clearance, 1e-6) << "side_clear " << side;
+  }
+  // A slower car 30 m ahead in the ego's lane, and a faster one 25 m behind in the next lane.
+  // A mild brake (to 14 m/s in 4 s) keeps the car behind out of reach; a hard one (to 8 m/s in
+  // 2.5 s) leaves more room ahead but lets the car behind come alongside, 1.6 m across.
+  const std::vector<Option> options = {{14, 4.0, 1.0}, {8, 2.5, 2.0}};
+  for (const auto& [side, winner] : {std::pair{0.0, 0}, std::pair{1.0, 1}}) {
+    Stages st(SideClearConfig(side));
+    const std::vector<SceneCar> cars = {{kS + 30, st.ws.lane_center[1], 14},
+                                        {kS - 25, st.ws.lane_center[0], 26}};
+    Start(st, cars);
+    SetCandidates(st, options);
+    double clearance[2];
+    for (int c = 0; c < 2; ++c) {
+      clearance[c] = ClearanceAt(st.ws, st.collisions.StepsOf(c, 0.0, 1.0));
+    }
+    bool over_budget = false;
+    ASSERT_TRUE(st.least_harm.Choose(&over_budget)) << side;
+    EXPECT_FALSE(over_budget);
+    EXPECT_EQ(st.ws.winner_index, winner)
+        << "side_clear " << side << ": clearances " << clearance[0] << ", " << clearance[1];
   }
 }
 
@@ -224,55 +272,59 @@ int ReferenceChoice(Stages& st, bool* last_resort = nullptr, bool* kept_side = n
 
 TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
-  std::mt19937 rng(14);
-  std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0);
-  int chosen = 0, last_resorts = 0, kept_sides = 0;
-  for (int scene = 0; scene < 48; ++scene) {
-    // Traffic in every lane around the ego, denser scene by scene; the ego at various speeds
-    // and offsets, and with the lane-line count near and past its limit (then once for each
-    // lane the last winner may have gone to, and for none).
-    std::vector<SceneCar> cars;
-    for (int k = 0; k < 3 + scene / 2; ++k) {
-      cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
-    }
-    const bool astride = scene % 4 == 3;
-    const double d0 = st.ws.lane_center[1] + (astride ? 1.6 : 0.0);
-    for (int prev = -1; prev < (astride ? 3 : 0); ++prev) {
-      Start(st, cars);
-      st.Prepare({kS, 8.0 + scene % 12, 0, d0, 0, 0}, cars);
-      // Near the limit, or with time left to leave the line either way.
-      st.ws.straddle_at_start = !astride               ? 0
-                                : (scene / 4) % 2 == 0 ? 100 + 10 * (scene % 5)
-                                                       : 20 + 20 * (scene % 5);
-      st.ws.prev_lat_lane = prev;
-      st.lattice.Generate();
-      ASSERT_TRUE(st.scorer.Score());
-      // Every other scene, Choose makes the costs exact itself, as far as it needs them.
-      const bool lazy = scene % 2 == 1;
-      if (!lazy) {
+  // Also with check.side_clear, whose separations across BestClear bounds as the clearance
+  // counts them.
+  for (const double side : {0.0, 1.0}) {
+    Stages st(SideClearConfig(side));
+    std::mt19937 rng(14);
+    std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0);
+    int chosen = 0, last_resorts = 0, kept_sides = 0;
+    for (int scene = 0; scene < 48; ++scene) {
+      // Traffic in every lane around the ego, denser scene by scene; the ego at various speeds
+      // and offsets, and with the lane-line count near and past its limit (then once for each
+      // lane the last winner may have gone to, and for none).
+      std::vector<SceneCar> cars;
+      for (int k = 0; k < 3 + scene / 2; ++k) {
+        cars.push_back({kS + ahead(rng), st.ws.lane_center[k % 3], speed(rng)});
+      }
+      const bool astride = scene % 4 == 3;
+      const double d0 = st.ws.lane_center[1] + (astride ? 1.6 : 0.0);
+      for (int prev = -1; prev < (astride ? 3 : 0); ++prev) {
+        Start(st, cars);
+        st.Prepare({kS, 8.0 + scene % 12, 0, d0, 0, 0}, cars);
+        // Near the limit, or with time left to leave the line either way.
+        st.ws.straddle_at_start = !astride               ? 0
+                                  : (scene / 4) % 2 == 0 ? 100 + 10 * (scene % 5)
+                                                         : 20 + 20 * (scene % 5);
+        st.ws.prev_lat_lane = prev;
+        st.lattice.Generate();
+        ASSERT_TRUE(st.scorer.Score());
+        // Every other scene, Choose makes the costs exact itself, as far as it needs them.
+        const bool lazy = scene % 2 == 1;
+        if (!lazy) {
+          ASSERT_TRUE(st.scorer.ResolveAll());
+        }
+        bool over_budget = false;
+        // Every third scene says the last search found nothing passing (the candidates are then
+        // visited in cost order without bounds until a clear one is found): the same choice.
+        const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
         ASSERT_TRUE(st.scorer.ResolveAll());
+        bool last_resort = false, kept_side = false;
+        const int expected = ReferenceChoice(st, &last_resort, &kept_side);
+        last_resorts += last_resort;
+        kept_sides += kept_side;
+        EXPECT_FALSE(over_budget);
+        EXPECT_EQ(ok, expected >= 0) << "scene " << scene << " prev " << prev;
+        if (ok) {
+          EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene << " prev " << prev;
+        }
+        chosen += ok;
       }
-      bool over_budget = false;
-      // Every third scene says the last search found nothing passing (the candidates are then
-      // visited in cost order without bounds until a clear one is found): the same choice.
-      const bool ok = st.least_harm.Choose(&over_budget, scene % 3 == 0);
-      ASSERT_TRUE(st.scorer.ResolveAll());
-      bool last_resort = false, kept_side = false;
-      const int expected = ReferenceChoice(st, &last_resort, &kept_side);
-      last_resorts += last_resort;
-      kept_sides += kept_side;
-      EXPECT_FALSE(over_budget);
-      EXPECT_EQ(ok, expected >= 0) << "scene " << scene << " prev " << prev;
-      if (ok) {
-        EXPECT_EQ(st.ws.winner_index, expected) << "scene " << scene << " prev " << prev;
-      }
-      chosen += ok;
     }
+    EXPECT_GT(chosen, 24);
+    EXPECT_GT(last_resorts, 0) << "a way off the line within the simulator's count decided";
+    EXPECT_GT(kept_sides, 0) << "the last winner's lane decided";
   }
-  EXPECT_GT(chosen, 24);
-  EXPECT_GT(last_resorts, 0) << "a way off the line within the simulator's count decided";
-  EXPECT_GT(kept_sides, 0) << "the last winner's lane decided";
 }
 
 // check.clear_enough: the cheapest candidate (exact cost, then index) whose bare boxes keep
