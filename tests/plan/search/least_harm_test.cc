@@ -44,17 +44,18 @@ void Start(Stages& st, const std::vector<SceneCar>& cars) {
   st.Prepare({kS, 20, 0, st.ws.lane_center[1], 0, 0}, cars);
 }
 
-// The default configuration with check.side_clear set to `metres` (0: off).
-PlannerConfig SideClearConfig(double metres) {
+// The default configuration with least harm ranking every clear candidate by its room
+// (check.clear_enough 0) and check.side_clear set to `side` (0: off, every separation counts).
+PlannerConfig RoomiestConfig(double side = 0) {
   PlannerConfig config = testing::DefaultConfig();
-  EXPECT_TRUE(
-      config.Overlay("check:\n  side_clear: " + std::to_string(metres) + "\n", "test").ok());
+  const std::string overlay = "check:\n  clear_enough: 0\n  side_clear: " + std::to_string(side);
+  EXPECT_TRUE(config.Overlay(overlay + "\n", "test").ok());
   return config;
 }
 
 TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
   REQUIRE_UDACITY_MAP();
-  Stages st(SideClearConfig(0));  // every separation counts (SideClearCountsACarAlongsideAsClear)
+  Stages st(RoomiestConfig(0));  // every separation counts (SideClearCountsACarAlongsideAsClear)
   // Alongside in the next lane at the same speed: 4 m apart laterally, 2.4 m wide.
   st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS, 2.0, 20}});
   traj::FrenetTrajectory tr;
@@ -71,7 +72,7 @@ TEST(SearchLeastHarmTest, ClearanceIsTheBareBoxesSeparation) {
 
 TEST(SearchLeastHarmTest, PrefersMoreClearanceOverLowerCost) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
+  Stages st(RoomiestConfig());
   // A slower car 30 m ahead: keeping 20 m/s hits it; slowing to 10 m/s in 4 s leaves ~5 m of
   // clearance, in 3 s ~10 m.
   Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
@@ -141,7 +142,7 @@ TEST(SearchLeastHarmTest, SideClearCountsACarAlongsideAsClear) {
   const double across = 4.0 - testing::DefaultConfig().value("check.car_width");
   for (const auto& [side, clearance] :
        {std::pair{0.0, across}, std::pair{across + 0.1, across}, std::pair{across - 0.1, 1e9}}) {
-    Stages st(SideClearConfig(side));
+    Stages st(RoomiestConfig(side));
     st.Prepare({kS, 20, 0, 6.0, 0, 0}, {{kS, 2.0, 20}});
     EXPECT_NEAR(Clearance(st.ws, tr), clearance, 1e-6) << "side_clear " << side;
   }
@@ -150,7 +151,7 @@ TEST(SearchLeastHarmTest, SideClearCountsACarAlongsideAsClear) {
   // 2.5 s) leaves more room ahead but lets the car behind come alongside, 1.6 m across.
   const std::vector<Option> options = {{14, 4.0, 1.0}, {8, 2.5, 2.0}};
   for (const auto& [side, winner] : {std::pair{0.0, 0}, std::pair{1.0, 1}}) {
-    Stages st(SideClearConfig(side));
+    Stages st(RoomiestConfig(side));
     const std::vector<SceneCar> cars = {{kS + 30, st.ws.lane_center[1], 14},
                                         {kS - 25, st.ws.lane_center[0], 26}};
     Start(st, cars);
@@ -169,7 +170,7 @@ TEST(SearchLeastHarmTest, SideClearCountsACarAlongsideAsClear) {
 
 TEST(SearchLeastHarmTest, EqualClearanceGoesToTheLowerCost) {
   REQUIRE_UDACITY_MAP();
-  Stages st;
+  Stages st(RoomiestConfig());
   Start(st, {{kS + 30, st.ws.lane_center[1], 10}});
   // The same trajectory twice: the same clearance, the cost decides, then the index.
   SetCandidates(st, {{10, 3.0, 3.0}, {10, 4.0, 2.0}, {10, 3.0, 1.0}, {10, 3.0, 1.0}});
@@ -275,7 +276,7 @@ TEST(SearchLeastHarmTest, ChoosesWhatTheWholeRankingChooses) {
   // Also with check.side_clear, whose separations across BestClear bounds as the clearance
   // counts them.
   for (const double side : {0.0, 1.0}) {
-    Stages st(SideClearConfig(side));
+    Stages st(RoomiestConfig(side));
     std::mt19937 rng(14);
     std::uniform_real_distribution<double> ahead(-25.0, 60.0), speed(5.0, 22.0);
     int chosen = 0, last_resorts = 0, kept_sides = 0;
