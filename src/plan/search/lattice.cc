@@ -613,6 +613,11 @@ void Lattice::Generate() {
           Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti);
       for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, T));
     }
+    if (ws_.none_passed_last && cfg_.lat.escape_duration > 0 && !centred && !crawl_hold) {
+      for (int oi = 0; oi < offsets; ++oi) {
+        AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, cfg_.lat.escape_duration));
+      }
+    }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives
     // (a queue), which a goal's orientation and the lanelets' borders mind.

@@ -63,6 +63,7 @@ Settings::Settings(const PlannerConfig& c) {
   lat.offset_step = c.value("grid.lat_offset_step");
   lat.escape_offsets = c.int_value("grid.escape_lat_offsets");
   lat.escape_offset_step = c.value("grid.escape_lat_offset_step");
+  lat.escape_duration = c.value("grid.escape_lat_duration");
   grid.lane_reach = c.value("grid.lane_reach");
   lat.delays = c.int_value("grid.lat_delays");
   grid.passes = c.int_value("grid.passes") != 0;

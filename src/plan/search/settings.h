@@ -95,6 +95,8 @@ struct Settings {
     // instead (grid.escape_lat_offsets, 0: the same as above; grid.escape_lat_offset_step).
     int escape_offsets = 0;
     double escape_offset_step = 0;
+    // And then also moves of this duration (s) to each lane (grid.escape_lat_duration, 0: none).
+    double escape_duration = 0;
     int delays = 0;  // delayed starts, delay_step (s) apart
     double delay_step = 0;
   };

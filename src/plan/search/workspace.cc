@@ -29,9 +29,10 @@ Workspace::Workspace(const Settings& cfg) {
       cfg.road.num_lanes * cfg.grid.gap_targets * cfg.grid.durations +
       cfg.brake.decels * cfg.brake.targets + cost::kMaxGoalRegions * cfg.grid.durations +
       cfg.grid.accels * (cfg.road.num_lanes + 1) + 9;
-  const int max_lat =
-      cfg.road.num_lanes * (cfg.lat.durations + 1 + cfg.lat.delays) * cfg.lat.offsets +
-      kMaxSwerves + kMaxPasses + 9;
+  const int escape_moves = cfg.lat.escape_duration > 0 ? 1 : 0;
+  const int max_lat = cfg.road.num_lanes * (cfg.lat.durations + 1 + escape_moves + cfg.lat.delays) *
+                          std::max(cfg.lat.offsets, cfg.lat.escape_offsets) +
+                      kMaxSwerves + kMaxPasses + 9;
   lon.reserve(max_lon);
   lat.reserve(max_lat);
   for (auto* v : {&lon_s, &lon_sd, &lon_sdd}) v->assign(max_lon * n_samples, 0.0);

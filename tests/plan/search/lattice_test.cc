@@ -84,8 +84,8 @@ TEST(SearchLatticeTest, TheCurvePrefilterDropsWhatTheBendRulesOut) {
   // off-road check's d limits on this uniform road, and the chords' 1.5 m), not the lane
   // borders at the start.
   EXPECT_GE(ws.max_abs_d, std::max({std::abs(ws.road_left), std::abs(ws.road_right),
-                                    std::abs(on.cfg.limits.d_min),
-                                    std::abs(on.cfg.limits.d_max)}) + 1.5 - 1e-9);
+                                    std::abs(on.cfg.limits.d_min), std::abs(on.cfg.limits.d_max)}) +
+                              1.5 - 1e-9);
   const int n = ws.n_samples;
   int near_limit = 0;
   for (int i = 0; i < static_cast<int>(ws.lon.size()); ++i) {
@@ -511,6 +511,7 @@ TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
   PlannerConfig c = GridOnly();
   ASSERT_TRUE(c.Set("grid.escape_lat_offsets", 5).ok());
   ASSERT_TRUE(c.Set("grid.escape_lat_offset_step", 1.0).ok());
+  ASSERT_TRUE(c.Set("grid.escape_lat_duration", 0.0).ok());  // the offsets alone (tested below)
   Stages st(c);
   for (const bool escape : {false, true}) {
     PrepareCentred(st, 20);
@@ -532,6 +533,36 @@ TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
   }
   // Odd counts only (0: the same as grid.lat_offsets).
   EXPECT_FALSE(c.Set("grid.escape_lat_offsets", 4).ok());
+}
+
+// After a search where nothing passed, grid.escape_lat_duration adds a quicker move to each
+// lane but the own one the ego is centred in (a lane change, or back to the lane's centre, in
+// 1.5 s instead of lat_min_duration's 2), and none otherwise.
+TEST(SearchLatticeTest, AfterABoxEachLaneGetsAQuickerMove) {
+  REQUIRE_UDACITY_MAP();
+  PlannerConfig c = GridOnly();
+  ASSERT_TRUE(c.Set("grid.escape_lat_duration", 1.5).ok());
+  ASSERT_TRUE(c.Set("grid.lat_min_duration", 2.0).ok());
+  Stages st(c);
+  for (const bool escape : {false, true}) {
+    PrepareCentred(st, 20);
+    st.ws.none_passed_last = escape;
+    st.lattice.Generate();
+    std::set<int> quick_lanes;
+    for (const LatTraj& l : st.ws.lat) {
+      EXPECT_GE(l.traj.duration, escape ? 1.5 : 2.0);
+      if (l.traj.duration < 2.0) quick_lanes.insert(l.lane);
+    }
+    const std::set<int> expected = escape ? std::set<int>{0, 2} : std::set<int>{};
+    EXPECT_EQ(quick_lanes, expected) << escape;
+  }
+  // 0: none after a box-in either.
+  ASSERT_TRUE(c.Set("grid.escape_lat_duration", 0.0).ok());
+  Stages off(c);
+  PrepareCentred(off, 20);
+  off.ws.none_passed_last = true;
+  off.lattice.Generate();
+  for (const LatTraj& l : off.ws.lat) EXPECT_GE(l.traj.duration, 2.0);
 }
 
 // On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets
