@@ -192,7 +192,6 @@ void BuildContext(const Settings& cfg, const map::Road& road, const Predictor& p
   // The predictor's ghosts (they follow every real car) go last, for the hard checks only.
   const auto cars = predictor.cars();
   int nc = 0, real = 0;
-  ws.side_clear = cfg.check.side_clear;
   for (int i = 0; i < static_cast<int>(cars.size()) && nc < kMaxCars; ++i) {
     const TrackedCar& car = cars[i];
     const double hl = 0.5 * car.length, hw = 0.5 * car.width;

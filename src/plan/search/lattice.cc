@@ -63,8 +63,9 @@ void Lattice::AddLon(const LonTraj& l) {
   ws_.lon.back().jerk2 = l.traj.poly.JerkSquaredIntegral(l.traj.duration);
   const int n = ws_.n_samples;
   const double dt = cfg_.score.dt;
-  l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
-                &ws_.lon_sdd[i * n]);
+  l.traj.Sample(
+      0, n, [dt](int k) { return k * dt; }, &ws_.lon_s[i * n], &ws_.lon_sd[i * n],
+      &ws_.lon_sdd[i * n]);
   ws_.lon_near_have[i] = 0;  // its masks: when first needed (Scorer::InputFor)
   if (cfg_.check.curve_prefilter && TooFastForTheCurve(i)) {
     ws_.lon.pop_back();
@@ -116,8 +117,9 @@ void Lattice::AddLat(const LatTraj& l) {
   ws_.lat.back().jerk2 = l.traj.JerkSquared();
   const int n = ws_.n_samples;
   const double dt = cfg_.score.dt;
-  l.traj.Sample(0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
-                &ws_.lat_ddd[i * n]);
+  l.traj.Sample(
+      0, n, [dt](int k) { return k * dt; }, &ws_.lat_d[i * n], &ws_.lat_dd[i * n],
+      &ws_.lat_ddd[i * n]);
   NearLat(ws_, ws_.lat_d.data() + i * n, ws_.lat_near.data() + 2 * i * n);
 }
 
@@ -608,15 +610,15 @@ void Lattice::Generate() {
     const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.road.lane_width;
     const bool centred = own && at_rest && std::abs(ws_.lane_center[l] - start.d) < 0.1;
     const bool crawl_hold = own && at_rest && !centred && start.s_d < kCrawlSpeed;
-    for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
-      const double T =
-          Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti);
+    // Moves of T s to each end offset around the lane's centre.
+    const auto add_ends = [&](double T) {
       for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, T));
+    };
+    for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
+      add_ends(Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti));
     }
     if (ws_.none_passed_last && cfg_.lat.escape_duration > 0 && !centred && !crawl_hold) {
-      for (int oi = 0; oi < offsets; ++oi) {
-        AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, cfg_.lat.escape_duration));
-      }
+      add_ends(cfg_.lat.escape_duration);
     }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives

@@ -8,6 +8,7 @@
 namespace frenetic::plan::search {
 
 Workspace::Workspace(const Settings& cfg) {
+  side_clear = cfg.check.side_clear;
   // The uniform road's lanes (another road's are read each cycle, BuildContext).
   for (int l = 0; l < cfg.road.num_lanes; ++l) {
     lane_nominal[l] = lane_center[l] = (l + 0.5) * cfg.road.lane_width;

@@ -141,8 +141,8 @@ struct Workspace {
   // Per car: its half length and half width (m), and the ego's and its together (the
   // separation of two aligned boxes' centres at contact: 0.5 ego_length + car_hl...).
   std::vector<double> car_hl, car_hw, car_sep_s, car_sep_d;
-  // Settings::Check::side_clear: least harm's clearance counts a separation across the road
-  // (bare boxes) of at least this as clear (SidePart in least_harm.h).
+  // Settings::Check::side_clear, set once: least harm's clearance counts a separation across the
+  // road (bare boxes) of at least this as clear (SidePart in least_harm.h).
   double side_clear = std::numeric_limits<double>::infinity();
   // FirstCollision's broad reach along s (before margins) and across (m): 8 and 5 for the
   // Udacity footprints, more with a larger ego; per car, the more its own size adds (0 for a

@@ -27,6 +27,14 @@ void PrepareCentred(Stages& st, double speed, double d_d = 0,
   st.Prepare({kS, speed, 0, st.ws.lane_center[1], d_d, 0}, cars);
 }
 
+// The lattice of PrepareCentred at 20 m/s, after a search where nothing passed or not
+// (Workspace::none_passed_last).
+void GenerateCentred(Stages& st, bool box_in) {
+  PrepareCentred(st, 20);
+  st.ws.none_passed_last = box_in;
+  st.lattice.Generate();
+}
+
 // The shipped grid alone, without the lane-limit speeds a bend adds (kS is on a gentle bend).
 PlannerConfig GridOnly() {
   PlannerConfig c = testing::DefaultConfig();
@@ -514,9 +522,7 @@ TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
   ASSERT_TRUE(c.Set("grid.escape_lat_duration", 0.0).ok());  // the offsets alone (tested below)
   Stages st(c);
   for (const bool escape : {false, true}) {
-    PrepareCentred(st, 20);
-    st.ws.none_passed_last = escape;
-    st.lattice.Generate();
+    GenerateCentred(st, escape);
     std::set<double> offsets;
     int neighbour = 0;
     for (const LatTraj& l : st.ws.lat) {
@@ -540,29 +546,24 @@ TEST(SearchLatticeTest, AfterABoxInTheLateralEndsReachTheLanesEdges) {
 // 1.5 s instead of lat_min_duration's 2), and none otherwise.
 TEST(SearchLatticeTest, AfterABoxEachLaneGetsAQuickerMove) {
   REQUIRE_UDACITY_MAP();
-  PlannerConfig c = GridOnly();
-  ASSERT_TRUE(c.Set("grid.escape_lat_duration", 1.5).ok());
-  ASSERT_TRUE(c.Set("grid.lat_min_duration", 2.0).ok());
-  Stages st(c);
-  for (const bool escape : {false, true}) {
-    PrepareCentred(st, 20);
-    st.ws.none_passed_last = escape;
-    st.lattice.Generate();
+  struct Case {
+    double quick;  // grid.escape_lat_duration
+    bool box_in;
+    std::set<int> quick_lanes;
+  };
+  for (const Case& k : {Case{1.5, false, {}}, Case{1.5, true, {0, 2}}, Case{0.0, true, {}}}) {
+    PlannerConfig c = GridOnly();
+    ASSERT_TRUE(c.Set("grid.escape_lat_duration", k.quick).ok());
+    ASSERT_TRUE(c.Set("grid.lat_min_duration", 2.0).ok());
+    Stages st(c);
+    GenerateCentred(st, k.box_in);
     std::set<int> quick_lanes;
     for (const LatTraj& l : st.ws.lat) {
-      EXPECT_GE(l.traj.duration, escape ? 1.5 : 2.0);
+      EXPECT_GE(l.traj.duration, k.quick > 0 && k.box_in ? k.quick : 2.0);
       if (l.traj.duration < 2.0) quick_lanes.insert(l.lane);
     }
-    const std::set<int> expected = escape ? std::set<int>{0, 2} : std::set<int>{};
-    EXPECT_EQ(quick_lanes, expected) << escape;
+    EXPECT_EQ(quick_lanes, k.quick_lanes) << k.quick << " " << k.box_in;
   }
-  // 0: none after a box-in either.
-  ASSERT_TRUE(c.Set("grid.escape_lat_duration", 0.0).ok());
-  Stages off(c);
-  PrepareCentred(off, 20);
-  off.ws.none_passed_last = true;
-  off.lattice.Generate();
-  for (const LatTraj& l : off.ws.lat) EXPECT_GE(l.traj.duration, 2.0);
 }
 
 // On a bend the outer lanes' limits are lower than the fastest lane's: each such lane gets
