@@ -64,6 +64,7 @@ constexpr Default kDefaults[] = {
     {"grid.escape_lat_offsets", 0, 0, 7, false},
     {"grid.escape_lat_offset_step", 1.0, 0.05, 2, false},
     {"grid.escape_lat_duration", 0, 0, 6, false},
+    {"grid.escape_lat_least_harm", 0, 0, 1, false},
     {"grid.limit_ramps", 0, 0, 1, false},
     {"grid.lane_reach", 2.5, 1, 4, false},
     {"grid.lat_delays", 2, 0, 4, false},

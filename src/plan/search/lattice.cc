@@ -618,7 +618,11 @@ void Lattice::Generate() {
       add_ends(Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti));
     }
     if (ws_.none_passed_last && cfg_.lat.escape_duration > 0 && !centred && !crawl_hold) {
+      const auto first = ws_.lat.size();
       add_ends(cfg_.lat.escape_duration);
+      for (auto j = first; j < ws_.lat.size(); ++j) {
+        ws_.lat[j].least_harm_only = cfg_.lat.escape_least_harm;
+      }
     }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives

@@ -45,6 +45,9 @@ struct LatTraj {
   double offset = 0;  // m from that lane's centre at the end
   double jerk2 = 0;
   int goal = -1;  // a swerve's goal region (its index in the cycle's goals); -1 otherwise
+  // Offered to the least harm only (an escape after a box-in:
+  // Settings::Lateral::escape_least_harm); the selection skips it.
+  bool least_harm_only = false;
   bool swerve() const { return kind == LatKind::kSwerve; }
   bool pass() const { return kind == LatKind::kPass; }
 };

@@ -64,6 +64,7 @@ Settings::Settings(const PlannerConfig& c) {
   lat.escape_offsets = c.int_value("grid.escape_lat_offsets");
   lat.escape_offset_step = c.value("grid.escape_lat_offset_step");
   lat.escape_duration = c.value("grid.escape_lat_duration");
+  lat.escape_least_harm = c.int_value("grid.escape_lat_least_harm") != 0;
   grid.lane_reach = c.value("grid.lane_reach");
   lat.delays = c.int_value("grid.lat_delays");
   grid.passes = c.int_value("grid.passes") != 0;

@@ -97,6 +97,8 @@ struct Settings {
     double escape_offset_step = 0;
     // And then also moves of this duration (s) to each lane (grid.escape_lat_duration, 0: none).
     double escape_duration = 0;
+    // Those quicker moves for the least harm only, not the selection (grid.escape_lat_least_harm).
+    bool escape_least_harm = false;
     int delays = 0;  // delayed starts, delay_step (s) apart
     double delay_step = 0;
   };

@@ -67,5 +67,47 @@ TEST(SelectionTest, TheBareContactsFirstChooseWhatTheFullChecksChoose) {
   EXPECT_GE(bare_read, 30) << "the bare contacts were not measured first";
 }
 
+// After a box-in the lattice adds quicker lateral moves (grid.escape_lat_duration). With
+// grid.escape_lat_least_harm they are the least harm's alone: the selection never takes one,
+// in scenes where without the option it does.
+TEST(SelectionTest, QuickEscapesForTheLeastHarmAloneAreNeverSelected) {
+  REQUIRE_UDACITY_MAP();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> gap(10.0, 20.0), slower(4.0, 12.0), beside(-6.0, 6.0);
+  int quick_taken[2] = {0, 0}, flagged[2] = {0, 0};
+  for (const int only : {0, 1}) {
+    PlannerConfig config = testing::DefaultConfig();
+    ASSERT_TRUE(config.Set("grid.escape_lat_duration", 1.5).ok());
+    ASSERT_TRUE(config.Set("grid.escape_lat_least_harm", only).ok());
+    Stages st(config);
+    Tracer tracer(st.cfg, st.ws, st.scorer, *st.costs, *st.line, *st.predictor);
+    Selection selection(st.cfg, st.ws, st.scorer, st.limits, st.collisions, tracer, st.clock);
+    rng.seed(5);
+    for (int scene = 0; scene < 40; ++scene) {
+      // Off the middle lane's centre toward the left one, a much slower car close ahead in the
+      // middle lane, the left lane free and a car beside in the right one: braking comes too
+      // late, a 2 s move left stays beside the slow car too long, a quicker one clears it.
+      const double v = 18.0 + scene % 4;
+      const std::vector<SceneCar> cars = {{kS + gap(rng), st.ws.lane_center[1], v - slower(rng)},
+                                          {kS + beside(rng), st.ws.lane_center[2], v}};
+      st.Prepare({kS, v, 0, st.ws.lane_center[1] - 0.8, 0, 0}, cars);
+      st.ws.none_passed_last = true;
+      st.lattice.Generate();
+      for (const LatTraj& l : st.ws.lat) flagged[only] += l.least_harm_only;
+      ASSERT_TRUE(st.scorer.Score());
+      PlanSummary sum;
+      bool over_budget = false;
+      if (!selection.Select(true, &sum, &over_budget)) continue;
+      const LatTraj& won = st.ws.lat[st.ws.winner_lat];
+      EXPECT_FALSE(won.least_harm_only) << "scene " << scene;
+      quick_taken[only] += won.traj.duration < 2.0;
+    }
+  }
+  EXPECT_EQ(flagged[0], 0);
+  EXPECT_GT(flagged[1], 0);
+  EXPECT_GT(quick_taken[0], 0) << "no scene where the selection takes a quick move";
+  EXPECT_EQ(quick_taken[1], 0);
+}
+
 }  // namespace
 }  // namespace frenetic::plan::search
