@@ -85,6 +85,8 @@ constexpr Default kDefaults[] = {
     {"check.behind_time", 1.0, 0, 4, false},
     {"check.clear_enough", 0, 0, 20, false},
     {"check.side_clear", 0, 0, 5, false},
+    {"check.keep_side", 0.3, 0, 2, false},
+    {"check.last_resort_ticks", 145, 0, 149, false},
     {"check.curve_prefilter", 0, 0, 1, false},
     {"vehicle.wheelbase", 0, 0, 10, false},
     {"vehicle.max_steer", 0, 0, 1.5, false},

@@ -49,8 +49,9 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   int best = -1;
   bool all_known = false;
   const bool astride = ws_.straddle_at_start > 0;
-  for (int pass = 0; pass < (astride ? 2 : 1) && best < 0; ++pass) {
-    limits_.SetStraddleLimit(pass == 0 ? kMaxStraddleTicks : kLastResortStraddleTicks);
+  const bool last_resort = astride && cfg_.check.last_resort_ticks > 0;
+  for (int pass = 0; pass < (last_resort ? 2 : 1) && best < 0; ++pass) {
+    limits_.SetStraddleLimit(pass == 0 ? kMaxStraddleTicks : cfg_.check.last_resort_ticks);
     if (cfg_.check.clear_enough > 0) best = CheapestClearEnough(over_budget);
     if (best < 0 && !*over_budget) best = BestClear(over_budget, &all_known, none_passed_before);
     if (*over_budget || (best < 0 && !all_known)) break;
@@ -59,7 +60,7 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   if (*over_budget) return false;
   if (best < 0 && all_known) {
     best = LatestContact(over_budget);
-    if (best >= 0 && astride) best = KeepSide(best);
+    if (best >= 0 && astride && cfg_.check.keep_side > 0) best = KeepSide(best);
   }
   if (best >= 0) {
     ws_.TakeWinner(best);
@@ -72,7 +73,7 @@ int LeastHarm::KeepSide(int best) {
   const int lane = ws_.prev_lat_lane;
   if (lane < 0 || ws_.lat[ws_.cand_lat[best]].lane == lane) return best;
   const int steps =
-      static_cast<int>(std::lround(kKeepSideSeconds / (ws_.collision_step * kTickSeconds)));
+      static_cast<int>(std::lround(cfg_.check.keep_side / (ws_.collision_step * kTickSeconds)));
   const int floor = collisions_.BareContact(best) - steps;
   int keep = -1, keep_hit = 0, k = 0;
   for (const int c : ws_.order) {

@@ -168,8 +168,8 @@ class LeastHarm {
   // With check.clear_enough > 0 the cheapest feasible candidate whose bare boxes keep that far
   // from every car comes first (CheapestClearEnough); the harm ranking only when none does.
   // Astride a line with the timer running: the clear tests once more with the simulator's
-  // count (kLastResortStraddleTicks), and the latest contact keeps the last winner's side
-  // (KeepSide).
+  // count less a little (check.last_resort_ticks), and the latest contact keeps the last winner's
+  // side (KeepSide, check.keep_side).
   bool Choose(bool* over_budget, bool none_passed_before = false);
 
  private:
@@ -203,14 +203,13 @@ class LeastHarm {
   // cut short.
   int LatestContact(bool* over_budget);
   // Astride a line with the timer running, after LatestContact chose `best`: the last winner's
-  // lane (ws.prev_lat_lane) when a feasible move there meets a car at most kKeepSideSeconds
+  // lane (ws.prev_lat_lane) when a feasible move there meets a car at most check.keep_side s
   // sooner (the latest such, then the cheapest), else best. When no candidate passes, the
   // latest contact's choice can swing between the lanes either side from cycle to cycle as the
   // predictions move; each new move first spends its start reversing the last one's motion
   // across, and the ego stays on the line until the timer runs out. Out of time (the checks'
   // deadline), best.
   int KeepSide(int best);
-  static constexpr double kKeepSideSeconds = 0.3;
   // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
   // pairs [first, last), taken by bound from a heap there; -1 when none is (or the deadline cut
   // it short). *k counts the candidates taken, for the deadline checks.

@@ -72,7 +72,7 @@ class LimitChecker {
 
   // The lane-line timer's limit (ticks astride a line, from the start's count) the checks hold
   // a trajectory to: kMaxStraddleTicks unless set. The least-harm choice, when no candidate
-  // keeps it, asks for the simulator's own count less a little (kLastResortStraddleTicks)
+  // keeps it, asks for the simulator's own count less a little (check.last_resort_ticks)
   // before it drops the timer.
   void SetStraddleLimit(int ticks) { straddle_limit_ = ticks; }
 

@@ -82,6 +82,8 @@ Settings::Settings(const PlannerConfig& c) {
   check.clear_enough = c.value("check.clear_enough");
   const double side_clear = c.value("check.side_clear");
   check.side_clear = side_clear > 0 ? side_clear : std::numeric_limits<double>::infinity();
+  check.keep_side = c.value("check.keep_side");
+  check.last_resort_ticks = c.int_value("check.last_resort_ticks");
   check.curve_prefilter = c.int_value("check.curve_prefilter") != 0;
   check.behind_time = c.value("check.behind_time");
   followers_react = c.int_value("prediction.followers_react") != 0;

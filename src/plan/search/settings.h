@@ -23,8 +23,6 @@ inline constexpr double kFollowerLateral = 1.0;
 inline constexpr double kStraddle = 0.8;       // m
 inline constexpr double kLaneLineBand = 0.9;   // m
 inline constexpr int kMaxStraddleTicks = 135;  // ticks
-// The least harm's last try before it drops the timer: the simulator's 150 less 0.1 s.
-inline constexpr int kLastResortStraddleTicks = 145;  // ticks
 // Settings::curve_prefilter's tests (Lattice::TooFastForTheCurve, LimitChecker::CurveExcess)
 // rule out a lateral acceleration this share above limits.max_accel: the XY check measures the
 // total on 0.2 s means, which the tests' lower bounds leave a little room to.
@@ -119,6 +117,13 @@ struct Settings {
     // m: least harm counts a car this far to the side of the ego (bare boxes) as clear at that
     // step, whatever the gap along the road (infinite: off; check.side_clear 0).
     double side_clear = std::numeric_limits<double>::infinity();
+    // s: astride a line with the timer running, the latest contact keeps the last winner's
+    // side when a move there meets a car at most this much sooner (LeastHarm::KeepSide;
+    // check.keep_side, 0: off).
+    double keep_side = 0;
+    // Ticks: astride a line, least harm's clear tests once more with this lane-line count
+    // before it drops the timer (check.last_resort_ticks, 0: no second try).
+    int last_resort_ticks = 0;
     // Longitudinal trajectories whose v^2 kappa along the line clearly exceeds
     // limits.max_accel are not candidates (Lattice::AddLon).
     bool curve_prefilter = false;

@@ -212,7 +212,7 @@ PlannerConfig ClearEnoughConfig(double metres) {
 // The whole ranking as the search planner once did it: every candidate's contact and
 // clearance, sorted, then the first feasible one with the lane-line timer; astride a line
 // (the timer running), the first clear one within the simulator's count less a little
-// (kLastResortStraddleTicks); else the first feasible one without the timer.
+// (check.last_resort_ticks); else the first feasible one without the timer.
 // *last_resort: the choice came from the simulator's count; *kept_side: from the last winner's
 // lane.
 int ReferenceChoice(Stages& st, bool* last_resort = nullptr, bool* kept_side = nullptr) {
@@ -240,7 +240,7 @@ int ReferenceChoice(Stages& st, bool* last_resort = nullptr, bool* kept_side = n
   };
   int c = first_feasible(true, true);
   if (c < 0 && ws.straddle_at_start > 0) {
-    st.limits.SetStraddleLimit(kLastResortStraddleTicks);
+    st.limits.SetStraddleLimit(st.cfg.check.last_resort_ticks);
     c = first_feasible(true, true);
     st.limits.SetStraddleLimit(kMaxStraddleTicks);
     if (last_resort != nullptr) *last_resort = c >= 0;
