@@ -50,6 +50,10 @@ constexpr RegressionDrive kDrives[] = {
     // Astride a line, no clear way off it within the planner's lane-line limit; one within the
     // simulator's own count less 0.1 s (round of 2026-12-05, third stop).
     {"udacity", 446, IncidentKind::kLane, 184.2, "check.last_resort_ticks", 0},
+    // Astride a line, every candidate meets a car: the latest contact's choice swings from side
+    // to side; the last winner's side, when a move there meets one at most 0.3 s sooner
+    // (round of 2026-12-05, third stop).
+    {"dense", 1047, IncidentKind::kCollision, 345.7, "check.keep_side", 0},
 };
 
 // The drive to 1 s past the old incident with `key` set to `value` (NaN: the default).
