@@ -103,6 +103,7 @@ constexpr Default kDefaults[] = {
     {"prediction.brake_horizon", 2, 0, 6, false},
     {"prediction.lateral_threshold", 0.7, 0.2, 3, false},
     {"prediction.lane_change_ghosts", 1, 0, 1, false},
+    {"prediction.follow_gap", 0, 0, 40, false},
     {"prediction.followers_react", 1, 0, 1, false},
     {"prediction.merge_time", 3, 0, 8, false},
     {"refine.enabled", 1, 0, 1, false},

@@ -221,6 +221,8 @@ class TrafficPredictor : public Predictor {
       slot_.push_back(car.recorded ? slot : -1);
     }
     AddCarsToCome(rows, futures, ego_s);
+    for (TrackedCar& c : cars_) c.brake_time = options_.brake_horizon;
+    if (manoeuvres_ && options_.follow_gap > 0 && road_->uniform()) FollowGaps();
     if (manoeuvres_ && options_.lane_change_ghosts && road_->uniform()) {
       AddLaneChangeGhosts(now, ego_d);
     }
@@ -236,7 +238,7 @@ class TrafficPredictor : public Predictor {
     p.v = c.v_s;
     if (c.a_s < -options_.brake_threshold) {
       // Braking at a_s for tb, then at the reached speed (never backwards).
-      const double tb = std::clamp(std::min(options_.brake_horizon, c.v_s / -c.a_s), 0.0, t);
+      const double tb = std::clamp(std::min(c.brake_time, c.v_s / -c.a_s), 0.0, t);
       p.s += c.v_s * tb + 0.5 * c.a_s * tb * tb;
       p.v = std::max(0.0, c.v_s + c.a_s * tb);
       p.s += p.v * (t - tb);
@@ -309,6 +311,32 @@ class TrafficPredictor : public Predictor {
       return;
     }
     *m = {id, s, v, now};
+  }
+
+  // Each braking car's brake_time behind a leader in its lane (the nearest ahead within 2 m
+  // across) whose bumper gap is under follow_gap: the time until the gap, at the leader's
+  // present speed and the car's present deceleration, has opened to follow_gap (at most
+  // brake_horizon). A car braking with no such leader keeps brake_horizon.
+  void FollowGaps() {
+    const int n = static_cast<int>(cars_.size());
+    for (int i = 0; i < n; ++i) {
+      TrackedCar& c = cars_[i];
+      if (!(c.a_s < -options_.brake_threshold) || c.recorded || !(c.s > kAbsentS)) continue;
+      int lead = -1;
+      for (int j = 0; j < n; ++j) {
+        const TrackedCar& o = cars_[j];
+        if (j == i || o.recorded || !(std::abs(o.d - c.d) < 2.0) || !(o.s > c.s)) continue;
+        if (lead < 0 || o.s < cars_[lead].s) lead = j;
+      }
+      if (lead < 0) continue;
+      const TrackedCar& l = cars_[lead];
+      const double gap = l.s - c.s - 0.5 * (l.length + c.length);
+      if (!(gap < options_.follow_gap)) continue;
+      // gap + (v_l - v) t - a t^2 / 2 = follow_gap, a < 0: the positive root.
+      const double a = -c.a_s, b = l.v_s - c.v_s, need = options_.follow_gap - gap;
+      const double t = (-b + std::sqrt(b * b + 2 * a * need)) / a;
+      if (std::isfinite(t)) c.brake_time = std::clamp(t, 0.0, options_.brake_horizon);
+    }
   }
 
   // The second hypothesis of every car ahead that may change lanes by the traffic's own rule

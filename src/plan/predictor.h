@@ -29,6 +29,9 @@ struct TrackedCar {
   double d_target = 0;   // m: where a lateral move is predicted to end (= d when none)
   bool ghost = false;    // a lane change the car may start (PredictorOptions::lane_change_ghosts)
   double lat_delay = 0;  // s before a predicted lateral move starts
+  // s a braking car (a_s below -brake_threshold) is predicted to go on braking: brake_horizon,
+  // or less behind a leader it is predicted to fall back from (PredictorOptions::follow_gap).
+  double brake_time = 0;
   double length = 0, width = 0;  // footprint, m (the row's, else PredictorOptions' defaults)
   bool recorded = false;         // predicted from its CarFuture
   // s after the observation a car to come appears (CarFuture::start); 0 for a car there now.
@@ -67,6 +70,11 @@ struct PredictorOptions {
   // ego_d is known and more than 3 m from the target lane's centre (the rule then ignores the
   // ego: a car alongside or just ahead may move in).
   bool lane_change_ghosts = false;
+  // m: on a uniform road (the Udacity track), a braking car with a leader in its lane closer
+  // than this (bumpers) is predicted to brake only until the gap has opened to it, as the
+  // traffic's following rule brakes in full while its ray hits a car within 10-20 m (§8.3);
+  // 0: brake_horizon for every braking car.
+  double follow_gap = 0;
   double ghost_lateral_speed = 1.6;  // m/s across, about a lane in 2.5 s
   // Both predictors, on a road that is not uniform: a car (not recorded, not moving across
   // already) whose lane drops (map::Road::Drops: a lane drop, a zipper merge, an on-ramp's

@@ -88,6 +88,53 @@ TEST(PredictorTest, ExtrapolatesBrakingAndLaneChanges) {
   EXPECT_NEAR(cv->Predict(0, 3.0).d, 9.0, 0.05);
 }
 
+// With follow_gap, a braking car close behind a slower leader in its lane is predicted to brake
+// until the gap (bumpers, the leader at its present speed) has opened to follow_gap; a braking
+// car with no leader that close keeps brake_horizon, and so does every car with follow_gap 0.
+TEST(PredictorTest, BrakingBehindALeaderLastsUntilTheGapOpens) {
+  REQUIRE_UDACITY_MAP();
+  const auto line = search::testing::UdacityLine();
+  // Ego at s = 200; the follower at s = 240, 17 m/s, braking at 6 m/s^2 (read 0.1 s apart), and
+  // a leader at 15 m/s `ahead` m further on (centre to centre), or none.
+  const auto predicted_speed = [&](double follow_gap, double ahead) {
+    PredictorOptions o;
+    o.follow_gap = follow_gap;
+    auto pred = MakeManoeuvrePredictor(line, o);
+    for (const double t : {0.0, 0.1}) {
+      std::vector<SensorCar> rows;
+      const double v = 17.0 - 6.0 * t, s = 240 + 17.0 * t - 3.0 * t * t;
+      const map::CartesianPose p = line->ToCartesian(s, 6.0);
+      rows.push_back({0, p.x, p.y, v * std::cos(p.heading), v * std::sin(p.heading), s, 6.0});
+      if (ahead > 0) {
+        const double sl = 240 + ahead + 15.0 * t;
+        const map::CartesianPose q = line->ToCartesian(sl, 6.0);
+        rows.push_back(
+            {1, q.x, q.y, 15.0 * std::cos(q.heading), 15.0 * std::sin(q.heading), sl, 6.0});
+      }
+      pred->Observe(rows, 200, t);
+    }
+    const TrackedCar& c = pred->cars()[0];
+    EXPECT_NEAR(c.a_s, -6.0, 0.05);
+    if (ahead > 0) {
+      // The time the gap takes to open: gap + (15 - v) t + 3 t^2 = follow_gap.
+      const TrackedCar& l = pred->cars()[1];
+      const double gap = l.s - c.s - 0.5 * (l.length + c.length), b = l.v_s - c.v_s;
+      const double t = (-b + std::sqrt(b * b + 2 * 6.0 * (follow_gap - gap))) / 6.0;
+      if (gap < follow_gap) {
+        EXPECT_GT(t, 0.3);
+        EXPECT_LT(t, 1.9);
+        EXPECT_NEAR(pred->Predict(0, 3.0).v, c.v_s + c.a_s * t, 0.05);
+      }
+    }
+    return pred->Predict(0, 3.0).v;
+  };
+  const double horizon = 17.0 - 0.6 - 6.0 * 2.0;  // braked for brake_horizon (2 s), then holds
+  EXPECT_NEAR(predicted_speed(0, 20), horizon, 0.1);
+  EXPECT_GT(predicted_speed(18, 20), horizon + 3);     // the gap opens within about 1.3 s
+  EXPECT_NEAR(predicted_speed(18, 40), horizon, 0.1);  // the leader is already far enough
+  EXPECT_NEAR(predicted_speed(18, 0), horizon, 0.1);   // no leader: a hard brake of its own
+}
+
 // A lane drop (a zipper merge, an on-ramp's acceleration lane): a car in the lane that ends
 // moves into the lane beside over the last merge_time s before the end, in both predictors; not
 // when the end is no drop (a lane leaving the road), nor when the car reaches it past the

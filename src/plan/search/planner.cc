@@ -52,6 +52,7 @@ std::unique_ptr<Predictor> MakePredictor(const PlannerConfig& config,
   po.brake_horizon = config.value("prediction.brake_horizon");
   po.lateral_threshold = config.value("prediction.lateral_threshold");
   po.lane_change_ghosts = config.int_value("prediction.lane_change_ghosts") != 0;
+  po.follow_gap = config.value("prediction.follow_gap");
   po.merge_time = config.value("prediction.merge_time");
   po.lane_width = cfg.road.lane_width;
   po.num_lanes = cfg.road.num_lanes;
