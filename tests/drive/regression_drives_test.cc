@@ -3,10 +3,12 @@
 // from the start to just past the old incident, as `frenetic drive --latency random
 // --no-timing` drives it (the map is read from ../shared at test time, never copied).
 //
-// Two tests per drive: with the default configuration it has no incident; with the setting
-// turned back, the incident comes back (the drive still needs the mechanism). When a planner
-// change makes the second one fail, the drive no longer tests its mechanism: find another seed
-// (docs/udacity-results.md says how each was found), do not drop the first.
+// Two tests per drive, each with the settings it was found with: as they are, it has no
+// incident; with the mechanism's setting turned back, the incident comes back (the drive still
+// needs the mechanism). A change of a default elsewhere changes the drives, so each carries the
+// settings that changed since (found_with). When a change to the planner's code makes the
+// second test fail, the drive no longer tests its mechanism: find another seed
+// (docs/udacity-results.md says how each was found); do not drop the first.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,11 +34,17 @@ struct RegressionDrive {
   double incident_t;   // ...and when it came with the setting turned back (s)
   const char* key;     // the setting whose mechanism removed it...
   double off;          // ...and the value that turns it back
+  // The settings the drive was found with where today's defaults differ (YAML over
+  // config/planner.yaml): a later default elsewhere in the planner would drive another drive.
+  const char* found_with;
 };
 
 std::ostream& operator<<(std::ostream& os, const RegressionDrive& r) {
   return os << r.scenario << " seed " << r.seed << " (" << r.key << ")";
 }
+
+// The drives found before prediction.follow_gap (round of 2026-12-06, third stop).
+constexpr const char* kBeforeFollowGap = "prediction:\n  follow_gap: 0\n";
 
 // Found by driving held-out seeds with and without the setting (`--config` with the key set
 // back) and keeping the drives whose first difference from the drive without it comes within
@@ -44,16 +52,21 @@ std::ostream& operator<<(std::ostream& os, const RegressionDrive& r) {
 constexpr RegressionDrive kDrives[] = {
     // A car moves into the ego's lane and brakes; a car in the next lane would come alongside
     // during a hard brake, and least harm took a gentle one (round of 2026-12-06).
-    {"cut-in", 141, IncidentKind::kCollision, 23.02, "check.side_clear", 0},
-    {"cut-in", 1223, IncidentKind::kCollision, 24.04, "check.side_clear", 0},
-    {"dense", 1789, IncidentKind::kCollision, 74.66, "check.side_clear", 0},
+    {"cut-in", 141, IncidentKind::kCollision, 23.02, "check.side_clear", 0, kBeforeFollowGap},
+    {"cut-in", 1223, IncidentKind::kCollision, 24.04, "check.side_clear", 0, kBeforeFollowGap},
+    {"dense", 1789, IncidentKind::kCollision, 74.66, "check.side_clear", 0, kBeforeFollowGap},
     // Astride a line, no clear way off it within the planner's lane-line limit; one within the
     // simulator's own count less 0.1 s (round of 2026-12-05, third stop).
-    {"udacity", 446, IncidentKind::kLane, 184.2, "check.last_resort_ticks", 0},
+    {"udacity", 446, IncidentKind::kLane, 184.2, "check.last_resort_ticks", 0, kBeforeFollowGap},
     // Astride a line, every candidate meets a car: the latest contact's choice swings from side
     // to side; the last winner's side, when a move there meets one at most 0.3 s sooner
     // (round of 2026-12-05, third stop).
-    {"dense", 1047, IncidentKind::kCollision, 345.7, "check.keep_side", 0},
+    {"dense", 1047, IncidentKind::kCollision, 345.7, "check.keep_side", 0, kBeforeFollowGap},
+    // A car cuts in 10 m ahead while it brakes behind its own leader; predicted to brake for 2 s
+    // it meets every candidate, and the latest contact's cheapest keeps speed. Braking only
+    // until its gap opens, a hard brake behind it is clear (this round). A prediction changes the
+    // drive from its first braking car on, so no first difference near the collision shows it.
+    {"cut-in", 17, IncidentKind::kCollision, 99.06, "prediction.follow_gap", 0, ""},
 };
 
 // The drive to 1 s past the old incident with `key` set to `value` (NaN: the default).
@@ -61,6 +74,7 @@ StatusOr<DriveReport> Drive(const std::shared_ptr<const World>& world, const Reg
                             double value) {
   auto config = plan::PlannerConfig::LoadDefault();
   if (!config.ok()) return config.status();
+  if (Status s = config->Overlay(r.found_with, "regression drive"); !s.ok()) return s;
   if (!std::isnan(value)) {
     if (Status s = config->Set(r.key, value); !s.ok()) return s;
   }
