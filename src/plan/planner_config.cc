@@ -233,6 +233,10 @@ Status PlannerConfig::Validate() const {
     return err("continuity.keep_points must leave room in continuity.output_points");
   }
   if (int_value("grid.lat_offsets") % 2 == 0) return err("grid.lat_offsets must be odd");
+  // The last resort relaxes the checks' own lane-line limit (135 ticks, search/settings.h).
+  if (const int t = int_value("check.last_resort_ticks"); t != 0 && t <= 135) {
+    return err("check.last_resort_ticks must be 0 (off) or 136-149, above the checks' 135 ticks");
+  }
   if (int_value("grid.escape_lat_offsets") > 0 && int_value("grid.escape_lat_offsets") % 2 == 0) {
     return err("grid.escape_lat_offsets must be odd (or 0: grid.lat_offsets)");
   }

@@ -91,6 +91,13 @@ TEST(PlannerConfigTest, SetGetRangesAndRoundTrip) {
   Status bad = c->Set("limits.max_speed_mph", 130);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.message().find("limits.max_speed_mph"), std::string::npos);
+  // A last resort at or under the checks' own lane-line limit would relax nothing.
+  Status low = c->Set("check.last_resort_ticks", 14);
+  ASSERT_FALSE(low.ok());
+  EXPECT_NE(low.message().find("check.last_resort_ticks"), std::string::npos);
+  EXPECT_DOUBLE_EQ(*c->Get("check.last_resort_ticks"), 145);
+  EXPECT_TRUE(c->Set("check.last_resort_ticks", 0).ok());
+  EXPECT_TRUE(c->Set("check.last_resort_ticks", 145).ok());
   Status unknown = c->Set("weights.nonsense", 1);
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.message().find("weights.nonsense"), std::string::npos);
