@@ -610,19 +610,21 @@ void Lattice::Generate() {
     const bool own = std::abs(ws_.lane_center[l] - start.d) < 0.5 * cfg_.road.lane_width;
     const bool centred = own && at_rest && std::abs(ws_.lane_center[l] - start.d) < 0.1;
     const bool crawl_hold = own && at_rest && !centred && start.s_d < kCrawlSpeed;
-    // Moves of T s to each end offset around the lane's centre.
-    const auto add_ends = [&](double T) {
-      for (int oi = 0; oi < offsets; ++oi) AddLat(MakeLat(l, (oi - offsets / 2) * offset_step, T));
+    // Moves of T s to each end offset around the lane's centre (for the least harm alone: see
+    // LatTraj::least_harm_only).
+    const auto add_ends = [&](double T, bool least_harm_only) {
+      for (int oi = 0; oi < offsets; ++oi) {
+        LatTraj m = MakeLat(l, (oi - offsets / 2) * offset_step, T);
+        m.least_harm_only = least_harm_only;
+        AddLat(m);
+      }
     };
     for (int ti = 0; ti < (centred ? 1 : crawl_hold ? 0 : cfg_.lat.durations); ++ti) {
-      add_ends(Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti));
+      add_ends(Linspace(cfg_.lat.min_duration, cfg_.lat.max_duration, cfg_.lat.durations, ti),
+               false);
     }
     if (ws_.none_passed_last && cfg_.lat.escape_duration > 0 && !centred && !crawl_hold) {
-      const auto first = ws_.lat.size();
-      add_ends(cfg_.lat.escape_duration);
-      for (auto j = first; j < ws_.lat.size(); ++j) {
-        ws_.lat[j].least_harm_only = cfg_.lat.escape_least_harm;
-      }
+      add_ends(cfg_.lat.escape_duration, cfg_.lat.escape_least_harm);
     }
     // At a crawl, laterally at rest off the lane's centre: holding d, the own lane's only move. A
     // move across there turns the car far off the lane's heading for the little way it drives

@@ -43,7 +43,7 @@ bool Selection::Select(bool none_passed_before, PlanSummary* summary, bool* over
       return false;
     }
     const int c = ws_.order[r];
-    if (ws_.lat[ws_.cand_lat[c]].least_harm_only) continue;
+    if (LeastHarmOnly(c)) continue;
     ++sum.candidates_checked;
     // Cheapest first: the Frenet-only collision test skips the tick sampling and the XY
     // conversion for the many candidates that run into traffic. Past the traced ranks, whether
@@ -87,7 +87,7 @@ int Selection::CheapestPassing(int r0, bool none_passed_before, PlanSummary* sum
   for (int k = r0; k < n; ++k) {
     const int c = ws_.order[k];
     popped_[c] = 0;
-    if (ws_.lat[ws_.cand_lat[c]].least_harm_only) {
+    if (LeastHarmOnly(c)) {
       popped_[c] = 1;  // the rank walk below skips it too
       continue;
     }

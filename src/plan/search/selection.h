@@ -57,6 +57,11 @@ class Selection {
   int CheapestPassing(int r0, bool none_passed_before, PlanSummary* summary, bool* cut);
 
  private:
+  // Whether candidate c is for the least harm alone (LatTraj::least_harm_only): only ever so
+  // with grid.escape_lat_least_harm, so without it no candidate's move is read.
+  bool LeastHarmOnly(int c) const {
+    return cfg_.lat.escape_least_harm && ws_.lat[ws_.cand_lat[c]].least_harm_only;
+  }
   const Settings& cfg_;
   Workspace& ws_;
   Scorer& scorer_;
