@@ -338,7 +338,7 @@ def main():
                         "$FRENETIC_BUILD_DIR when set)")
     p.add_argument("--jobs", type=int, default=0,
                    help="scenario files planned in parallel (frenetic commonroad --jobs; default "
-                        "0: all cores)")
+                        "0: every core this process may use)")
     p.add_argument("--sets", default=",".join(SETS),
                    help=f"comma-separated sets to run (default: all: {','.join(SETS)})")
     p.add_argument("--predictions", default="recorded,cv",

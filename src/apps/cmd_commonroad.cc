@@ -15,11 +15,10 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "apps/commonroad_mpi.h"
@@ -31,6 +30,7 @@
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
+#include "frenetic/cores.h"
 #include "frenetic/json_text.h"
 #include "frenetic/plan/planner_config.h"
 #include "frenetic/tune/cluster.h"
@@ -253,7 +253,7 @@ std::vector<FileReport> RunShare(const Args& a, const Setup& setup, const tune::
   }
   const int share = static_cast<int>(mine.size());
   std::vector<FileReport> results(n);
-  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  const int cores = UsableCores();
   const int jobs = std::max(1, std::min(a.jobs > 0 ? a.jobs : cores, share));
   std::atomic<int> next{0}, done{0}, solved{0}, problems{0};
   std::mutex progress_mutex;
@@ -411,7 +411,8 @@ void RegisterCommonRoad(CLI::App& app) {
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->add_option("--jobs", args->jobs,
                   "Scenario files planned in parallel per process (under mpirun, per rank; 0 = "
-                  "all cores). Results do not depend on it. Default: 0")
+                  "every core this process may use, its CPU affinity: taskset). Results do not "
+                  "depend on it. Default: 0")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,
                 "Show the progress line on stderr even when it is not a terminal");

@@ -291,7 +291,8 @@ void RegisterDrive(CLI::App& app) {
                   "Default: 1")
       ->check(CLI::Range(1, 100000));
   sub->add_option("--jobs", args->jobs,
-                  "Threads for --episodes (0 = all cores). Results do not depend on it. "
+                  "Threads for --episodes (0 = every core this process may use, its CPU affinity: "
+                  "taskset). Results do not depend on it. "
                   "Default: 0")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--progress", args->progress,

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "frenetic/cores.h"
 #include "frenetic/drive/traffic_runs.h"
 #include "frenetic/eval/fidelity.h"
 #include "frenetic/json_text.h"
@@ -118,8 +119,7 @@ int RunFidelity(const FidelityArgs& args) {
     options.minutes = args.minutes;
     options.episode_seconds = args.episode_seconds;
     options.first_seed = args.seed;
-    options.jobs = args.jobs > 0 ? args.jobs
-                                 : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    options.jobs = args.jobs > 0 ? args.jobs : UsableCores();
     sim::TrafficStatsBuilder real((*world)->track.max_s);
     for (const auto& r : *recordings) real.AddRun(sim::RecordingTrafficSamples(r));
     auto simulated = sim::SimulateTraffic(*world, options, args.config);
@@ -278,8 +278,8 @@ void RegisterFidelity(CLI::App& app) {
   sub->add_option("--seed", args->seed, "First episode seed; episodes use seed, seed+1, ... "
                                         "(default: 1)");
   sub->add_option("--jobs", args->jobs,
-                  "Threads for the traffic episodes, 0 = all cores (default: 0); results do not\n"
-                  "depend on it")
+                  "Threads for the traffic episodes, 0 = every core this process may use (its CPU\n"
+                  "affinity: taskset; default: 0); results do not depend on it")
       ->check(CLI::Range(0, 256));
   sub->add_flag("--json", args->json, "Print the results as one JSON object on stdout");
   sub->callback([args] { ExitWith(RunFidelity(*args)); });

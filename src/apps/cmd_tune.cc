@@ -154,7 +154,9 @@ void RegisterTune(CLI::App& app) {
   sub->add_option("-o,--output", args->output, "Write the tuned planner config (YAML) here");
   sub->add_option("--map", args->map, "Track file (overrides the suite's map)");
   sub->add_option("--budget", args->budget, "Search evaluations (default: the suite's budget)");
-  sub->add_option("--jobs", args->jobs, "Threads per process (default: all cores)");
+  sub->add_option("--jobs", args->jobs,
+                  "Threads per process (default: every core this process may use, its CPU "
+                  "affinity: taskset)");
   sub->add_option("--resume", args->resume,
                   "Continue from this JSON-lines log (also the log unless --log is given)");
   sub->add_option("--log", args->log, "Append every evaluation to this JSON-lines log");

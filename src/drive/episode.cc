@@ -11,6 +11,7 @@
 #include <optional>
 #include <thread>
 
+#include "frenetic/cores.h"
 #include "frenetic/drive/evaluators.h"
 #include "frenetic/drive/foresee.h"
 #include "frenetic/drive/record.h"
@@ -258,7 +259,7 @@ StatusOr<AggregateReport> RunEpisodes(std::shared_ptr<const World> world, const 
   if (options.oracle) {
     if (Status s = options.oracle->Validate(); !s.ok()) return s;
   }
-  if (jobs <= 0) jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (jobs <= 0) jobs = UsableCores();
   jobs = std::min(jobs, episodes);
   std::vector<std::optional<StatusOr<DriveReport>>> results(episodes);
   std::atomic<int> next{0};

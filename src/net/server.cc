@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "frenetic/cores.h"
 #include "frenetic/percentile.h"
 #include "frenetic/units.h"
 #include "net/refusal.h"
@@ -224,7 +225,7 @@ void Server::Run() {
   Impl& s = *impl_;
   int threads = s.options.planning_threads;
   if (threads == 0) {
-    threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 2, 8);
+    threads = std::clamp(UsableCores(), 2, 8);
   }
   spdlog::info("listening on ws://{}:{} (any path), {} planning threads, at most {} connections",
                s.options.bind_address, s.bound_port, threads, s.options.max_connections);

@@ -17,6 +17,7 @@
 #include "frenetic/commonroad/runner.h"
 #include "frenetic/commonroad/setup.h"
 #include "frenetic/commonroad/solution.h"
+#include "frenetic/cores.h"
 #include "frenetic/drive/episode.h"
 #include "frenetic/map/track.h"
 #include "frenetic/plan/planner.h"
@@ -351,7 +352,7 @@ StatusOr<std::unique_ptr<Evaluator>> Evaluator::Create(const Suite& suite, int j
   auto impl = std::make_unique<Impl>();
   impl->suite = suite;
   impl->cluster = &cluster;
-  impl->jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  impl->jobs = jobs > 0 ? jobs : UsableCores();
   if (suite.kind == SuiteKind::kCommonRoad) {
     auto start = LoadStartConfig(suite);
     if (!start.ok()) return start.status();
