@@ -87,6 +87,7 @@ constexpr Default kDefaults[] = {
     {"check.side_clear", 0, 0, 5, false},
     {"check.keep_side", 0.3, 0, 2, false},
     {"check.last_resort_ticks", 145, 0, 149, false},
+    {"check.keep_lane", 0, 0, 3, false},
     {"check.curve_prefilter", 0, 0, 1, false},
     {"vehicle.wheelbase", 0, 0, 10, false},
     {"vehicle.max_steer", 0, 0, 1.5, false},

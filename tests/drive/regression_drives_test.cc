@@ -43,8 +43,10 @@ std::ostream& operator<<(std::ostream& os, const RegressionDrive& r) {
   return os << r.scenario << " seed " << r.seed << " (" << r.key << ")";
 }
 
-// The drives found before prediction.follow_gap (round of 2026-12-06, third stop).
-constexpr const char* kBeforeFollowGap = "prediction:\n  follow_gap: 0\n";
+// The drives found before prediction.follow_gap (round of 2026-12-06, third stop) and
+// check.keep_lane (fourth stop), and the ones found before check.keep_lane only.
+constexpr const char* kBeforeFollowGap = "prediction:\n  follow_gap: 0\ncheck:\n  keep_lane: 0\n";
+constexpr const char* kBeforeKeepLane = "check:\n  keep_lane: 0\n";
 
 // Found by driving held-out seeds with and without the setting (`--config` with the key set
 // back) and keeping the drives whose first difference from the drive without it comes within
@@ -66,7 +68,13 @@ constexpr RegressionDrive kDrives[] = {
     // it meets every candidate, and the latest contact's cheapest keeps speed. Braking only
     // until its gap opens, a hard brake behind it is clear (this round). A prediction changes the
     // drive from its first braking car on, so no first difference near the collision shows it.
-    {"cut-in", 17, IncidentKind::kCollision, 99.06, "prediction.follow_gap", 0, ""},
+    {"cut-in", 17, IncidentKind::kCollision, 99.06, "prediction.follow_gap", 0, kBeforeKeepLane},
+    // No candidate passes from 10.18 s: a car from the left lane moves in ahead, braking, while
+    // the ego is on the line to the right lane. At 10.92 s the latest contact's choice goes back
+    // to the middle lane; after a cycle with none passing, the last winner's lane, the right
+    // one, when a move there meets a car at most 1 s sooner (this round; first difference
+    // 1.08 s before the collision).
+    {"dense", 17, IncidentKind::kCollision, 12.0, "check.keep_lane", 0, ""},
 };
 
 // The drive to 1 s past the old incident with `key` set to `value` (NaN: the default).

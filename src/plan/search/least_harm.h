@@ -164,7 +164,8 @@ class LeastHarm {
   // none is even feasible but for the timer, or when the deadline (85% of budget_ms) cut it
   // short: then *over_budget is set.
   // none_passed_before: the last cycle's search found no candidate passing either (its Choose
-  // was the last call), a hint that changes no choice, only the work.
+  // was the last call): a hint for the work, and with check.keep_lane the latest contact keeps
+  // the last winner's lane (KeepSide) off a line too.
   // With check.clear_enough > 0 the cheapest feasible candidate whose bare boxes keep that far
   // from every car comes first (CheapestClearEnough); the harm ranking only when none does.
   // Astride a line with the timer running: the clear tests once more with the simulator's
@@ -202,14 +203,15 @@ class LeastHarm {
   // contact exact (known_ 1) unless it returns a candidate of a contact from latest_ on or is
   // cut short.
   int LatestContact(bool* over_budget);
-  // Astride a line with the timer running, after LatestContact chose `best`: the last winner's
-  // lane (ws.prev_lat_lane) when a feasible move there meets a car at most check.keep_side s
+  // After LatestContact chose `best`, astride a line with the timer running (keep_side:
+  // check.keep_side) or after a cycle in which none passed either (check.keep_lane): the last
+  // winner's lane (ws.prev_lat_lane) when a feasible move there meets a car at most keep_side s
   // sooner (the latest such, then the cheapest), else best. When no candidate passes, the
-  // latest contact's choice can swing between the lanes either side from cycle to cycle as the
-  // predictions move; each new move first spends its start reversing the last one's motion
-  // across, and the ego stays on the line until the timer runs out. Out of time (the checks'
-  // deadline), best.
-  int KeepSide(int best);
+  // latest contact's choice can swing between lanes from cycle to cycle as the predictions
+  // move; each new move first spends its start reversing the last one's motion across, so the
+  // ego stays on the line until the timer runs out, or brakes half as hard as either move
+  // would. Out of time (the checks' deadline), best.
+  int KeepSide(int best, double keep_side);
   // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
   // pairs [first, last), taken by bound from a heap there; -1 when none is (or the deadline cut
   // it short). *k counts the candidates taken, for the deadline checks.

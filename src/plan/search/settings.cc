@@ -84,6 +84,7 @@ Settings::Settings(const PlannerConfig& c) {
   check.side_clear = side_clear > 0 ? side_clear : std::numeric_limits<double>::infinity();
   check.keep_side = c.value("check.keep_side");
   check.last_resort_ticks = c.int_value("check.last_resort_ticks");
+  check.keep_lane = c.value("check.keep_lane");
   check.curve_prefilter = c.int_value("check.curve_prefilter") != 0;
   check.behind_time = c.value("check.behind_time");
   followers_react = c.int_value("prediction.followers_react") != 0;

@@ -124,6 +124,10 @@ struct Settings {
     // Ticks: astride a line, least harm's clear tests once more with this lane-line count
     // before it drops the timer (check.last_resort_ticks, 0: no second try).
     int last_resort_ticks = 0;
+    // s: after a cycle in which no candidate passed, when every candidate meets a car, least
+    // harm keeps the last winner's lane if a move there meets one at most this much sooner
+    // (LeastHarm::KeepSide off the line too; check.keep_lane, 0: off).
+    double keep_lane = 0;
     // Longitudinal trajectories whose v^2 kappa along the line clearly exceeds
     // limits.max_accel are not candidates (Lattice::AddLon).
     bool curve_prefilter = false;

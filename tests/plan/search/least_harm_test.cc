@@ -190,6 +190,56 @@ TEST(SearchLeastHarmTest, TakesTheLatestContactWhenAllCollideAndCostBreaksTies) 
   EXPECT_EQ(st.ws.winner_index, 2) << "identical trajectories: the cheaper one";
 }
 
+TEST(SearchLeastHarmTest, KeepLaneHoldsTheLastWinnersLaneAfterACycleWithNonePassing) {
+  REQUIRE_UDACITY_MAP();
+  // Stopped cars 36 m ahead in the ego's (middle) lane and 46 m ahead in the left one. Keeping
+  // the lane at 20 m/s meets the first after about 1.5 s; moving left in 2 s meets the second
+  // about 0.5 s later, so the latest contact moves left. After a cycle in which none passed,
+  // check.keep_lane keeps the last winner's lane (the middle) when that is at most keep_lane
+  // sooner.
+  struct Case {
+    double keep_lane;
+    bool none_passed_before;
+    int winner;
+  };
+  for (const Case& k :
+       {Case{0.0, true, 1}, Case{0.3, true, 1}, Case{0.8, true, 0}, Case{0.8, false, 1}}) {
+    PlannerConfig config = testing::DefaultConfig();
+    ASSERT_TRUE(
+        config.Overlay("check:\n  keep_lane: " + std::to_string(k.keep_lane) + "\n", "test").ok());
+    Stages st(config);
+    Start(st, {{kS + 36, st.ws.lane_center[1], 0}, {kS + 46, st.ws.lane_center[0], 0}});
+    Workspace& ws = st.ws;
+    ws.lon.clear();
+    ws.lat.clear();
+    ws.cand_lon.clear();
+    ws.cand_lat.clear();
+    ws.cand_cost.clear();
+    ws.order.clear();
+    ws.lon.push_back(st.lattice.MakeLon(cost::LonKind::kVelocityKeeping, -1, 20, 3.0));
+    ws.lat.push_back(st.lattice.MakeLat(1, 0.0, 3.0));
+    ws.lat.push_back(st.lattice.MakeLat(0, 0.0, 2.0));
+    for (int c = 0; c < 2; ++c) {
+      ws.cand_lon.push_back(0);
+      ws.cand_lat.push_back(c);
+      ws.order.push_back(c);
+      ws.cand_cost.push_back(1.0 + c);
+    }
+    st.scorer.TakeCostsAsExact();
+    ws.prev_lat_lane = 1;
+    const int contact[2] = {st.collisions.BareContact(0), st.collisions.BareContact(1)};
+    ASSERT_LE(contact[1], ws.n_steps) << "the move left meets the car in the left lane";
+    const double sooner = (contact[1] - contact[0]) * ws.collision_step * kTickSeconds;
+    ASSERT_GT(sooner, 0.35) << "keeping the lane meets its car sooner";
+    ASSERT_LT(sooner, 0.75);
+    bool over_budget = false;
+    ASSERT_TRUE(st.least_harm.Choose(&over_budget, k.none_passed_before));
+    EXPECT_FALSE(over_budget);
+    EXPECT_EQ(ws.winner_index, k.winner)
+        << "keep_lane " << k.keep_lane << ", none passed before " << k.none_passed_before;
+  }
+}
+
 TEST(SearchLeastHarmTest, NeverTakesAnInfeasibleCandidate) {
   REQUIRE_UDACITY_MAP();
   Stages st;
