@@ -20,14 +20,18 @@ using testing::Stages;
 struct Option {
   double end_speed, T, cost;
 };
-void SetCandidates(Stages& st, const std::vector<Option>& options) {
-  Workspace& ws = st.ws;
+// No bundles and no candidates.
+void ClearCandidates(Workspace& ws) {
   ws.lon.clear();
   ws.lat.clear();
   ws.cand_lon.clear();
   ws.cand_lat.clear();
   ws.cand_cost.clear();
   ws.order.clear();
+}
+void SetCandidates(Stages& st, const std::vector<Option>& options) {
+  Workspace& ws = st.ws;
+  ClearCandidates(ws);
   ws.lat.push_back(st.lattice.MakeLat(1, 0.0, 3.0));
   for (const Option& o : options) {
     ws.cand_lon.push_back(static_cast<int>(ws.lon.size()));
@@ -210,12 +214,7 @@ TEST(SearchLeastHarmTest, KeepLaneHoldsTheLastWinnersLaneAfterACycleWithNonePass
     Stages st(config);
     Start(st, {{kS + 36, st.ws.lane_center[1], 0}, {kS + 46, st.ws.lane_center[0], 0}});
     Workspace& ws = st.ws;
-    ws.lon.clear();
-    ws.lat.clear();
-    ws.cand_lon.clear();
-    ws.cand_lat.clear();
-    ws.cand_cost.clear();
-    ws.order.clear();
+    ClearCandidates(ws);
     ws.lon.push_back(st.lattice.MakeLon(cost::LonKind::kVelocityKeeping, -1, 20, 3.0));
     ws.lat.push_back(st.lattice.MakeLat(1, 0.0, 3.0));
     ws.lat.push_back(st.lattice.MakeLat(0, 0.0, 2.0));
