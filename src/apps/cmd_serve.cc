@@ -116,11 +116,11 @@ void RegisterServe(CLI::App& app) {
                   "Connections open at once (upgrading or upgraded); one more is answered HTTP "
                   "503 with the reason and closed (default: 8, room for a few simulators)")
       ->check(CLI::Range(1, 10000));
-  sub->add_option(
-         "--planning-threads", args->server.planning_threads,
-         "Threads that convert frames and plan, shared by all connections (each "
-         "connection's planner is used by one thread at a time); 0 = one per core this "
-         "process may use (its CPU affinity: taskset), at least 2 and at most 8 (default: 0)")
+  sub->add_option("--planning-threads", args->server.planning_threads,
+                  "Threads that convert frames and plan, shared by all connections (each "
+                  "connection's planner is used by one thread at a time); 0 = one per core this "
+                  "process may use (its CPU affinity: taskset), at least 2 and at most 8 "
+                  "(default: 0)")
       ->check(CLI::Range(0, 256));
   sub->add_flag("--no-deadlines", args->no_deadlines,
                 "Switch the planner's wall-clock deadlines (budget_ms, refine.budget_ms) off, as "

@@ -60,11 +60,11 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   if (*over_budget) return false;
   if (best < 0 && all_known) {
     best = LatestContact(over_budget);
-    if (best >= 0 && astride && cfg_.check.keep_side > 0) {
-      best = KeepSide(best, cfg_.check.keep_side);
-    } else if (best >= 0 && none_passed_before && cfg_.check.keep_lane > 0) {
-      best = KeepSide(best, cfg_.check.keep_lane);
-    }
+    // Astride a line keep_side (when on), else after a cycle with none passing keep_lane.
+    const double margin = astride && cfg_.check.keep_side > 0 ? cfg_.check.keep_side
+                          : none_passed_before                ? cfg_.check.keep_lane
+                                                              : 0.0;
+    if (best >= 0 && margin > 0) best = KeepSide(best, margin);
   }
   if (best >= 0) {
     ws_.TakeWinner(best);
@@ -73,10 +73,10 @@ bool LeastHarm::Choose(bool* over_budget, bool none_passed_before) {
   return !*over_budget && ChooseByRanking(over_budget, all_known);
 }
 
-int LeastHarm::KeepSide(int best, double keep_side) {
+int LeastHarm::KeepSide(int best, double margin) {
   const int lane = ws_.prev_lat_lane;
   if (lane < 0 || ws_.lat[ws_.cand_lat[best]].lane == lane) return best;
-  const int steps = static_cast<int>(std::lround(keep_side / (ws_.collision_step * kTickSeconds)));
+  const int steps = static_cast<int>(std::lround(margin / (ws_.collision_step * kTickSeconds)));
   const int floor = collisions_.BareContact(best) - steps;
   int keep = -1, keep_hit = 0, k = 0;
   for (const int c : ws_.order) {

@@ -203,15 +203,15 @@ class LeastHarm {
   // contact exact (known_ 1) unless it returns a candidate of a contact from latest_ on or is
   // cut short.
   int LatestContact(bool* over_budget);
-  // After LatestContact chose `best`, astride a line with the timer running (keep_side:
+  // After LatestContact chose `best`, astride a line with the timer running (margin:
   // check.keep_side) or after a cycle in which none passed either (check.keep_lane): the last
-  // winner's lane (ws.prev_lat_lane) when a feasible move there meets a car at most keep_side s
+  // winner's lane (ws.prev_lat_lane) when a feasible move there meets a car at most margin s
   // sooner (the latest such, then the cheapest), else best. When no candidate passes, the
   // latest contact's choice can swing between lanes from cycle to cycle as the predictions
   // move; each new move first spends its start reversing the last one's motion across, so the
   // ego stays on the line until the timer runs out, or brakes half as hard as either move
   // would. Out of time (the checks' deadline), best.
-  int KeepSide(int best, double keep_side);
+  int KeepSide(int best, double margin);
   // The cheapest feasible candidate (by exact cost, then index) of the (cost bound, index)
   // pairs [first, last), taken by bound from a heap there; -1 when none is (or the deadline cut
   // it short). *k counts the candidates taken, for the deadline checks.
