@@ -18,7 +18,6 @@
 #include <csignal>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <vector>
 
 #include "frenetic/cores.h"
