@@ -186,7 +186,9 @@ FileReport RunFile(const InputFile& item, const plan::PlannerConfig& config,
       solution.trajectories.push_back(std::move(t));
     }
   }
-  if (options.timing) solution.computation_time = computation;
+  // commonroad-io's reader asserts a computation time above 0: none is written when no cycle ran
+  // (every problem infeasible at start) or the clock read 0.
+  if (options.timing && computation > 0) solution.computation_time = computation;
   if (!solution_dir.empty() && !solution.trajectories.empty()) {
     const Status saved = cr::SaveSolution(solution, solution_dir);
     if (saved.ok()) {

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include <boost/geometry/index/rtree.hpp>
@@ -22,8 +26,8 @@ namespace bgi = boost::geometry::index;
 
 namespace {
 
-// Holes below this are slivers between lanelets, not road features (see the header).
-constexpr double kMinHoleArea = 1.0;  // m^2
+// Holes below this are the rounding of shared points, not gaps of the network (see the header).
+constexpr double kMinHoleArea = 1e-9;  // m^2
 
 bool Finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
@@ -71,6 +75,119 @@ std::vector<std::vector<Vec2>> LaneletRings(const Lanelet& lanelet, double open_
   return rings;
 }
 
+// The outline of each lane section, as CommonRoad's drivability checker builds its road
+// (commonroad_dc.boundary.lanelet_bounds.lane_sections and lane_hull): a section is a lanelet with
+// every lanelet reached from it through adjacentLeft / adjacentRight (either driving direction);
+// its outline runs across its start from the rightmost lanelet's right bound to the leftmost's
+// left bound, along that left bound, back across its end and along the rightmost's right bound.
+// The lane lines inside a section are not part of it. A section is listed once per lanelet the
+// walk starts from that it has not met (as the checker's does; the union does not mind).
+struct Section {
+  std::vector<Vec2> ring;
+  std::vector<int> members;  // lanelet ids
+};
+
+std::vector<Section> SectionRings(std::span<const Lanelet> lanelets) {
+  std::unordered_map<int, const Lanelet*> by_id;
+  for (const Lanelet& l : lanelets) by_id.emplace(l.id, &l);
+  const auto find = [&](const std::optional<Adjacent>& a) -> const Lanelet* {
+    if (!a) return nullptr;
+    const auto it = by_id.find(a->id);
+    return it == by_id.end() ? nullptr : it->second;
+  };
+  const int limit = static_cast<int>(lanelets.size());  // a cycle of references ends there
+  std::unordered_set<int> met;
+  std::vector<Section> rings;
+  for (auto it = lanelets.rbegin(); it != lanelets.rend(); ++it) {  // the checker pops the last
+    if (met.count(it->id) != 0) continue;
+    met.insert(it->id);
+    const Lanelet* current = &*it;
+    std::vector<int> members{it->id};
+    bool direction = true;  // whether `current` is driven as the first lanelet is
+    // To the rightmost lanelet.
+    for (int n = 0; n < limit; ++n) {
+      const std::optional<Adjacent>& a =
+          direction ? current->adjacent_right : current->adjacent_left;
+      const Lanelet* next = find(a);
+      if (next == nullptr) break;
+      direction = direction == a->same_direction;
+      current = next;
+      members.push_back(current->id);
+    }
+    const auto bounds_of = [](const Lanelet* l) {
+      return std::make_pair(CleanPolyline(l->left), CleanPolyline(l->right));
+    };
+    std::vector<Vec2> start, end_reversed;  // across the start (right to left); the end's reverse
+    auto [left0, right0] = bounds_of(current);
+    if (left0.empty() || right0.empty()) continue;
+    std::vector<Vec2> right_side = direction ? right0 : left0;  // along the section
+    if (!direction) std::reverse(right_side.begin(), right_side.end());
+    const auto add_across = [&](const std::vector<Vec2>& left, const std::vector<Vec2>& right,
+                                bool dir, bool initial) {
+      if (initial) {
+        start.push_back(dir ? right.front() : left.back());
+        end_reversed.push_back(dir ? right.back() : left.front());
+      }
+      start.push_back(dir ? left.front() : right.back());
+      end_reversed.push_back(dir ? left.back() : right.front());
+    };
+    add_across(left0, right0, direction, true);
+    // Leftward to the leftmost lanelet.
+    bool ok = true;
+    for (int n = 0; n < limit; ++n) {
+      const std::optional<Adjacent>& a =
+          direction ? current->adjacent_left : current->adjacent_right;
+      const Lanelet* next = find(a);
+      if (next == nullptr) break;
+      direction = direction == a->same_direction;
+      current = next;
+      met.insert(current->id);
+      members.push_back(current->id);
+      auto [l, r] = bounds_of(current);
+      if (l.empty() || r.empty()) {
+        ok = false;
+        break;
+      }
+      add_across(l, r, direction, false);
+    }
+    if (!ok) continue;
+    auto [left1, right1] = bounds_of(current);
+    std::vector<Vec2> left_side = direction ? left1 : right1;
+    if (!direction) std::reverse(left_side.begin(), left_side.end());
+    // start, the left side's inner points, the end (left to right), the right side's inner
+    // points backwards: one closed outline.
+    std::vector<Vec2> ring = start;
+    for (size_t i = 1; i + 1 < left_side.size(); ++i) ring.push_back(left_side[i]);
+    ring.insert(ring.end(), end_reversed.rbegin(), end_reversed.rend());
+    for (size_t i = right_side.size() - 1; i-- > 1;) ring.push_back(right_side[i]);
+    rings.push_back({CleanPolyline(ring), std::move(members)});
+  }
+  return rings;
+}
+
+// Unites `ring` into `area`, grown by `tolerance` (then unbuffered when Boost.Geometry cannot
+// grow it). False when neither could be united.
+bool Unite(BoostMultiPolygon& area, const std::vector<Vec2>& ring, double tolerance) {
+  const BoostPolygon polygon = ToBoostPolygon(ring);
+  for (const double distance : {tolerance, 0.0}) {
+    try {
+      const BoostMultiPolygon grown = Buffered(polygon, distance);
+      if (grown.empty()) continue;
+      BoostMultiPolygon merged;
+      bg::union_(area, grown, merged);
+      if (merged.empty()) continue;
+      area = std::move(merged);
+      return true;
+    } catch (const std::exception&) {
+    }
+  }
+  return false;
+}
+
+bool UsableRing(const std::vector<Vec2>& ring) {
+  return ring.size() >= 3 && std::all_of(ring.begin(), ring.end(), Finite);
+}
+
 }  // namespace
 
 struct RoadArea::Impl {
@@ -86,33 +203,36 @@ RoadArea RoadArea::Build(std::span<const Lanelet> lanelets, double tolerance,
   auto impl = std::make_shared<Impl>();
   tolerance = std::isfinite(tolerance) ? std::max(tolerance, 0.0) : 0.0;
   open_end_margin = std::isfinite(open_end_margin) ? std::max(open_end_margin, 0.0) : 0.0;
+  // The lane sections' outlines. One that is no simple polygon (a section whose lanelets end at
+  // different places can fold its outline), or that Boost.Geometry cannot unite, gives way to its
+  // lanelets' own polygons.
+  std::unordered_set<int> in_section;
+  std::unordered_set<int> own_polygon;
+  for (const Section& section : SectionRings(lanelets)) {
+    in_section.insert(section.members.begin(), section.members.end());
+    bool united = false;
+    if (UsableRing(section.ring)) {
+      const BoostPolygon polygon = ToBoostPolygon(section.ring);
+      united = std::abs(bg::area(polygon)) >= 1e-9 && bg::is_valid(polygon) &&
+               Unite(impl->area, section.ring, tolerance);
+    }
+    if (!united) own_polygon.insert(section.members.begin(), section.members.end());
+  }
   for (const Lanelet& lanelet : lanelets) {
     bool lanelet_ok = true;
-    for (const std::vector<Vec2>& ring : LaneletRings(lanelet, open_end_margin)) {
-      if (ring.size() < 3 || !std::all_of(ring.begin(), ring.end(), Finite)) {
+    const bool own = own_polygon.count(lanelet.id) != 0 || in_section.count(lanelet.id) == 0;
+    const std::vector<std::vector<Vec2>> rings = LaneletRings(lanelet, open_end_margin);
+    for (size_t i = own ? 0 : 1; i < rings.size(); ++i) {  // rings[0]: its polygon
+      const std::vector<Vec2>& ring = rings[i];
+      if (!UsableRing(ring)) {
         lanelet_ok = false;
         continue;
       }
       // A degenerate extension (a lane that ends in a point) adds nothing.
-      const BoostPolygon polygon = ToBoostPolygon(ring);
-      if (std::abs(bg::area(polygon)) < 1e-9) continue;
-      bool united = false;
+      if (std::abs(bg::area(ToBoostPolygon(ring))) < 1e-9) continue;
       // Boost.Geometry reports input it cannot handle with exceptions: fall back to the
       // unbuffered polygon, then to leaving the ring out.
-      for (const double distance : {tolerance, 0.0}) {
-        try {
-          const BoostMultiPolygon grown = Buffered(polygon, distance);
-          if (grown.empty()) continue;
-          BoostMultiPolygon merged;
-          bg::union_(impl->area, grown, merged);
-          if (merged.empty()) continue;
-          impl->area = std::move(merged);
-          united = true;
-          break;
-        } catch (const std::exception&) {
-        }
-      }
-      lanelet_ok = lanelet_ok && united;
+      lanelet_ok = Unite(impl->area, ring, tolerance) && lanelet_ok;
     }
     if (!lanelet_ok) impl->skipped.push_back(lanelet.id);
   }
@@ -171,6 +291,23 @@ int RoadArea::HoleCount() const {
   int holes = 0;
   for (const BoostPolygon& p : impl_->area) holes += static_cast<int>(p.inners().size());
   return holes;
+}
+
+std::vector<std::vector<Vec2>> RoadArea::HoleRings() const {
+  std::vector<std::vector<Vec2>> rings;
+  for (const BoostPolygon& p : impl_->area) {
+    for (const auto& hole : p.inners()) rings.emplace_back(hole.begin(), hole.end());
+  }
+  return rings;
+}
+
+std::vector<std::vector<Vec2>> RoadArea::BoundaryRings() const {
+  std::vector<std::vector<Vec2>> rings;
+  for (const BoostPolygon& p : impl_->area) {
+    rings.emplace_back(p.outer().begin(), p.outer().end());
+    for (const auto& hole : p.inners()) rings.emplace_back(hole.begin(), hole.end());
+  }
+  return rings;
 }
 
 std::span<const int> RoadArea::SkippedLanelets() const { return impl_->skipped; }

@@ -276,8 +276,11 @@ ScenarioRun RunScenario(const Scenario& sc, const plan::PlannerConfig& config,
     }
     run.stop_reason = "time";
     const GoalTest goal(sc, problem.goals);
+    // A state that meets a goal ends the run after it. The initial state ends it one step on:
+    // CommonRoad's feasibility check fails on a trajectory of a single state.
+    const bool met_at_start = goal.MeetsAny(ego);
     for (int k = start; k < end; ++k) {
-      if (goal.MeetsAny(ego)) {
+      if (k > start && (met_at_start || goal.MeetsAny(ego))) {
         run.stop_reason = "goal";
         break;
       }

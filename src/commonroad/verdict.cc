@@ -282,8 +282,10 @@ Verdict VerdictChecker::Check(const PlanningProblem& problem,
          Fmt("starts at (%.3f, %.3f), the problem at (%.3f, %.3f)", s0.x, s0.y,
              init.position.x, init.position.y));
   } else if (init.orientation &&
-             std::abs(WrapAngle(s0.orientation - *init.orientation)) >
-                 options_.start_orientation_tolerance) {
+             // Unwrapped, as the solution checker's np.allclose compares them: a first state
+             // turned by a whole turn does not start where the problem does.
+             !(std::abs(s0.orientation - *init.orientation) <=
+               options_.start_orientation_tolerance)) {
     fail(FailureKind::kStart, s0.time_step,
          Fmt("starts with orientation %.4f rad, the problem with %.4f rad", s0.orientation,
              *init.orientation));

@@ -284,6 +284,22 @@ TEST_F(CommonRoadCliTest, InfeasibleAtStartIsCountedApart) {
   EXPECT_EQ(blocked.at("infeasible_at_start"), 1);
   EXPECT_EQ(blocked.at("solved"), 0);
   EXPECT_EQ(blocked.at("solved_share"), 0.0);
+
+  // With timing on, a scenario in which no cycle ran writes no computation time (commonroad-io
+  // asserts one above 0), and its file reads back; one that was planned writes its time.
+  const fs::path out = dir_ / "blocked_solutions";
+  CommandResult t = RunFrenetic("commonroad " + (dir_ / "blocked").string() +
+                                " --json --solution-dir " + out.string());
+  ASSERT_EQ(t.exit_code, 0) << t.out;
+  auto blocked_file =
+      commonroad::LoadSolution((out / "solution_KS2:WX1:ZAM_Blocked-2_1_T-1:2020a.xml").string());
+  ASSERT_TRUE(blocked_file.ok()) << blocked_file.message();
+  EXPECT_FALSE(blocked_file->computation_time.has_value());
+  auto planned =
+      commonroad::LoadSolution((out / "solution_KS2:WX1:ZAM_Reach-1_1_T-1:2020a.xml").string());
+  ASSERT_TRUE(planned.ok()) << planned.message();
+  ASSERT_TRUE(planned->computation_time.has_value());
+  EXPECT_GT(*planned->computation_time, 0.0);
 }
 
 TEST_F(CommonRoadCliTest, MalformedFileIsOneLineAndTheOthersStillRun) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -20,19 +21,54 @@ Lanelet Make(int id, std::vector<Vec2> left, std::vector<Vec2> right) {
   return l;
 }
 
-TEST(RoadAreaTest, TwoLanesWithASliverBetweenThemAreOneRoad) {
-  // The left lane's right bound sits 1.5 cm above the right lane's left bound.
-  const std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
-                                      Make(2, Line(0, 100, 3.515), Line(0, 100, 0.015))};
+TEST(RoadAreaTest, AdjacentLanesWithASliverBetweenThemAreOneRoad) {
+  // The left lane's right bound sits 1.5 cm above the right lane's left bound; the lanelets are
+  // adjacent: one lane section, whose outline leaves the lane line out.
+  std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
+                                Make(2, Line(0, 100, 3.515), Line(0, 100, 0.015))};
+  lanes[0].adjacent_left = Adjacent{2, true};
+  lanes[1].adjacent_right = Adjacent{1, true};
   const RoadArea road = RoadArea::Build(lanes);
   EXPECT_EQ(road.PolygonCount(), 1);
   EXPECT_EQ(road.HoleCount(), 0);
   // A car straddling the lane line is on the road.
   EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
-  // Without the tolerance the sliver splits the road.
-  const RoadArea strict = RoadArea::Build(lanes, 0.0);
-  EXPECT_EQ(strict.PolygonCount(), 2);
-  EXPECT_FALSE(strict.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
+  EXPECT_NEAR(road.Area(), 100 * 7.015, 0.01);
+}
+
+TEST(RoadAreaTest, ASliverBetweenLanesThatAreNotAdjacentIsNoRoad) {
+  // The same lanes without adjacency: two sections, and the sliver between them is not road
+  // (CommonRoad's solution checker keeps it as road boundary).
+  const std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
+                                      Make(2, Line(0, 100, 3.515), Line(0, 100, 0.015))};
+  const RoadArea road = RoadArea::Build(lanes);
+  EXPECT_EQ(road.PolygonCount(), 2);
+  EXPECT_FALSE(road.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
+  EXPECT_TRUE(road.ContainsConvex(BoxCorners({50, -1.75}, 0, 4.5, 1.8)));
+  // Closed at both ends, the sliver is a hole: a lane line shared up to x = 20 m and from 80 m,
+  // 5 mm apart between.
+  std::vector<Vec2> line = Line(0, 100, 0);
+  for (Vec2& p : line) {
+    if (p.x > 20 && p.x < 80) p.y = -0.005;
+  }
+  const std::vector<Lanelet> touching = {Make(1, line, Line(0, 100, -3.5)),
+                                         Make(2, Line(0, 100, 3.5), Line(0, 100, 0))};
+  const RoadArea holed = RoadArea::Build(touching);
+  EXPECT_EQ(holed.PolygonCount(), 1);
+  ASSERT_EQ(holed.HoleCount(), 1);
+  EXPECT_FALSE(holed.ContainsConvex(BoxCorners({50, 0}, 0, 4.5, 1.8)));
+  const std::vector<std::vector<Vec2>> holes = holed.HoleRings();
+  ASSERT_EQ(holes.size(), 1u);
+  double lo = 1e9, hi = -1e9;
+  for (const Vec2& p : holes[0]) {
+    lo = std::min(lo, p.x);
+    hi = std::max(hi, p.x);
+  }
+  EXPECT_NEAR(lo, 20, 1e-6);
+  EXPECT_NEAR(hi, 80, 1e-6);
+  EXPECT_TRUE(holed.ContainsConvex(BoxCorners({95, 0}, 0, 4.5, 1.8)));  // where the lanes touch
+  // A tolerance wider than the sliver closes it.
+  EXPECT_EQ(RoadArea::Build(touching, 0.01).HoleCount(), 0);
 }
 
 TEST(RoadAreaTest, TheToleranceIsTheAllowedOverhang) {

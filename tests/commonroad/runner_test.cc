@@ -139,6 +139,33 @@ TEST(RunnerTest, ChangesLanesPastASlowCarIntoAGoalLanelet) {
   EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
 }
 
+// Two lanelets side by side that are not adjacent, their shared line 5 mm apart from x = 20 to
+// 120 m: CommonRoad's solution checker counts that sliver as road boundary (RoadArea), so a lane
+// change into the goal lanelet must cross the line where it is one line, past x = 120 m.
+TEST(RunnerTest, ChangesLanesOnlyWhereTheLanesTouch) {
+  std::vector<Vec2> lane1_left = Line(0, 400, 0);
+  for (Vec2& p : lane1_left) {
+    if (p.x > 20 && p.x < 120) p.y = -0.005;
+  }
+  ScenarioXml xml;
+  xml.Lanelet(Lane(1, lane1_left, Line(0, 400, -3.5)))
+      .Lanelet(Lane(2, Line(0, 400, 3.5), Line(0, 400, 0)))
+      .Problem(1, {10, -1.75}, 0, 15, {GoalLaneletXml(2, 20, 100)});
+  auto sc = ParseScenario(xml.Str(), "test.xml");
+  ASSERT_TRUE(sc.ok()) << sc.message();
+  const VerdictChecker checker(*sc, VehicleParams());
+  ASSERT_EQ(checker.road().HoleCount(), 1);
+  const ProblemRun p = RunOne(xml);
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  // No state's box reaches across the line before x = 120 m (the sliver's end).
+  for (const KsState& s : p.trajectory) {
+    const auto box =
+        BoxCorners({s.x, s.y}, s.orientation, VehicleParams().length, VehicleParams().width);
+    const bool across = std::any_of(box.begin(), box.end(), [](Vec2 c) { return c.y > -0.005; });
+    if (across) EXPECT_GE(s.x, 120.0 - 0.5 * VehicleParams().length) << "step " << s.time_step;
+  }
+}
+
 // A file's own step size: the same scene in seconds at 0.1 s, at 0.05 s (2.5 of the planner's
 // 0.02 s ticks: the ego aims between two points and the path left over keeps its phase) and at
 // 0.04 s. Each is solved, at about the same time, at about the same speeds: a step that is not
@@ -541,6 +568,19 @@ TEST(RunnerTest, ARunEndsAtItsFirstCollision) {
   EXPECT_EQ(p.trajectory.back().time_step, hit->step);
   EXPECT_EQ(static_cast<int>(p.cycles.size()), hit->step);
   EXPECT_LT(hit->step, 40);
+}
+
+// A goal the initial state already meets (here a time-only goal from step 0) ends the run after
+// one driven step: CommonRoad's feasibility check fails on a trajectory of a single state.
+TEST(RunnerTest, AGoalMetAtTheStartStillDrivesOneStep) {
+  ScenarioXml xml;
+  AddStraightRoad(xml, 300).Problem(3, {20, -1.75}, 0, 20, {GoalTimeOnlyXml(0, 30)});
+  const ProblemRun p = RunOne(xml);
+  EXPECT_TRUE(p.verdict.solved) << p.verdict.Summary();
+  EXPECT_EQ(p.stop_reason, "goal");
+  ASSERT_EQ(p.trajectory.size(), 2u);
+  EXPECT_EQ(p.trajectory[1].time_step, p.trajectory[0].time_step + 1);
+  EXPECT_EQ(p.verdict.goal_step, 0);
 }
 
 TEST(RunnerTest, AProblemInfeasibleAtStartIsNotPlanned) {

@@ -99,14 +99,25 @@ TEST(SharedFilesTest, EveryExampleIsReadWithTheExpectedContents) {
         EXPECT_EQ(o.trajectory[i].time_step, static_cast<int>(i) + 1);
       }
     }
-    // The road is one piece without gaps between its lanelets. (With its open ends extended,
-    // DEU_Hhr-1_1's network encloses one area.)
+    // The road is one piece without gaps between its lane sections, but in DEU_Muc-2: its two
+    // lanelets are not adjacent, and their shared line differs by up to 9 mm, which leaves slivers
+    // between them that CommonRoad's solution checker (and RoadArea) count as no road. (With its
+    // open ends extended, DEU_Hhr-1_1's network encloses one area.)
+    const bool gaps = s->benchmark_id.rfind("DEU_Muc-2_", 0) == 0;
     const RoadArea road = RoadArea::Build(s->lanelets);
-    EXPECT_EQ(road.PolygonCount(), 1);
     EXPECT_TRUE(road.SkippedLanelets().empty());
     const RoadArea closed = RoadArea::Build(s->lanelets, RoadArea::kDefaultTolerance, 0.0);
-    EXPECT_EQ(closed.PolygonCount(), 1);
-    EXPECT_EQ(closed.HoleCount(), 0);
+    if (gaps) {
+      EXPECT_GT(closed.HoleCount(), 0);
+      // Grown by a centimetre, the lanelets close the slivers.
+      const RoadArea grown = RoadArea::Build(s->lanelets, 0.01, 0.0);
+      EXPECT_EQ(grown.PolygonCount(), 1);
+      EXPECT_EQ(grown.HoleCount(), 0);
+    } else {
+      EXPECT_EQ(road.PolygonCount(), 1);
+      EXPECT_EQ(closed.PolygonCount(), 1);
+      EXPECT_EQ(closed.HoleCount(), 0);
+    }
     for (const PlanningProblem& p : s->problems) EXPECT_TRUE(road.Contains(p.initial.position));
   }
 }

@@ -492,6 +492,12 @@ TEST(VerdictTest, TheTrajectoryMustStartAtTheInitialState) {
   EXPECT_TRUE(v.solved) << v.Summary();  // within 0.1 m and 2 m/s
   v = CheckTrajectory(s, s.problems[0], VehicleParams(), Drive(Start(10, -1.75, 20, 0.2), 20));
   ASSERT_NE(v.Find(FailureKind::kStart), nullptr) << v.Summary();
+  // A whole turn more is another orientation to the solution checker (np.allclose, unwrapped).
+  std::vector<KsState> turned = Drive(Start(10, -1.75, 20), 20);
+  for (KsState& st : turned) st.orientation += 2 * std::numbers::pi;
+  v = CheckTrajectory(s, s.problems[0], VehicleParams(), turned);
+  ASSERT_NE(v.Find(FailureKind::kStart), nullptr) << v.Summary();
+  EXPECT_EQ(v.Find(FailureKind::kDynamics), nullptr) << v.Summary();
 }
 
 TEST(VerdictTest, BrokenTrajectoriesAreNamedNotCrashedOn) {

@@ -14,7 +14,8 @@
 // circle; a state is kept
 // while the ego's box (grown by `ego_margin`) is clear of every predicted car's box at that step
 // and lies between the road's edges (the planner's road, its ends closed; where a lane begins or
-// ends under the box, also inside the lanelets' own outline: SetRoadArea). It uses what the
+// ends under the box, or where the outline runs inside the edges, also inside the lanelets' own
+// outline: SetRoadArea). It uses what the
 // planner was told and nothing else: the telemetry's futures of the cars (recorded
 // predictions), else each car carried on along the road at its speed, a car moving across it
 // faster than `lateral_threshold` into the next lane's centre as the planner's predictor has it
@@ -192,7 +193,11 @@ class Rescue {
   // of the road begins or ends within 5 m of the ego's box along the road. The road's lane
   // begins and ends at one station, while a lanelet's first or last edge may lie slanted across
   // the road: a box over the lane's first metres can be between the lane's borders and still
-  // stick out of the lanelets (US-101's merging lanes). Elsewhere the borders are the lanelets'.
+  // stick out of the lanelets (US-101's merging lanes). It is checked too wherever a segment of
+  // the outline lies more than 5 cm inside the road's borders (found once, here): a sliver
+  // between two lanelets that are not adjacent, which the solution checker counts as road
+  // boundary (DEU_Muc-2: a lane change must cross where the lanes touch), or the wedge where a
+  // ramp leaves the lane beside it. Elsewhere the borders are the lanelets'.
   // nullptr (the default): the road's borders only.
   void SetRoadArea(const RoadArea* area);
 
@@ -298,6 +303,10 @@ class Rescue {
   const map::Road& road_;
   const RoadArea* area_ = nullptr;
   std::vector<double> lane_ends_;  // s of every lane's begin and end, sorted (SetRoadArea)
+  // [s_lo, s_hi] along the line of every stretch where the road area's boundary runs inside the
+  // road's edges (a gap between lanelets that are not adjacent, a wedge where a ramp leaves the
+  // lane beside it), merged and sorted (SetRoadArea): there a box is checked against the area.
+  std::vector<std::pair<double, double>> interior_;
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;

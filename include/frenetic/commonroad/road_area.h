@@ -1,16 +1,21 @@
 // The drivable area of a lanelet network, for CommonRoad's road-compliance check ("the ego does
 // not leave the lanelets").
 //
-// The area is the union of every lanelet's polygon, both driving directions: CommonRoad's
-// solution checker (commonroad_dc.feasibility.solution_checker.boundary_collision) builds its road
-// boundary from the hull of all lanelets of the network (commonroad_dc.boundary.construction,
-// lanelet_bounds.lateral_bounds follows adjacency either way), so an oncoming lane is road too.
+// The area is built as CommonRoad's solution checker builds its road (commonroad_dc.feasibility.
+// solution_checker._construct_boundary_checker: construction.construct with section_triangles
+// and triangulation; lanelet_bounds.lane_sections and lane_hull): the union of the outlines of
+// the lane sections, a section being a lanelet with every lanelet it reaches through adjacentLeft
+// and adjacentRight, either driving direction (so an oncoming lane is road too). The lane lines
+// inside a section do not count: where adjacent lanelets do not give their shared bound point for
+// point (the US-101 examples), the slivers between them are road. Between lanelets that are not
+// adjacent, they are not: the checker's triangulation keeps a sliver between two sections as
+// road boundary, and so does this area (DEU_Muc-2's two lanelets, whose shared line differs by up
+// to 9 mm, and which a lane change there crosses). A section whose outline is no simple polygon
+// falls back to its lanelets' own polygons.
 //
-// Each polygon is grown by `tolerance` before the union (Boost.Geometry buffer, mitred joins), and
-// holes smaller than 1 m^2 are dropped from the union: adjacent lanelets whose shared bound is not
-// given point for point leave slivers up to ~2 cm wide between them (the US-101 and DEU_Muc
-// examples), and a car straddling the lane line there is on the road. So a box counts as on the
-// road when it sticks out over the road's edge by at most `tolerance`.
+// Each outline is grown by `tolerance` before the union (Boost.Geometry buffer, mitred joins),
+// 1 micrometre by default: shared points that differ only by rounding leave no gap; the checker
+// has no tolerance. Holes smaller than 1e-9 m^2 (rounding) are dropped.
 //
 // Ends: by default the network's ends are closed, as in CommonRoad's solution checker, whose road
 // boundary is the outline of the lanelet network (the triangulated boundary closes the ends): a
@@ -22,6 +27,7 @@
 
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "frenetic/commonroad/geometry.h"
 #include "frenetic/commonroad/lanelet.h"
@@ -30,7 +36,7 @@ namespace frenetic::commonroad {
 
 class RoadArea {
  public:
-  static constexpr double kDefaultTolerance = 0.02;      // m
+  static constexpr double kDefaultTolerance = 1e-6;      // m
   static constexpr double kDefaultOpenEndMargin = 0.0;   // m: closed ends
 
   // An empty area (contains nothing).
@@ -54,6 +60,11 @@ class RoadArea {
   double Area() const;        // m^2
   int PolygonCount() const;   // separate pieces
   int HoleCount() const;
+  // The holes' rings (closed, the first point repeated last): gaps of the network inside its
+  // outline, such as a sliver between two lanelets that are not adjacent.
+  std::vector<std::vector<Vec2>> HoleRings() const;
+  // Every ring of the area's boundary, outlines and holes (closed).
+  std::vector<std::vector<Vec2>> BoundaryRings() const;
   double tolerance() const { return tolerance_; }
   std::span<const int> SkippedLanelets() const;
 
