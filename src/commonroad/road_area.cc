@@ -104,15 +104,21 @@ std::vector<Section> SectionRings(std::span<const Lanelet> lanelets) {
     const Lanelet* current = &*it;
     std::vector<int> members{it->id};
     bool direction = true;  // whether `current` is driven as the first lanelet is
-    // To the rightmost lanelet.
-    for (int n = 0; n < limit; ++n) {
+    // One lanelet to the right (or left), seen in the first lanelet's driving direction; false
+    // when there is none.
+    const auto step = [&](bool rightward) {
       const std::optional<Adjacent>& a =
-          direction ? current->adjacent_right : current->adjacent_left;
+          direction == rightward ? current->adjacent_right : current->adjacent_left;
       const Lanelet* next = find(a);
-      if (next == nullptr) break;
+      if (next == nullptr) return false;
       direction = direction == a->same_direction;
       current = next;
       members.push_back(current->id);
+      return true;
+    };
+    // To the rightmost lanelet.
+    for (int n = 0; n < limit; ++n) {
+      if (!step(true)) break;
     }
     const auto bounds_of = [](const Lanelet* l) {
       return std::make_pair(CleanPolyline(l->left), CleanPolyline(l->right));
@@ -134,15 +140,8 @@ std::vector<Section> SectionRings(std::span<const Lanelet> lanelets) {
     add_across(left0, right0, direction, true);
     // Leftward to the leftmost lanelet.
     bool ok = true;
-    for (int n = 0; n < limit; ++n) {
-      const std::optional<Adjacent>& a =
-          direction ? current->adjacent_left : current->adjacent_right;
-      const Lanelet* next = find(a);
-      if (next == nullptr) break;
-      direction = direction == a->same_direction;
-      current = next;
+    for (int n = 0; n < limit && step(false); ++n) {
       met.insert(current->id);
-      members.push_back(current->id);
       auto [l, r] = bounds_of(current);
       if (l.empty() || r.empty()) {
         ok = false;
