@@ -156,5 +156,34 @@ TEST(RoadAreaTest, DegenerateInputDoesNotBreakIt) {
   EXPECT_FALSE(RoadArea::Build(lane).ContainsConvex(BoxCorners({std::nan(""), 0}, 0, 4, 2)));
 }
 
+// Adjacency that loops, points at itself or at a lanelet that is not there, flips direction, or
+// joins a lanelet whose bound is not finite: the walk over the sections ends, and the area is
+// still the lanelets' (a section that cannot be outlined falls back to its lanelets' polygons).
+TEST(RoadAreaTest, HostileAdjacencyEndsAndKeepsTheLanelets) {
+  std::vector<Lanelet> lanes = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
+                                Make(2, Line(0, 100, 3.5), Line(0, 100, 0)),
+                                Make(3, Line(0, 100, 7), Line(0, 100, 3.5))};
+  lanes[0].adjacent_left = Adjacent{2, true};
+  lanes[1].adjacent_left = Adjacent{3, true};
+  lanes[2].adjacent_left = Adjacent{1, true};  // a cycle
+  lanes[0].adjacent_right = Adjacent{1, true};  // itself
+  lanes[1].adjacent_right = Adjacent{99, false};  // not there
+  const RoadArea looped = RoadArea::Build(lanes);
+  EXPECT_TRUE(looped.SkippedLanelets().empty());
+  for (const double y : {-1.75, 1.75, 5.25}) {
+    EXPECT_TRUE(looped.ContainsConvex(BoxCorners({50, y}, 0, 4.5, 1.8))) << y;
+  }
+  EXPECT_FALSE(looped.Contains({50, 8}));
+  // A lanelet with a point that is not finite, adjacent to a sound one.
+  std::vector<Lanelet> broken = {Make(1, Line(0, 100, 0), Line(0, 100, -3.5)),
+                                 Make(2, {{0, 3.5}, {50, std::nan("")}, {100, 3.5}},
+                                      Line(0, 100, 0))};
+  broken[0].adjacent_left = Adjacent{2, true};
+  broken[1].adjacent_right = Adjacent{1, false};  // and its direction flipped
+  const RoadArea area = RoadArea::Build(broken);
+  EXPECT_TRUE(area.ContainsConvex(BoxCorners({50, -1.75}, 0, 4.5, 1.8)));
+  EXPECT_EQ(area.SkippedLanelets().size(), 1u);
+}
+
 }  // namespace
 }  // namespace frenetic::commonroad
