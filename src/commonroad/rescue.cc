@@ -279,25 +279,24 @@ bool Rescue::Clear(const KsState& s, int k, double s_hint, map::FrenetPoint* at)
 
 void Rescue::SetRoadArea(const RoadArea* area) {
   area_ = area;
-  lane_ends_.clear();
-  interior_.clear();
+  area_stretches_.clear();
   if (area_ == nullptr) return;
+  // The stretches along the line where the box is checked against the area: every lane's begin
+  // and end (a point), and wherever a boundary segment of the area lies more than kInside inside
+  // the edges, where the edges alone do not tell the area's inside.
+  std::vector<std::pair<double, double>> spans;
   for (int l = 0; l < road_.num_lanes(); ++l) {
     for (const double end : {road_.LaneBegin(l), road_.LaneEnd(l)}) {
-      if (std::isfinite(end)) lane_ends_.push_back(end);
+      if (std::isfinite(end)) spans.emplace_back(end, end);
     }
   }
-  std::sort(lane_ends_.begin(), lane_ends_.end());
-  // Where a boundary segment of the area lies inside the edges (by more than kInside), the edges
-  // alone do not tell the area's inside.
   constexpr double kInside = 0.05;  // m
   const map::ReferenceLine& line = road_.line();
-  std::vector<std::pair<double, double>> spans;
   for (const std::vector<Vec2>& ring : area_->BoundaryRings()) {
     double s_prev = std::numeric_limits<double>::quiet_NaN();
     bool inside_prev = false;
-    for (size_t i = 0; i < ring.size(); ++i) {
-      const map::FrenetPoint fe = line.ToFrenet(ring[i].x, ring[i].y, s_prev);
+    for (const Vec2& p : ring) {
+      const map::FrenetPoint fe = line.ToFrenet(p.x, p.y, s_prev);
       if (!std::isfinite(fe.s) || !std::isfinite(fe.d)) {
         s_prev = std::numeric_limits<double>::quiet_NaN();
         inside_prev = false;
@@ -305,29 +304,27 @@ void Rescue::SetRoadArea(const RoadArea* area) {
       }
       const map::Road::Span e = road_.EdgesAt(fe.s);
       const bool inside = e.exists && fe.d > e.left + kInside && fe.d < e.right - kInside;
-      if (inside || inside_prev) {
-        const double lo = std::isfinite(s_prev) ? std::min(s_prev, fe.s) : fe.s;
-        const double hi = std::isfinite(s_prev) ? std::max(s_prev, fe.s) : fe.s;
-        spans.emplace_back(lo, hi);
+      if (inside || inside_prev) {  // the segment from the last point, or this point
+        spans.emplace_back(std::isfinite(s_prev) ? std::min(s_prev, fe.s) : fe.s,
+                           std::isfinite(s_prev) ? std::max(s_prev, fe.s) : fe.s);
       }
       s_prev = fe.s;
       inside_prev = inside;
     }
   }
+  // Merged (a gap under 1 m changes no answer: OnRoad asks about at least 10 m).
   std::sort(spans.begin(), spans.end());
-  interior_.clear();
   for (const auto& [lo, hi] : spans) {
-    if (!interior_.empty() && lo <= interior_.back().second + 1.0) {
-      interior_.back().second = std::max(interior_.back().second, hi);
+    if (!area_stretches_.empty() && lo <= area_stretches_.back().second + 1.0) {
+      area_stretches_.back().second = std::max(area_stretches_.back().second, hi);
     } else {
-      interior_.emplace_back(lo, hi);
+      area_stretches_.emplace_back(lo, hi);
     }
   }
   double length = 0;
-  for (const auto& [lo, hi] : interior_) length += hi - lo;
-  spdlog::debug(
-      "rescue: the road area's boundary lies inside the edges over {} stretches, {:.1f} m",
-      interior_.size(), length);
+  for (const auto& [lo, hi] : area_stretches_) length += hi - lo;
+  spdlog::debug("rescue: the box is checked against the road area over {} stretches, {:.1f} m",
+                area_stretches_.size(), length);
 }
 
 bool Rescue::OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const {
@@ -343,16 +340,13 @@ bool Rescue::OnRoad(const KsState& s, double s_hint, map::FrenetPoint* at) const
     if (!e.exists || fe.d - across < e.left || fe.d + across > e.right) return false;
   }
   // Between the borders: off the lanelets only where a lane's end edge may lie slanted under the
-  // box, and there only if the outline's boundary crosses it (inside the borders, the box is not
-  // wholly outside the lanelets).
-  const auto end = std::lower_bound(lane_ends_.begin(), lane_ends_.end(), fe.s - along - kEndReach);
-  bool near = end != lane_ends_.end() && *end <= fe.s + along + kEndReach;
-  // Where the area's boundary runs inside the edges too (interior_: few stretches, sorted).
-  for (size_t i = 0;
-       !near && i < interior_.size() && interior_[i].first <= fe.s + along + kEndReach; ++i) {
-    near = interior_[i].second >= fe.s - along - kEndReach;
-  }
-  if (near) {
+  // box or the outline runs inside the borders (area_stretches_, within kEndReach), and there
+  // only if the outline's boundary crosses it (inside the borders, the box is not wholly outside
+  // the lanelets).
+  const double lo = fe.s - along - kEndReach, hi = fe.s + along + kEndReach;
+  const auto stretch = std::lower_bound(area_stretches_.begin(), area_stretches_.end(), lo,
+                                        [](const auto& c, double v) { return c.second < v; });
+  if (stretch != area_stretches_.end() && stretch->first <= hi) {
     const auto corners = BoxCorners({s.x, s.y}, s.orientation, 2 * hl, 2 * hw);
     return !area_->BoundaryTouches(corners);
   }

@@ -162,7 +162,9 @@ TEST(RunnerTest, ChangesLanesOnlyWhereTheLanesTouch) {
     const auto box =
         BoxCorners({s.x, s.y}, s.orientation, VehicleParams().length, VehicleParams().width);
     const bool across = std::any_of(box.begin(), box.end(), [](Vec2 c) { return c.y > -0.005; });
-    if (across) EXPECT_GE(s.x, 120.0 - 0.5 * VehicleParams().length) << "step " << s.time_step;
+    if (across) {
+      EXPECT_GE(s.x, 120.0 - 0.5 * VehicleParams().length) << "step " << s.time_step;
+    }
   }
 }
 

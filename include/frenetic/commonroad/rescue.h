@@ -302,11 +302,11 @@ class Rescue {
 
   const map::Road& road_;
   const RoadArea* area_ = nullptr;
-  std::vector<double> lane_ends_;  // s of every lane's begin and end, sorted (SetRoadArea)
-  // [s_lo, s_hi] along the line of every stretch where the road area's boundary runs inside the
-  // road's edges (a gap between lanelets that are not adjacent, a wedge where a ramp leaves the
-  // lane beside it), merged and sorted (SetRoadArea): there a box is checked against the area.
-  std::vector<std::pair<double, double>> interior_;
+  // [s_lo, s_hi] along the line where a box is checked against the road area (SetRoadArea): every
+  // lane's begin and end, and where the area's boundary runs inside the road's edges (a gap
+  // between lanelets that are not adjacent, a wedge where a ramp leaves the lane beside it);
+  // merged, disjoint and sorted.
+  std::vector<std::pair<double, double>> area_stretches_;
   VehicleParams vehicle_;
   double dt_;
   RescueOptions options_;
